@@ -1,0 +1,29 @@
+# Every dependency comes from a Debian package (scripts/install-deps.sh) and is found here,
+# once, for the whole build. Each library links only what it includes.
+find_package(Threads REQUIRED)
+find_package(PkgConfig REQUIRED)
+# Debian's OpenSubdivConfig.cmake names static libraries the package does not ship, so the
+# shared CPU library is located directly.
+find_path(OPENSUBDIV_INCLUDE_DIR opensubdiv/far/topologyRefiner.h REQUIRED)
+find_library(OPENSUBDIV_CPU_LIBRARY NAMES osdCPU REQUIRED)
+add_library(OpenSubdiv::osdCPU UNKNOWN IMPORTED)
+set_target_properties(OpenSubdiv::osdCPU PROPERTIES
+  IMPORTED_LOCATION ${OPENSUBDIV_CPU_LIBRARY}
+  INTERFACE_INCLUDE_DIRECTORIES ${OPENSUBDIV_INCLUDE_DIR})
+find_package(embree 3 REQUIRED CONFIG)
+find_package(TBB REQUIRED CONFIG)
+find_package(FastFloat REQUIRED CONFIG)
+find_package(CLI11 REQUIRED CONFIG)
+find_package(fmt REQUIRED CONFIG)
+find_package(spdlog REQUIRED CONFIG)
+find_package(nlohmann_json 3 REQUIRED CONFIG)
+find_package(PNG REQUIRED)
+find_package(ZLIB REQUIRED)
+pkg_check_modules(LIBDEFLATE REQUIRED IMPORTED_TARGET libdeflate)
+pkg_check_modules(FFTW3F REQUIRED IMPORTED_TARGET fftw3f)
+if(DISPEX_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(DISPEX_BUILD_BENCH)
+  find_package(benchmark REQUIRED)
+endif()

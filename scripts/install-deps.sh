@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs the Debian packages dispex builds against. Idempotent: quiet and quick when
+# everything is already there. Uses sudo only when not root; never prompts.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config git
+  libosd-dev libembree-dev libtbb-dev
+  libdeflate-dev zlib1g-dev libfftw3-dev
+  libfast-float-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev
+  libpng-dev libgtest-dev libgmock-dev libbenchmark-dev
+)
+if [[ "${DISPEX_WITH_FUZZ:-0}" == 1 ]]; then
+  packages+=(clang libclang-rt-14-dev)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+[[ ${#missing[@]} -eq 0 ]] && exit 0
+
+if [[ $(id -u) -eq 0 ]]; then sudo=(); else sudo=(sudo); fi
+echo "install-deps: installing ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+"${sudo[@]}" apt-get update -qq
+"${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

@@ -1,0 +1,160 @@
+#include "core/atomic_output.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <utility>
+
+namespace dispex {
+
+namespace {
+
+// Temporary paths of live outputs, kept in fixed storage so a signal handler can read them
+// without locks or allocation.
+constexpr int kMaxLiveOutputs = 16;
+constexpr std::size_t kMaxPath = 4096;
+struct LiveSlot {
+  std::atomic<bool> used{false};
+  std::atomic<bool> ready{false};
+  char path[kMaxPath];
+};
+std::array<LiveSlot, kMaxLiveOutputs> g_live;
+
+int RegisterLive(const std::string& path) {
+  if (path.size() >= kMaxPath) return -1;
+  for (int i = 0; i < kMaxLiveOutputs; ++i) {
+    bool expected = false;
+    if (g_live[i].used.compare_exchange_strong(expected, true)) {
+      std::memcpy(g_live[i].path, path.c_str(), path.size() + 1);
+      g_live[i].ready.store(true);
+      return i;
+    }
+  }
+  return -1;
+}
+
+void UnregisterLive(int slot) {
+  if (slot < 0) return;
+  g_live[slot].ready.store(false);
+  g_live[slot].used.store(false);
+}
+
+std::string ErrnoText(int err) { return std::strerror(err); }
+
+}  // namespace
+
+void RemoveTemporaryOutputs() noexcept {
+  for (auto& slot : g_live) {
+    if (slot.ready.load()) ::unlink(slot.path);
+  }
+}
+
+StatusOr<AtomicOutput> AtomicOutput::Create(const std::string& target) {
+  namespace fs = std::filesystem;
+  if (target.empty()) return Status::Error("empty output file name");
+  std::error_code ec;
+  fs::path path(target);
+  if (fs::is_directory(path, ec)) return Status::Error(target + ": is a directory");
+  fs::path dir = path.parent_path();
+  if (dir.empty()) dir = ".";
+  if (!fs::exists(dir, ec)) {
+    return Status::Error(target + ": output directory " + dir.string() + " does not exist");
+  }
+  if (!fs::is_directory(dir, ec)) {
+    return Status::Error(target + ": " + dir.string() + " is not a directory");
+  }
+  std::string pattern = target + ".tmp.XXXXXX";
+  std::string buffer = pattern;
+  int fd = ::mkstemp(buffer.data());
+  if (fd < 0) {
+    return Status::Error(target + ": cannot create output in " + dir.string() + ": " +
+                         ErrnoText(errno));
+  }
+  ::fchmod(fd, 0644 & ~[] {
+    mode_t m = ::umask(0);
+    ::umask(m);
+    return m;
+  }());
+  AtomicOutput out;
+  out.target_ = target;
+  out.temp_ = buffer;
+  out.fd_ = fd;
+  out.slot_ = RegisterLive(buffer);
+  return out;
+}
+
+AtomicOutput::AtomicOutput(AtomicOutput&& other) noexcept
+    : target_(std::move(other.target_)),
+      temp_(std::move(other.temp_)),
+      fd_(std::exchange(other.fd_, -1)),
+      slot_(std::exchange(other.slot_, -1)),
+      written_(std::exchange(other.written_, 0)) {}
+
+AtomicOutput& AtomicOutput::operator=(AtomicOutput&& other) noexcept {
+  if (this != &other) {
+    Abandon();
+    target_ = std::move(other.target_);
+    temp_ = std::move(other.temp_);
+    fd_ = std::exchange(other.fd_, -1);
+    slot_ = std::exchange(other.slot_, -1);
+    written_ = std::exchange(other.written_, 0);
+  }
+  return *this;
+}
+
+AtomicOutput::~AtomicOutput() { Abandon(); }
+
+Status AtomicOutput::Write(const void* data, std::size_t size) {
+  if (fd_ < 0) return Status::Error(target_ + ": output is closed");
+  const char* p = static_cast<const char*>(data);
+  while (size > 0) {
+    ssize_t n = ::write(fd_, p, size);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return Status::Error(target_ + ": write failed: " + ErrnoText(errno));
+    }
+    p += n;
+    size -= static_cast<std::size_t>(n);
+    written_ += static_cast<std::size_t>(n);
+  }
+  return Status::Ok();
+}
+
+Status AtomicOutput::Commit() {
+  if (fd_ < 0) return Status::Error(target_ + ": output is closed");
+  if (::fsync(fd_) != 0 && errno != EINVAL) {
+    return Status::Error(target_ + ": flush failed: " + ErrnoText(errno));
+  }
+  if (::close(std::exchange(fd_, -1)) != 0) {
+    return Status::Error(target_ + ": close failed: " + ErrnoText(errno));
+  }
+  if (::rename(temp_.c_str(), target_.c_str()) != 0) {
+    return Status::Error(target_ + ": cannot rename temporary file: " + ErrnoText(errno));
+  }
+  UnregisterLive(std::exchange(slot_, -1));
+  temp_.clear();
+  return Status::Ok();
+}
+
+void AtomicOutput::Abandon() {
+  if (fd_ >= 0) ::close(std::exchange(fd_, -1));
+  if (!temp_.empty()) {
+    ::unlink(temp_.c_str());
+    temp_.clear();
+  }
+  UnregisterLive(std::exchange(slot_, -1));
+}
+
+Status WriteFileAtomically(const std::string& target, const void* data, std::size_t size) {
+  DISPEX_ASSIGN_OR_RETURN(AtomicOutput out, AtomicOutput::Create(target));
+  DISPEX_RETURN_IF_ERROR(out.Write(data, size));
+  return out.Commit();
+}
+
+}  // namespace dispex

@@ -1,0 +1,54 @@
+// Output files that appear whole or not at all.
+//
+// AtomicOutput writes to a temporary file beside the target ("<target>.tmp.XXXXXX") and
+// renames it over the target on Commit(). Destroying it without Commit(), an error, or a
+// signal (see RemoveTemporaryOutputs) removes the temporary file and leaves any existing
+// target untouched, so a renderer never reads a half-written map.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "dispex/status.h"
+
+namespace dispex {
+
+class AtomicOutput {
+ public:
+  // Fails with a clear message if the directory is missing or not writable, or the target
+  // is a directory.
+  static StatusOr<AtomicOutput> Create(const std::string& target);
+
+  AtomicOutput() = default;
+  AtomicOutput(AtomicOutput&& other) noexcept;
+  AtomicOutput& operator=(AtomicOutput&& other) noexcept;
+  AtomicOutput(const AtomicOutput&) = delete;
+  AtomicOutput& operator=(const AtomicOutput&) = delete;
+  ~AtomicOutput();
+
+  Status Write(const void* data, std::size_t size);
+  // Flushes, closes and renames the temporary file onto the target.
+  Status Commit();
+  // Closes and removes the temporary file (also done by the destructor).
+  void Abandon();
+
+  const std::string& target() const { return target_; }
+  const std::string& temp_path() const { return temp_; }
+  std::size_t bytes_written() const { return written_; }
+
+ private:
+  std::string target_;
+  std::string temp_;
+  int fd_ = -1;
+  int slot_ = -1;
+  std::size_t written_ = 0;
+};
+
+// Writes `size` bytes to `target` atomically.
+Status WriteFileAtomically(const std::string& target, const void* data, std::size_t size);
+
+// Unlinks every temporary file of live AtomicOutputs. Async-signal-safe: a SIGINT/SIGTERM
+// handler calls it before exiting.
+void RemoveTemporaryOutputs() noexcept;
+
+}  // namespace dispex

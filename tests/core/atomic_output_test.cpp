@@ -1,0 +1,88 @@
+#include "core/atomic_output.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace dispex {
+namespace {
+
+namespace fs = std::filesystem;
+
+class AtomicOutputTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("dispex_atomic_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  static std::string Slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+  std::size_t FileCount() const {
+    return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir_), {}));
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(AtomicOutputTest, CommitReplacesTarget) {
+  fs::path target = dir_ / "map.ptx";
+  std::ofstream(target) << "old";
+  auto out = AtomicOutput::Create(target.string());
+  ASSERT_TRUE(out.ok()) << out.status().message();
+  ASSERT_TRUE(out->Write("new data", 8).ok());
+  EXPECT_EQ(Slurp(target), "old");  // untouched until the commit
+  EXPECT_EQ(FileCount(), 2u);
+  ASSERT_TRUE(out->Commit().ok());
+  EXPECT_EQ(Slurp(target), "new data");
+  EXPECT_EQ(FileCount(), 1u);
+}
+
+TEST_F(AtomicOutputTest, AbandonLeavesNothing) {
+  fs::path target = dir_ / "map.ptx";
+  {
+    auto out = AtomicOutput::Create(target.string());
+    ASSERT_TRUE(out.ok());
+    ASSERT_TRUE(out->Write("partial", 7).ok());
+  }
+  EXPECT_FALSE(fs::exists(target));
+  EXPECT_EQ(FileCount(), 0u);
+}
+
+TEST_F(AtomicOutputTest, SignalCleanupRemovesTemporaries) {
+  fs::path target = dir_ / "map.ptx";
+  auto out = AtomicOutput::Create(target.string());
+  ASSERT_TRUE(out.ok());
+  EXPECT_TRUE(fs::exists(out->temp_path()));
+  RemoveTemporaryOutputs();
+  EXPECT_FALSE(fs::exists(out->temp_path()));
+}
+
+TEST_F(AtomicOutputTest, MissingDirectoryIsAClearError) {
+  auto out = AtomicOutput::Create((dir_ / "nope" / "map.ptx").string());
+  ASSERT_FALSE(out.ok());
+  EXPECT_NE(out.status().message().find("does not exist"), std::string::npos);
+  auto dir = AtomicOutput::Create(dir_.string());
+  ASSERT_FALSE(dir.ok());
+  EXPECT_NE(dir.status().message().find("is a directory"), std::string::npos);
+}
+
+TEST_F(AtomicOutputTest, WriteFileAtomically) {
+  fs::path target = dir_ / "a.txt";
+  ASSERT_TRUE(WriteFileAtomically(target.string(), "abc", 3).ok());
+  EXPECT_EQ(Slurp(target), "abc");
+}
+
+}  // namespace
+}  // namespace dispex

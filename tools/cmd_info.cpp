@@ -1,0 +1,41 @@
+#include <fstream>
+
+#include "command.h"
+#include "core/mapped_file.h"
+#include "info.h"
+
+namespace dispex::cli {
+namespace {
+
+bool LooksLikePtex(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[4] = {};
+  in.read(magic, 4);
+  return in.gcount() == 4 && magic[0] == 'P' && magic[1] == 't' && magic[2] == 'e' &&
+         magic[3] == 'x';
+}
+
+void SetupInfo(CLI::App& app, int& exit_code) {
+  auto options = std::make_shared<InfoOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "info", "Summarise a mesh (OBJ, PLY) or a Ptex file: counts, tags, bounds, warnings");
+  cmd->add_option("file", options->path, "mesh (.obj, .ply) or Ptex (.ptx) file")->required();
+  cmd->add_flag("--json", options->json, "print a machine-readable JSON summary");
+  cmd->add_flag("--faces", options->faces, "Ptex: one line per face");
+  cmd->add_option("--dump", options->dump_face, "Ptex: print the texels of this face id");
+  cmd->add_flag("--strict", options->strict, "mesh: treat validation warnings as errors");
+  cmd->callback([options, &exit_code] {
+    Status readable = CheckReadableFile(options->path);
+    if (!readable.ok()) {
+      exit_code = ReportFailure(readable);
+      return;
+    }
+    exit_code = LooksLikePtex(options->path) ? PtexInfo(*options) : MeshInfo(*options);
+  });
+}
+
+}  // namespace
+
+DISPEX_REGISTER_COMMAND(10, SetupInfo);
+
+}  // namespace dispex::cli

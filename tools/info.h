@@ -1,0 +1,20 @@
+// `dispex info FILE`: a summary of a mesh (OBJ, PLY) or a Ptex file, chosen by content.
+#pragma once
+
+#include <string>
+
+namespace dispex::cli {
+
+struct InfoOptions {
+  std::string path;
+  bool json = false;    // machine-readable summary on stdout
+  bool faces = false;   // Ptex: one line per face
+  int dump_face = -1;   // Ptex: print the texels of this face
+  bool strict = false;  // mesh: validation warnings are errors
+};
+
+// Each returns the process exit code and prints to stdout (errors on stderr).
+int MeshInfo(const InfoOptions& options);
+int PtexInfo(const InfoOptions& options);
+
+}  // namespace dispex::cli

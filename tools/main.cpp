@@ -1,0 +1,65 @@
+// dispex: extract displacement maps from sculpts. This file only dispatches to the
+// subcommands (cmd_*.cpp); the work happens in the library.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <utility>
+#include <vector>
+
+#include "command.h"
+#include "dispex/version.h"
+
+namespace dispex::cli {
+namespace {
+std::vector<std::pair<int, CommandSetup>>& Registry() {
+  static std::vector<std::pair<int, CommandSetup>> registry;
+  return registry;
+}
+}  // namespace
+
+CommandRegistration::CommandRegistration(int order, CommandSetup setup) {
+  Registry().emplace_back(order, setup);
+}
+
+int ReportFailure(const Status& status, int exit_code) {
+  std::fprintf(stderr, "dispex: %s\n", status.message().c_str());
+  return exit_code;
+}
+
+bool StderrIsInteractive() {
+  const char* ci = std::getenv("CI");
+  if (ci && *ci && std::string(ci) != "false" && std::string(ci) != "0") return false;
+  return ::isatty(STDERR_FILENO) == 1;
+}
+
+}  // namespace dispex::cli
+
+int main(int argc, char** argv) {
+  using namespace dispex::cli;
+  CLI::App app{"dispex " DISPEX_VERSION_STRING
+               ": displacement maps (Ptex) from a Catmull-Clark base mesh and its sculpt"};
+  app.set_version_flag("--version", DISPEX_VERSION_STRING);
+  app.require_subcommand(1);
+  int exit_code = 0;
+  auto registry = Registry();
+  std::stable_sort(registry.begin(), registry.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [order, setup] : registry) setup(app, exit_code);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::string what = e.what();
+    std::replace(what.begin(), what.end(), '\n', ' ');
+    std::fprintf(stderr, "dispex: %s (see dispex --help)\n", what.c_str());
+    return 2;
+  }
+  return exit_code;
+}
