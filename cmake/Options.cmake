@@ -1,7 +1,7 @@
 # dispex_warnings: the warning set every dispex target compiles with.
 add_library(dispex_warnings INTERFACE)
 target_compile_options(dispex_warnings INTERFACE -Wall -Wextra -Wpedantic -Wshadow
-  -Wnon-virtual-dtor -Wcast-align -Wunused -Woverloaded-virtual -Wnull-dereference
+  -Wnon-virtual-dtor -Wcast-align -Wunused -Woverloaded-virtual
   -Wimplicit-fallthrough)
 if(DISPEX_WERROR)
   target_compile_options(dispex_warnings INTERFACE -Werror)

@@ -1,0 +1,88 @@
+// Options of the per-face resolution choice, and the totals over faces.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "dispex/spectral.h"
+
+namespace dispex {
+
+std::string_view ResolutionRuleName(ResolutionRule rule) {
+  switch (rule) {
+    case ResolutionRule::kErrorBound:
+      return "bound";
+    case ResolutionRule::kNonzero:
+      return "nonzero";
+    case ResolutionRule::kFixed:
+      return "fixed";
+  }
+  return "unknown";
+}
+
+StatusOr<ResolutionRule> ParseResolutionRule(std::string_view name) {
+  for (ResolutionRule rule :
+       {ResolutionRule::kErrorBound, ResolutionRule::kNonzero, ResolutionRule::kFixed}) {
+    if (name == ResolutionRuleName(rule)) return rule;
+  }
+  return Status::Error(
+      fmt::format("unknown resolution rule '{}' (expected bound, nonzero or fixed)", name));
+}
+
+Status ValidateSpectralOptions(const SpectralOptions& options) {
+  switch (options.rule) {
+    case ResolutionRule::kErrorBound:
+    case ResolutionRule::kNonzero:
+    case ResolutionRule::kFixed:
+      break;
+    default:
+      return Status::Error(fmt::format("resolution rule {} is not one of bound, nonzero, fixed",
+                                       static_cast<int>(options.rule)));
+  }
+  if (!std::isfinite(options.tolerance) || options.tolerance < 0) {
+    return Status::Error(
+        fmt::format("tolerance {} must be finite and >= 0 (object units)", options.tolerance));
+  }
+  if (!std::isfinite(options.nonzero_threshold) || options.nonzero_threshold < 0) {
+    return Status::Error(
+        fmt::format("nonzero threshold {} must be finite and >= 0", options.nonzero_threshold));
+  }
+  for (int l : {options.fixed_ulog2, options.fixed_vlog2}) {
+    if (l < 0 || l > kMaxSpectralLog2) {
+      return Status::Error(fmt::format("fixed resolution log2 {} x {}: {} is outside 0..{}",
+                                       options.fixed_ulog2, options.fixed_vlog2, l,
+                                       kMaxSpectralLog2));
+    }
+  }
+  return Status::Ok();
+}
+
+void SpectralTotals::Add(const SpectralFaceStats& face, int ulog2, int vlog2) {
+  ++faces;
+  constant_faces += face.constant ? 1 : 0;
+  stepped_up_faces += face.step_ups > 0 ? 1 : 0;
+  step_ups += face.step_ups;
+  texels_before += face.texels_before;
+  texels_after += face.texels_after;
+  max_bound = std::max(max_bound, face.bound);
+  max_measured_error = std::max(max_measured_error, face.measured_error);
+  ++ulog2_faces[std::clamp(ulog2, 0, kMaxSpectralLog2)];
+  ++vlog2_faces[std::clamp(vlog2, 0, kMaxSpectralLog2)];
+}
+
+void SpectralTotals::Merge(const SpectralTotals& other) {
+  faces += other.faces;
+  constant_faces += other.constant_faces;
+  stepped_up_faces += other.stepped_up_faces;
+  step_ups += other.step_ups;
+  texels_before += other.texels_before;
+  texels_after += other.texels_after;
+  max_bound = std::max(max_bound, other.max_bound);
+  max_measured_error = std::max(max_measured_error, other.max_measured_error);
+  for (int l = 0; l <= kMaxSpectralLog2; ++l) {
+    ulog2_faces[l] += other.ulog2_faces[l];
+    vlog2_faces[l] += other.vlog2_faces[l];
+  }
+}
+
+}  // namespace dispex
