@@ -6,9 +6,11 @@
 // winding of the file (counter-clockwise = outward).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "dispex/ids.h"
@@ -72,12 +74,50 @@ struct Mesh {
 
 struct ReadOptions {
   int threads = 0;  // 0: all available (TBB's default)
+  // Size of the pieces a text file is cut into for parallel parsing (0: 4 MiB). Cuts fall at
+  // line starts, so the result never depends on it or on `threads`; tests make it small to
+  // exercise the cuts.
+  std::size_t chunk_bytes = 0;
 };
 
-// Reads an OBJ or PLY file, chosen by content (PLY magic) and extension. Every malformed
-// input gives a Status naming the file and the line (OBJ) or element (PLY).
+enum class MeshFormat : std::uint8_t { kUnknown, kObj, kPly };
+
+// The reader ReadMesh picks for `path`: PLY when the file starts with the "ply" magic line or
+// is named *.ply, OBJ when named *.obj (any letter case), else kUnknown. Reads 5 bytes at most.
+MeshFormat DetectMeshFormat(const std::string& path);
+
+// Reads an OBJ or PLY file, chosen by DetectMeshFormat (an unknown format is an error).
+//
+// What every reader guarantees on success: at least one face; every face has at least 3
+// vertices; every index is in [0, num_vertices()); every position is finite; face_offsets
+// starts at 0 and ends at face_indices.size(); positions.capacity() > positions.size() (Embree
+// reads 16 bytes at the last vertex); `source` is the path (or `name`). The result is the same
+// for any ReadOptions. On failure the Status message is one line that starts with the file
+// name, then the 1-based line (OBJ, ASCII PLY) or the element and its index (PLY), then what
+// is wrong: "sculpt.obj:1234: face index 99 out of range (98 vertices)". Never throws for bad
+// bytes, never reads out of bounds, and rejects counts the file cannot hold before allocating.
 StatusOr<Mesh> ReadMesh(const std::string& path, const ReadOptions& options = {});
+
+// Wavefront OBJ, parsed in parallel over chunks of the memory-mapped file.
+//  - `v x y z [w | r g b ...]`: extra numbers are ignored; coordinates must be finite floats.
+//  - `f` with `i`, `i/t`, `i//n`, `i/t/n` corners and n-gons; negative indices count back from
+//    the vertices defined before the line; positive ones may refer to any vertex of the file.
+//    Texture and normal indices are checked for syntax only (they may dangle).
+//  - `o name` / `g name...`: a group per distinct name (blanks collapsed; no name = "default"),
+//    in order of first appearance, listing only groups that own faces; faces before the first
+//    group line form the group "default". With no o/g line, face_groups stays empty.
+//  - OpenSubdiv `t` tags (crease, corner, hole, interpolateboundary; others counted in
+//    tags.ignored_tags) with 0-based ids checked against the whole file.
+//  - `#` comments, blank lines, CRLF; a `\` at the end of any line (comments too) joins the
+//    next line. Every other keyword (vt, vn, usemtl, mtllib, s, l, p, ...) is ignored; a line
+//    that does not start with a keyword is an error.
+// Peak memory is about the final arrays: the file's pages are released as chunks are done.
 StatusOr<Mesh> ReadObj(const std::string& path, const ReadOptions& options = {});
+
+// PLY: ascii, binary_little_endian, binary_big_endian. The `vertex` element's x, y, z (any
+// numeric type) and the `face` element's `vertex_indices` (or `vertex_index`) list (any
+// integer count and index types) are read; other properties and elements are skipped. Binary
+// vertex and face data are converted in parallel.
 StatusOr<Mesh> ReadPly(const std::string& path, const ReadOptions& options = {});
 
 // The same parsers over bytes in memory (`name` is used in messages). For tests and fuzzing.
@@ -88,13 +128,14 @@ StatusOr<Mesh> ParsePly(std::string_view bytes, const std::string& name,
 
 // ---- Validation and summary ----------------------------------------------------------------
 
+// What ValidateMesh finds. clean() ignores boundary edges (open meshes are fine).
 struct MeshValidation {
   std::size_t unreferenced_vertices = 0;
-  std::size_t degenerate_faces = 0;       // a vertex repeated within a face
-  std::size_t non_manifold_edges = 0;     // edges used by more than two faces
-  std::size_t inconsistent_edges = 0;     // edges two faces traverse in the same direction
+  std::size_t degenerate_faces = 0;    // a vertex repeated within a face
+  std::size_t non_manifold_edges = 0;  // edges used by more than two faces
+  std::size_t inconsistent_edges = 0;  // edges two faces traverse in the same direction
   std::size_t boundary_edges = 0;
-  std::vector<std::string> warnings;      // one line each, naming the first offending element
+  std::vector<std::string> warnings;  // one line each, naming the first offending element
 
   bool clean() const {
     return unreferenced_vertices == 0 && degenerate_faces == 0 && non_manifold_edges == 0 &&
@@ -102,18 +143,31 @@ struct MeshValidation {
   }
 };
 
+// Counts the problems above and writes one warning per kind of problem that clean() rejects
+// ("3 unreferenced vertices (first: vertex 17)", "... (first: edge 4-5, faces 1, 2)"; the
+// first element is the lowest id). Boundary edges are counted but are no warning: open
+// meshes are valid. Edges are the sides (a, b) with a != b; a zero-length side of a degenerate
+// face is no edge. Runs in parallel; the result does not depend on the thread count.
+// Requires a well-formed mesh (indices in range), as the readers return.
 MeshValidation ValidateMesh(const Mesh& mesh);
 
-// Turns validation warnings into an error (the --strict flag).
+// OK when validation.clean(); otherwise an error "<source>: mesh is not clean: <warnings
+// joined by '; '>" (the --strict flag).
 Status RequireClean(const Mesh& mesh, const MeshValidation& validation);
 
 struct BoundingBox {
   Float3 min{0, 0, 0}, max{0, 0, 0};
+  // Length of max - min (0 for the default box).
   float diagonal() const;
 };
 
+// The box around all positions, referenced by a face or not; the zero box for no positions.
 BoundingBox ComputeBounds(const Mesh& mesh);
-// Median length of the mesh's edges (each undirected edge counted once per face side).
+
+// Median length of the mesh's face sides (an edge shared by two faces counts twice), the mean
+// of the two middle values for an even count; 0 for no faces. Above 2^22 sides it is the
+// median of every k-th side, k the smallest prime >= max(5, sides / 2^22): deterministic, and
+// a prime stride does not alias with the corners of triangles and quads.
 double MedianEdgeLength(const Mesh& mesh);
 
 }  // namespace dispex

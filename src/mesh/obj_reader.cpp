@@ -1,0 +1,253 @@
+// The OBJ reader: two parallel passes over chunks of the (memory-mapped) file.
+//
+// 1. Cut the file into chunks of about ReadOptions::chunk_bytes that start at logical line
+//    starts (a cut never splits a `\` continuation).
+// 2. Counting pass, in parallel: per chunk, physical lines, `v` lines and `f` lines.
+//    Prefix sums give each chunk its first line number, vertex base and face base, and the
+//    totals size the final arrays.
+// 3. Parsing pass, in parallel: each chunk writes its positions and face sizes straight into
+//    the final arrays and its face indices into a per-chunk buffer; relative indices, index
+//    ranges and tag ids are checked there with the exact line number.
+// 4. Merge, in file order: the first error of the earliest chunk is the file's first error;
+//    face sizes become offsets; index buffers are appended and freed one by one; groups and
+//    tags are concatenated.
+// Memory: the final arrays plus the index buffers of the chunks not yet appended; for a
+// mapped file the pages of each chunk are dropped after each pass, so the file itself does
+// not stay resident. The result is identical for any thread count and chunk size.
+#include <fmt/format.h>
+#include <sys/mman.h>
+#include <tbb/parallel_for.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <limits>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "core/check.h"
+#include "core/mapped_file.h"
+#include "dispex/mesh.h"
+#include "mesh/obj_chunk_parser.h"
+#include "mesh/obj_syntax.h"
+#include "mesh/parallel.h"
+#include "mesh/text_scan.h"
+
+namespace dispex {
+namespace {
+
+constexpr std::size_t kDefaultChunkBytes = std::size_t{4} << 20;
+
+struct Chunk {
+  const char* begin;
+  const char* end;
+};
+
+struct ChunkCounts {
+  std::int64_t lines = 0;  // '\n' bytes in the chunk
+  std::int64_t vertices = 0;
+  std::int64_t faces = 0;
+};
+
+std::vector<Chunk> CutIntoChunks(std::string_view bytes, std::size_t chunk_bytes) {
+  std::vector<Chunk> chunks;
+  const char* begin = bytes.data();
+  const char* end = begin + bytes.size();
+  const char* start = begin;
+  while (start < end) {
+    const char* stop = end;
+    if (static_cast<std::size_t>(end - start) > chunk_bytes) {
+      stop = obj::NextLineStart(begin, start + chunk_bytes - 1, end);
+    }
+    chunks.push_back({start, stop});
+    start = stop;
+  }
+  return chunks;
+}
+
+// A logical line starts at the chunk's start and after every '\n' that is not continued; each
+// is classified exactly as the parsing pass will classify it (SkipBlanks, then ReadKeyword).
+ChunkCounts CountChunk(const char* file_begin, const Chunk& chunk) {
+  ChunkCounts counts;
+  auto classify = [&](const char* p) {
+    std::int64_t crossed = 0;  // continuations at the line start: counted below, as newlines
+    text::SkipBlanks(p, chunk.end, crossed);
+    const obj::LineKind kind = obj::ReadKeyword(p, chunk.end);
+    counts.vertices += kind == obj::LineKind::kVertex;
+    counts.faces += kind == obj::LineKind::kFace;
+  };
+  classify(chunk.begin);
+  text::ForEachNewline(chunk.begin, chunk.end, [&](const char* newline) {
+    ++counts.lines;
+    if (newline + 1 < chunk.end && !text::IsContinuedNewline(file_begin, newline)) {
+      classify(newline + 1);
+    }
+  });
+  return counts;
+}
+
+// Drops the resident pages that lie wholly inside [begin, end) of a read-only file mapping:
+// they are read again from the page cache if touched later. Only for mapped files.
+void ReleaseMappedPages(const char* begin, const char* end) {
+  static const std::uintptr_t page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+  const std::uintptr_t first = (reinterpret_cast<std::uintptr_t>(begin) + page - 1) & ~(page - 1);
+  const std::uintptr_t last = reinterpret_cast<std::uintptr_t>(end) & ~(page - 1);
+  if (last > first) {
+    ::madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
+  }
+}
+
+Status LineError(const std::string& name, std::int64_t line, const std::string& message) {
+  return Status::Error(fmt::format("{}:{}: {}", name, line, message));
+}
+
+// Assigns group ids in order of first appearance, keeping only groups that own faces.
+void MergeGroups(const std::vector<obj::ChunkOutput>& outputs, Mesh& mesh) {
+  std::vector<const obj::GroupStart*> starts;
+  for (const auto& out : outputs) {
+    for (const auto& g : out.groups) starts.push_back(&g);
+  }
+  if (starts.empty()) return;
+  const std::int64_t num_faces = static_cast<std::int64_t>(mesh.num_faces());
+  mesh.face_groups.resize(static_cast<std::size_t>(num_faces));
+  std::unordered_map<std::string, std::int32_t> ids;
+  auto id_of = [&](const std::string& name) {
+    auto [it, inserted] = ids.try_emplace(name, static_cast<std::int32_t>(mesh.group_names.size()));
+    if (inserted) mesh.group_names.push_back(name);
+    return it->second;
+  };
+  // A group line names the faces that follow it; faces before the first one are "default".
+  std::int64_t face = 0;
+  const std::string* current = nullptr;
+  for (std::size_t i = 0; i <= starts.size(); ++i) {
+    const std::int64_t stop = i < starts.size() ? starts[i]->first_face : num_faces;
+    if (stop > face) {
+      const std::int32_t id = id_of(current != nullptr ? *current : std::string("default"));
+      std::fill(mesh.face_groups.begin() + face, mesh.face_groups.begin() + stop, id);
+      face = stop;
+    }
+    if (i < starts.size()) current = &starts[i]->name;
+  }
+}
+
+StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
+                              const ReadOptions& options, bool release_mapped_pages) {
+  const std::size_t chunk_bytes =
+      options.chunk_bytes > 0 ? options.chunk_bytes : kDefaultChunkBytes;
+  const std::vector<Chunk> chunks = CutIntoChunks(bytes, chunk_bytes);
+  const std::size_t n = chunks.size();
+  const char* file_begin = bytes.data();
+
+  std::vector<ChunkCounts> counts(n);
+  std::vector<obj::ChunkOutput> outputs(n);
+  Mesh mesh;
+  mesh.source = name;
+  std::vector<obj::ChunkInput> inputs(n);
+  std::atomic<bool> out_of_memory{false};
+
+  RunWithThreads(options.threads, [&] {
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+      counts[i] = CountChunk(file_begin, chunks[i]);
+      if (release_mapped_pages) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
+    });
+  });
+
+  std::int64_t lines = 0, vertices = 0, faces = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    inputs[i].file_begin = file_begin;
+    inputs[i].begin = chunks[i].begin;
+    inputs[i].end = chunks[i].end;
+    inputs[i].first_line = lines + 1;
+    inputs[i].vertex_base = vertices;
+    inputs[i].face_base = faces;
+    lines += counts[i].lines;
+    vertices += counts[i].vertices;
+    faces += counts[i].faces;
+  }
+  // Vertex ids are int32 (OpenSubdiv, Embree) and so are face ids.
+  if (vertices > std::numeric_limits<std::int32_t>::max()) {
+    return Status::Error(
+        fmt::format("{}: {} vertices: more than the 2^31-1 supported", name, vertices));
+  }
+  if (faces > std::numeric_limits<std::int32_t>::max()) {
+    return Status::Error(fmt::format("{}: {} faces: more than the 2^31-1 supported", name, faces));
+  }
+  // Embree reads 16 bytes at the last vertex: keep one spare element of capacity.
+  mesh.positions.reserve(static_cast<std::size_t>(vertices) + 1);
+  mesh.positions.resize(static_cast<std::size_t>(vertices));
+  mesh.face_offsets.resize(static_cast<std::size_t>(faces) + 1);
+  for (auto& in : inputs) {
+    in.num_vertices = vertices;
+    in.num_faces = faces;
+    in.positions = mesh.positions.data();
+    in.face_sizes = mesh.face_offsets.data() + 1;
+  }
+
+  RunWithThreads(options.threads, [&] {
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+      if (!obj::ParseChunk(inputs[i], outputs[i])) out_of_memory.store(true);
+      if (release_mapped_pages) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
+    });
+  });
+  if (out_of_memory.load()) return Status::Error(name + ": out of memory while reading");
+
+  std::uint64_t corners = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const obj::ChunkOutput& out = outputs[i];
+    if (out.error) return LineError(name, out.error->line, out.error->message);
+    DISPEX_CHECK_EQ(out.vertices, counts[i].vertices);
+    DISPEX_CHECK_EQ(out.faces, counts[i].faces);
+    corners += out.indices.size();
+  }
+  if (faces == 0) {
+    return Status::Error(
+        fmt::format("{}: no faces ({} vertices): not a polygon mesh", name, vertices));
+  }
+  if (corners > std::numeric_limits<std::uint32_t>::max()) {
+    return Status::Error(
+        fmt::format("{}: {} face corners: more than the 2^32-1 supported", name, corners));
+  }
+
+  // Face sizes -> offsets.
+  std::uint32_t offset = 0;
+  for (std::size_t f = 1; f < mesh.face_offsets.size(); ++f) {
+    offset += mesh.face_offsets[f];
+    mesh.face_offsets[f] = offset;
+  }
+  mesh.face_indices.reserve(static_cast<std::size_t>(corners));
+  for (auto& out : outputs) {
+    mesh.face_indices.insert(mesh.face_indices.end(), out.indices.begin(), out.indices.end());
+    out.indices.Release();
+  }
+
+  MergeGroups(outputs, mesh);
+
+  for (auto& out : outputs) {
+    SubdivTags& tags = mesh.tags;
+    tags.creases.insert(tags.creases.end(), out.tags.creases.begin(), out.tags.creases.end());
+    tags.corners.insert(tags.corners.end(), out.tags.corners.begin(), out.tags.corners.end());
+    tags.holes.insert(tags.holes.end(), out.tags.holes.begin(), out.tags.holes.end());
+    if (out.tags.boundary_from_file) {
+      tags.boundary = out.tags.boundary;
+      tags.boundary_from_file = true;
+    }
+    tags.ignored_tags += out.tags.ignored_tags;
+  }
+  return mesh;
+}
+
+}  // namespace
+
+StatusOr<Mesh> ParseObj(std::string_view bytes, const std::string& name,
+                        const ReadOptions& options) {
+  return ParseObjBuffer(bytes, name, options, /*release_mapped_pages=*/false);
+}
+
+StatusOr<Mesh> ReadObj(const std::string& path, const ReadOptions& options) {
+  DISPEX_ASSIGN_OR_RETURN(MappedFile file, MappedFile::Open(path));
+  return ParseObjBuffer(file.view(), path, options, /*release_mapped_pages=*/true);
+}
+
+}  // namespace dispex

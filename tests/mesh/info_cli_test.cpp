@@ -1,0 +1,136 @@
+// `dispex info MESH` end to end: runs the dispex binary and checks its output and exit code.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace {
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+CliRun Dispex(const std::string& args) {
+  const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string err_path =
+      ::testing::TempDir() + "/dispex_" + test->name() + "_" + std::to_string(::getpid()) + ".err";
+  const std::string command = std::string(DISPEX_EXE) + " " + args + " 2>" + err_path;
+  CliRun run;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  std::array<char, 4096> buffer;
+  std::size_t n;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    run.out.append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  run.err = Slurp(err_path);
+  std::remove(err_path.c_str());
+  return run;
+}
+
+std::string Data(const std::string& relative) {
+  return std::string(DISPEX_TEST_DATA_DIR) + "/" + relative;
+}
+
+TEST(InfoCli, TextSummary) {
+  const std::string path = Data("meshes/keenan_spot/spot_control_mesh.obj");
+  const CliRun run = Dispex("info " + path);
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err, "");
+  EXPECT_NE(run.out.find("mesh          " + path + "\n"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("format        OBJ\n"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("vertices      188\n"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("faces         180 (4 triangles, 160 quads, 16 5-gons)\n"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("bounds        min (-0.585967, -0.759125, -0.696223) max (0.585967, "
+                         "0.984026, 1.07776)\n"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("warnings      0\n"), std::string::npos) << run.out;
+}
+
+TEST(InfoCli, TagsAndWarningsInText) {
+  const CliRun run = Dispex("info " + Data("meshes/opensubdiv/catmark_fan.obj"));
+  EXPECT_EQ(run.exit_code, 0);
+  EXPECT_NE(run.out.find("boundary      edge_and_corner (from the file)\n"), std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("edges         20 boundary, 4 non-manifold, 0 inconsistently wound\n"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("  warning: 4 non-manifold edges"), std::string::npos) << run.out;
+  const CliRun creases = Dispex("info " + Data("meshes/opensubdiv/catmark_cubes_infsharp.obj"));
+  EXPECT_NE(creases.out.find("creases       18 (17 infinitely sharp)\n"), std::string::npos)
+      << creases.out;
+  EXPECT_NE(creases.out.find("ignored tags  1\n"), std::string::npos) << creases.out;
+}
+
+TEST(InfoCli, JsonParses) {
+  const CliRun run = Dispex("info --json " + Data("meshes/stanford_bunny/bun_zipper.ply"));
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["format"], "PLY");
+  EXPECT_EQ(j["vertices"], 35947);
+  EXPECT_EQ(j["faces"], 69451);
+  EXPECT_EQ(j["faces_by_size"]["3"], 69451);
+  EXPECT_EQ(j["face_corners"], 3 * 69451);
+  EXPECT_EQ(j["groups"].size(), 0u);
+  EXPECT_EQ(j["tags"]["boundary"], "edge_and_corner");
+  EXPECT_EQ(j["tags"]["boundary_from_file"], false);
+  EXPECT_NEAR(j["bounds"]["min"][0].get<double>(), -0.0946899, 1e-7);
+  EXPECT_NEAR(j["bounds"]["max"][1].get<double>(), 0.187321, 1e-7);
+  EXPECT_NEAR(j["median_edge_length"].get<double>(), 0.0014670207735407127, 1e-9);
+  EXPECT_EQ(j["validation"]["clean"], false);
+  EXPECT_EQ(j["validation"]["boundary_edges"], 223);
+  EXPECT_EQ(j["validation"]["unreferenced_vertices"], 1113);
+  ASSERT_EQ(j["validation"]["warnings"].size(), 1u);
+  EXPECT_EQ(j["validation"]["warnings"][0], "1113 unreferenced vertices (first: vertex 8)");
+}
+
+TEST(InfoCli, StrictTurnsWarningsIntoFailure) {
+  const std::string bunny = Data("meshes/stanford_bunny/bun_zipper.ply");
+  const CliRun run = Dispex("info --strict " + bunny);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(run.err, "dispex: " + bunny +
+                         ": mesh is not clean: 1113 unreferenced vertices (first: vertex 8)\n");
+  const CliRun clean = Dispex("info --strict " + Data("meshes/opensubdiv/catmark_cube.obj"));
+  EXPECT_EQ(clean.exit_code, 0) << clean.err;
+  EXPECT_EQ(clean.err, "");
+}
+
+TEST(InfoCli, ErrorsExitOneWithOneLine) {
+  const std::string bad = Data("malformed/obj_index_out_of_range.obj");
+  const CliRun run = Dispex("info " + bad);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(run.out, "");
+  EXPECT_EQ(run.err, "dispex: " + bad + ":4: face index 4 out of range (3 vertices)\n");
+  const CliRun json = Dispex("info --json " + Data("malformed/ply_huge_face_count.ply"));
+  EXPECT_EQ(json.exit_code, 1);
+  EXPECT_EQ(json.out, "");
+  EXPECT_EQ(json.err.find("dispex: "), 0u);
+  EXPECT_EQ(json.err.find('\n'), json.err.size() - 1) << json.err;
+  const CliRun missing = Dispex("info " + Data("meshes/no_such_mesh.obj"));
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("no such file"), std::string::npos) << missing.err;
+  const CliRun unknown = Dispex("info " + Data("malformed/not_a_mesh.stl"));
+  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_NE(unknown.err.find("unknown mesh format"), std::string::npos) << unknown.err;
+}
+
+}  // namespace

@@ -1,0 +1,188 @@
+// The parallel OBJ reader gives exactly the mesh of a one-chunk, one-thread parse, for any
+// thread count and chunk size, on a multi-megabyte file that uses every feature, so that
+// chunk cuts fall inside continuations, groups, tags, comments and CRLF lines.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include "dispex/mesh.h"
+#include "mesh_test_util.h"
+
+namespace dispex {
+namespace {
+
+constexpr std::size_t kOneChunk = std::size_t{1} << 40;
+
+// About 4 MB of OBJ: a grid of vertices and quads/triangles/n-gons written with every index
+// form, plus everything a reader must step over.
+std::string GenerateObj(int seed) {
+  std::mt19937 rng(static_cast<unsigned>(seed));
+  std::string s;
+  s.reserve(5 << 20);
+  s += "# generated for dispex tests\nmtllib none.mtl\n";
+  const int n = 180;  // vertices per side
+  std::int64_t vertices = 0;
+  auto eol = [&] { s += (rng() % 7 == 0) ? "\r\n" : "\n"; };
+  for (int block = 0; block < 6; ++block) {
+    s += fmt::format("o part{}", block % 4);  // part0..3, part0 and part1 twice
+    eol();
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const int style = static_cast<int>(rng() % 16);
+        const double x = i * 0.01 + block, y = j * 0.013, z = (rng() % 1000) * 1e-4;
+        if (style == 0) {
+          s += fmt::format("v {} \\", x);
+          eol();
+          s += fmt::format("  {} {}", y, z);
+        } else if (style == 1) {
+          s += fmt::format("v\t{:.9e}\t{:.3f} {} 1.0", x, y, z);  // w coordinate
+        } else if (style == 2) {
+          s += fmt::format("v {} {} {} 0.5 0.25 0.75", x, y, z);  // colour
+        } else {
+          s += fmt::format("v {} {} {}", x, y, z);
+        }
+        eol();
+        ++vertices;
+        if (rng() % 50 == 0) {
+          s += "vt 0.5 0.5";
+          eol();
+          s += "vn 0 0 1";
+          eol();
+        }
+      }
+    }
+    s += fmt::format("g block {}", block);
+    eol();
+    const std::int64_t base = vertices - n * n;  // 0-based id of this block's first vertex
+    for (int j = 0; j + 1 < n; ++j) {
+      for (int i = 0; i + 1 < n; ++i) {
+        const std::int64_t a = base + j * n + i, b = a + 1, c = a + n + 1, d = a + n;
+        const int style = static_cast<int>(rng() % 12);
+        switch (style) {
+          case 0:
+            s += fmt::format("f {} {} {} {}", a + 1, b + 1, c + 1, d + 1);
+            break;
+          case 1:
+            s += fmt::format("f {}/{} {}/{} {}/{}", a + 1, 1, b + 1, 2, c + 1, 3);
+            break;
+          case 2:
+            s += fmt::format("f {}//{} {}//{} {}//{} {}//9", a + 1, 1, b + 1, 1, c + 1, 1, d + 1);
+            break;
+          case 3:
+            s += fmt::format("f {}/1/1 {}/2/2 {}/3/3", a + 1, c + 1, d + 1);
+            break;
+          case 4:  // relative indices
+            s += fmt::format("f {} {} {} {}", a - vertices, b - vertices, c - vertices,
+                             d - vertices);
+            break;
+          case 5:  // continued face
+            s += fmt::format("f {} {} \\", a + 1, b + 1);
+            eol();
+            s += fmt::format("   {} {}", c + 1, d + 1);
+            break;
+          case 6:  // a pentagon (repeats a vertex: only the parser is tested here)
+            s += fmt::format("f {} {} {} {} {}", a + 1, b + 1, c + 1, d + 1, a + 1);
+            break;
+          case 7:
+            s += fmt::format("f {} {} {} {} # comment", a + 1, b + 1, c + 1, d + 1);
+            break;
+          default:
+            s += fmt::format("f {} {} {} {}", a + 1, b + 1, c + 1, d + 1);
+            break;
+        }
+        eol();
+        if (rng() % 97 == 0) {
+          s += "usemtl m";
+          eol();
+          s += "s 1";
+          eol();
+          s += "# a comment line";
+          eol();
+          eol();
+        }
+        if (rng() % 211 == 0) {
+          s += fmt::format("t crease 2/1/0 {} {} {}", a, b, (rng() % 100) * 0.1);
+          eol();
+        }
+        if (rng() % 503 == 0) {
+          s += fmt::format("t corner 1/1/0 {} 2.5", c);
+          eol();
+          s += "t smoothtriangles 0/0/1 \\";
+          eol();
+          s += "  catmark";
+          eol();
+        }
+      }
+    }
+    s += fmt::format("t hole 1/0/0 {}", block * 10);
+    eol();
+    s += fmt::format("t interpolateboundary 1/0/0 {}", block % 3);
+    eol();
+  }
+  return s;
+}
+
+TEST(ObjParallel, SameMeshForAnyThreadsAndChunks) {
+  const std::string text = GenerateObj(1);
+  ASSERT_GT(text.size(), std::size_t{3} << 20);
+  StatusOr<Mesh> reference = ParseObj(text, "gen.obj", ReadOptions{1, kOneChunk});
+  ASSERT_TRUE(reference.ok()) << reference.status().message();
+  EXPECT_EQ(reference->num_vertices(), 6u * 180 * 180);
+  EXPECT_EQ(reference->num_faces(), 6u * 179 * 179);
+  EXPECT_EQ(reference->group_names.size(), 6u);  // "block 0".."block 5"; part0..3 own no faces
+  EXPECT_GT(reference->tags.creases.size(), 100u);
+  EXPECT_EQ(reference->tags.holes.size(), 6u);
+  EXPECT_EQ(reference->tags.boundary, BoundaryInterpolation::kEdgeOnly);  // last value: 2
+
+  for (int threads : {1, 2, 0}) {
+    for (std::size_t chunk : {std::size_t{0}, std::size_t{1000}, std::size_t{4096},
+                              std::size_t{65536}, std::size_t{777777}}) {
+      StatusOr<Mesh> mesh = ParseObj(text, "gen.obj", ReadOptions{threads, chunk});
+      ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+      EXPECT_TRUE(testing::SameMesh(*mesh, *reference)) << threads << " threads, chunk " << chunk;
+    }
+  }
+}
+
+// Through the file path too (memory-mapped, pages dropped chunk by chunk).
+TEST(ObjParallel, ReadObjMatchesParseObj) {
+  const std::string text = GenerateObj(2);
+  const std::string path = testing::TempPath(".obj");
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+  }
+  StatusOr<Mesh> reference = ParseObj(text, path, ReadOptions{1, kOneChunk});
+  ASSERT_TRUE(reference.ok()) << reference.status().message();
+  for (std::size_t chunk : {std::size_t{0}, std::size_t{10000}, std::size_t{1} << 20}) {
+    StatusOr<Mesh> mesh = ReadObj(path, ReadOptions{2, chunk});
+    ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+    EXPECT_TRUE(testing::SameMesh(*mesh, *reference));
+  }
+  std::remove(path.c_str());
+}
+
+// An error deep in the file: the same line number for every chunking.
+TEST(ObjParallel, ErrorLineDoesNotDependOnChunks) {
+  std::string text = GenerateObj(3);
+  // Break the face on a line far into the file: the line number of that line, counted here.
+  std::size_t pos = text.find("\nf ", text.size() * 2 / 3);
+  ASSERT_NE(pos, std::string::npos);
+  std::size_t line = 2;  // the 'f' line after the newline at `pos`
+  for (std::size_t i = 0; i < pos; ++i) line += text[i] == '\n';
+  text.insert(pos + 3, "0 ");  // "f 0 a b c d": index 0
+  const std::string expected =
+      "gen.obj:" + std::to_string(line) + ": face index 0 (OBJ indices start at 1)";
+  for (std::size_t chunk : {kOneChunk, std::size_t{0}, std::size_t{3000}, std::size_t{50000}}) {
+    StatusOr<Mesh> mesh = ParseObj(text, "gen.obj", ReadOptions{2, chunk});
+    ASSERT_FALSE(mesh.ok());
+    EXPECT_EQ(mesh.status().message(), expected) << "chunk " << chunk;
+  }
+}
+
+}  // namespace
+}  // namespace dispex
