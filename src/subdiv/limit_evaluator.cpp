@@ -1,0 +1,97 @@
+// LimitEvaluator: argument checks around a FaceSampler, so that bad ids, holes and short
+// buffers are Status errors and the sampler's loops can trust their inputs.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <memory>
+
+#include "dispex/subdiv.h"
+#include "subdiv/face_sampler.h"
+#include "subdiv/surface_impl.h"
+
+namespace dispex {
+
+struct LimitEvaluator::Impl {
+  explicit Impl(const LimitSurface::Impl& s) : surface(s), sampler(s) {}
+  const LimitSurface::Impl& surface;
+  subdiv::FaceSampler sampler;
+
+  Status BindChecked(PtexFaceId face) {
+    if (face.value < 0 || face.value >= surface.num_ptex_faces()) {
+      return Status::Error(fmt::format("{}: Ptex face {} out of range ({} Ptex faces)",
+                                       surface.source, face.value, surface.num_ptex_faces()));
+    }
+    switch (sampler.Bind(face.value)) {
+      case subdiv::FaceSampler::BindResult::kOk:
+        return Status::Ok();
+      case subdiv::FaceSampler::BindResult::kNoSurface:
+        return Status::Error(fmt::format("{}: Ptex face {} (base face {}) has no limit surface",
+                                         surface.source, face.value,
+                                         surface.ptex_base[face.value]));
+      case subdiv::FaceSampler::BindResult::kFailed:
+        break;
+    }
+    return Status::Error(
+        fmt::format("{}: OpenSubdiv could not build the limit surface of base "
+                    "face {}: {}",
+                    surface.source, surface.ptex_base[face.value], sampler.error()));
+  }
+};
+
+LimitEvaluator::LimitEvaluator(const LimitSurface& surface)
+    : impl_(std::make_unique<Impl>(surface.impl())) {}
+LimitEvaluator::LimitEvaluator(LimitEvaluator&&) noexcept = default;
+LimitEvaluator& LimitEvaluator::operator=(LimitEvaluator&&) noexcept = default;
+LimitEvaluator::~LimitEvaluator() = default;
+
+Status LimitEvaluator::EvaluateGrid(PtexFaceId face, int rx, int ry, std::span<float> positions,
+                                    std::span<float> normals) {
+  if (rx < 1 || ry < 1) {
+    return Status::Error(fmt::format("{}: Ptex face {}: grid {}x{} is empty", impl_->surface.source,
+                                     face.value, rx, ry));
+  }
+  const std::size_t needed = 3 * static_cast<std::size_t>(rx) * static_cast<std::size_t>(ry);
+  if (positions.size() < needed || (!normals.empty() && normals.size() < needed)) {
+    return Status::Error(fmt::format(
+        "{}: Ptex face {}: a {}x{} grid needs {} floats per output (got {} and {})",
+        impl_->surface.source, face.value, rx, ry, needed, positions.size(), normals.size()));
+  }
+  DISPEX_RETURN_IF_ERROR(impl_->BindChecked(face));
+  impl_->sampler.Grid(rx, ry, positions.data(), normals.empty() ? nullptr : normals.data());
+  return Status::Ok();
+}
+
+Status LimitEvaluator::EvaluatePoints(PtexFaceId face, std::span<const float> uv,
+                                      std::span<float> positions, std::span<float> normals) {
+  if (uv.size() % 2 != 0) {
+    return Status::Error(fmt::format("{}: Ptex face {}: {} uv values is not a list of pairs",
+                                     impl_->surface.source, face.value, uv.size()));
+  }
+  const std::size_t n = uv.size() / 2;
+  if (positions.size() < 3 * n || (!normals.empty() && normals.size() < 3 * n)) {
+    return Status::Error(
+        fmt::format("{}: Ptex face {}: {} points need {} floats per output (got {} and {})",
+                    impl_->surface.source, face.value, n, 3 * n, positions.size(), normals.size()));
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const float u = uv[2 * i], v = uv[2 * i + 1];
+    if (!(u >= 0.0f && u <= 1.0f && v >= 0.0f && v <= 1.0f)) {
+      return Status::Error(
+          fmt::format("{}: Ptex face {}: point {} (u,v) = ({}, {}) is outside "
+                      "[0,1]^2",
+                      impl_->surface.source, face.value, i, u, v));
+    }
+  }
+  DISPEX_RETURN_IF_ERROR(impl_->BindChecked(face));
+  for (std::size_t i = 0; i < n; ++i) {
+    impl_->sampler.Point(uv[2 * i], uv[2 * i + 1], &positions[3 * i],
+                         normals.empty() ? nullptr : &normals[3 * i]);
+  }
+  return Status::Ok();
+}
+
+const LimitEvaluatorStats& LimitEvaluator::stats() const {
+  return impl_->sampler.stats();
+}
+
+}  // namespace dispex
