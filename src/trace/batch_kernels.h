@@ -1,0 +1,400 @@
+// The query loops of the Embree backend, written once over a Caster (ray_casters.h) so that
+// every RayMode shares them.
+//
+// Rays are handled in blocks of 64 queries held on the stack. A normal query casts its first
+// ray (+n; -n under inside-first) for the whole block, then a second pass casts the opposite
+// ray only for the queries whose answer it can still change, and only up to where it can
+// change it: under `nearest` the second ray's tfar is cut to the first hit's t, so Embree
+// stops traversing early (the measured win over two independent rays). Queries are packed
+// into casters in order, so rays from neighbouring samples of a face share a packet.
+//
+// Vertex guard. Embree 3's robust mode is watertight along shared edges but can still let a
+// ray through exactly at a shared vertex (Embree issues #181 and #387; measured here on rays
+// aimed exactly at cube-sphere vertices: ~0.3% slip through, none at edges). Such a query is
+// re-resolved from an origin moved sideways (Sideways()): far enough, 16 ulps of the
+// coordinates' magnitude, to leave the vertex's rounding zone so the rays cross a face or an
+// edge; close enough that t moves by ~1e-6 relative at most, and only for those queries.
+// Which queries: those that end as misses (TracerOptions::retry_misses: cheap, misses are
+// rare), and, with TracerOptions::verify_hits, those where one more sideways ray finds a
+// surface between the origin and the kept hit, which the first rays must have slipped past.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <span>
+
+#include "dispex/trace.h"
+#include "trace/embree_scene.h"
+
+namespace dispex::trace {
+
+inline constexpr int kBlock = 64;
+
+inline bool Finite(const Float3& p) {
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+}
+inline bool NonZero(const Float3& p) {
+  return p.x != 0 || p.y != 0 || p.z != 0;
+}
+inline float Dot(const Float3& a, const Float3& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+// One ray's hit as the kernels keep it between passes.
+struct Candidate {
+  float t = 0;
+  unsigned geom = RTC_INVALID_GEOMETRY_ID;
+  unsigned prim = 0;
+  bool back = false;
+  bool hit() const { return geom != RTC_INVALID_GEOMETRY_ID; }
+};
+
+// `o` moved sideways (perpendicular to d) by 16 ulps of the larger of the scene's and the
+// origin's coordinate magnitude. Deterministic.
+inline Float3 Sideways(const Float3& o, const Float3& d, float scene_scale) {
+  const float ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
+  // e = d x (the axis of d's smallest component): perpendicular to d, never zero.
+  const Float3 e = ax <= ay && ax <= az ? Float3{0, d.z, -d.y}
+                   : ay <= az           ? Float3{-d.z, 0, d.x}
+                                        : Float3{d.y, -d.x, 0};
+  const float scale = std::max({scene_scale, std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)});
+  const float step = scale * 0x1p-19f / std::sqrt(Dot(e, e));
+  return Float3{o.x + step * e.x, o.y + step * e.y, o.z + step * e.z};
+}
+
+// The normal-query kernel for one block of at most kBlock queries.
+template <class Caster>
+class NormalBlock {
+ public:
+  NormalBlock(const EmbreeScene& scene, const NormalQuery& query)
+      : scene_(scene),
+        query_(query),
+        nearest_(query.policy == HitPolicy::kNearest),
+        first_sign_(query.policy == HitPolicy::kInsideFirst ? -1.0f : 1.0f) {
+    rtcInitIntersectContext(&context_);
+    context_.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  }
+
+  // Resolves the queries o[j] +- t d[j], j < m, and writes their outputs at out[base + j].
+  void Run(const Float3* o, const Float3* d, int m, const NormalHits& out, std::size_t base,
+           TraceCounters& counters) {
+    o_ = o;
+    d_ = d;
+    int count = 0;
+    for (int j = 0; j < m; ++j) {
+      kept_[j] = Candidate{};
+      if (Finite(o[j]) && Finite(d[j]) && NonZero(d[j])) {
+        list_[count++] = j;
+      } else {
+        ++counters.invalid;
+      }
+    }
+    rays_ = 0;
+    repair_rays_ = 0;
+    Resolve(list_, count, false);
+    if (scene_.retry_misses()) {
+      int misses = 0;
+      for (int k = 0; k < count; ++k) {
+        if (!kept_[list_[k]].hit()) suspects_[misses++] = list_[k];
+      }
+      Resolve(suspects_, misses, true);
+    }
+    if (scene_.verify_hits()) Verify(count);
+    counters.rays_cast += rays_ + repair_rays_;
+    counters.repair_rays += repair_rays_;
+    Write(m, out, base, counters);
+  }
+
+ private:
+  // Casts, for each j in ids[0..count), the ray along sign * d[j] with t in [0, tfar_[j]] from
+  // o[j] (moved sideways when `sideways`), storing its hit in result[j].
+  void Cast(const int* ids, int count, float sign, Candidate* result, bool sideways) {
+    constexpr int W = Caster::kWidth;
+    for (int k0 = 0; k0 < count; k0 += W) {
+      const int width = std::min(W, count - k0);
+      for (int lane = 0; lane < width; ++lane) {
+        const int j = ids[k0 + lane];
+        const Float3 dir{sign * d_[j].x, sign * d_[j].y, sign * d_[j].z};
+        // Both rays of a query move the same way: sideways of d, not of dir.
+        caster_.Set(lane, sideways ? Sideways(o_[j], d_[j], scene_.scale()) : o_[j], dir, 0.0f,
+                    tfar_[j]);
+      }
+      caster_.Cast(scene_.scene(), &context_, width);
+      for (int lane = 0; lane < width; ++lane) {
+        if (!caster_.Hit(lane)) continue;
+        const int j = ids[k0 + lane];
+        const float facing = sign * Dot(d_[j], caster_.Ng(lane));
+        result[j] = Candidate{caster_.T(lane), caster_.Geom(lane), caster_.Prim(lane), facing > 0};
+      }
+    }
+    (sideways ? repair_rays_ : rays_) += static_cast<std::uint64_t>(count);
+  }
+
+  // Both rays of the listed queries and the policy's choice, into kept_ and kept_sign_.
+  void Resolve(const int* ids, int count, bool sideways) {
+    if (count == 0) return;
+    for (int k = 0; k < count; ++k) {
+      const int j = ids[k];
+      first_[j] = second_[j] = Candidate{};
+      tfar_[j] = query_.distance;
+    }
+    Cast(ids, count, first_sign_, first_, sideways);
+
+    // The second ray, where it can change the answer (see TraceCounters::rays_cast).
+    int count2 = 0;
+    for (int k = 0; k < count; ++k) {
+      const int j = ids[k];
+      if (!first_[j].hit()) {
+        second_ids_[count2++] = j;
+      } else if (nearest_ && first_[j].t > 0) {
+        tfar_[j] = first_[j].t;
+        second_ids_[count2++] = j;
+      }
+    }
+    Cast(second_ids_, count2, -first_sign_, second_, sideways);
+
+    for (int k = 0; k < count; ++k) {
+      const int j = ids[k];
+      const Candidate& a = first_[j];
+      const Candidate& b = second_[j];
+      // Under nearest, b was cast with tfar <= a.t: a tie keeps a (the +n hit).
+      const bool take_second = b.hit() && (!a.hit() || (nearest_ && b.t < a.t));
+      kept_[j] = take_second ? b : a;
+      kept_sign_[j] = take_second ? -first_sign_ : first_sign_;
+      // Where a surface would have changed the answer, for Verify: under nearest, anything
+      // within |t| on either side; otherwise anything before the hit on its side, plus the
+      // whole preferred side when the answer came from the other one.
+      const float other = nearest_ ? kept_[j].t : (take_second ? query_.distance : 0.0f);
+      reach_plus_[j] = kept_sign_[j] > 0 ? kept_[j].t : other;
+      reach_minus_[j] = kept_sign_[j] > 0 ? other : kept_[j].t;
+    }
+  }
+
+  // One sideways ray per hit over the open segment the rays covered, from -reach_minus to
+  // +reach_plus along d (ends trimmed by a margin so the kept hit itself is not found): a
+  // surface found there was slipped past, so the query is resolved again from sideways.
+  void Verify(int count) {
+    int segments = 0;
+    for (int k = 0; k < count; ++k) {
+      const int j = list_[k];
+      if (!kept_[j].hit() || kept_[j].t == 0) continue;
+      const float length = reach_minus_[j] + reach_plus_[j];
+      // The trim covers how far the sideways step can move the kept hit along the ray (up
+      // to 64 steps: surfaces within ~1 degree of the ray's direction excepted).
+      const float step =
+          std::max({scene_.scale(), std::fabs(o_[j].x), std::fabs(o_[j].y), std::fabs(o_[j].z)}) *
+          0x1p-19f;
+      const float margin = std::max(1e-4f * length, 64 * step);
+      segment_start_[j] = reach_minus_[j] - margin;
+      tfar_[j] = length - 2 * margin;
+      if (tfar_[j] > 0) suspects_[segments++] = j;
+    }
+    constexpr int W = Caster::kWidth;
+    int found = 0;
+    for (int k0 = 0; k0 < segments; k0 += W) {
+      const int width = std::min(W, segments - k0);
+      for (int lane = 0; lane < width; ++lane) {
+        const int j = suspects_[k0 + lane];
+        const Float3 s = Sideways(o_[j], d_[j], scene_.scale());
+        const float back = segment_start_[j];
+        caster_.Set(lane, Float3{s.x - back * d_[j].x, s.y - back * d_[j].y, s.z - back * d_[j].z},
+                    d_[j], 0.0f, tfar_[j]);
+      }
+      caster_.Cast(scene_.scene(), &context_, width);
+      for (int lane = 0; lane < width; ++lane) {
+        if (caster_.Hit(lane)) list2_[found++] = suspects_[k0 + lane];
+      }
+    }
+    repair_rays_ += static_cast<std::uint64_t>(segments);
+    // Resolve them again from sideways; keep the first answer where that finds nothing
+    // (the nearer surface lay within the trim).
+    for (int k = 0; k < found; ++k) {
+      saved_[k] = kept_[list2_[k]];
+      saved_sign_[k] = kept_sign_[list2_[k]];
+    }
+    Resolve(list2_, found, true);
+    for (int k = 0; k < found; ++k) {
+      if (kept_[list2_[k]].hit()) continue;
+      kept_[list2_[k]] = saved_[k];
+      kept_sign_[list2_[k]] = saved_sign_[k];
+    }
+  }
+
+  void Write(int m, const NormalHits& out, std::size_t base, TraceCounters& counters) const {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const bool with_prims = !out.prim.empty();
+    for (int j = 0; j < m; ++j) {
+      const std::size_t i = base + static_cast<std::size_t>(j);
+      const Candidate& pick = kept_[j];
+      if (!pick.hit()) {
+        out.t[i] = nan;
+        out.flags[i] = 0;
+        if (with_prims) out.prim[i] = SculptPrimId();
+        continue;
+      }
+      const float sign = kept_sign_[j];
+      out.t[i] = sign * pick.t;
+      out.flags[i] =
+          static_cast<std::uint8_t>(HitFlags::kHit | (sign < 0 ? HitFlags::kNegative : 0) |
+                                    (pick.back ? HitFlags::kBackFace : 0));
+      if (with_prims) out.prim[i] = SculptPrimId(scene_.FaceOf(pick.geom, pick.prim));
+      ++counters.hits;
+    }
+  }
+
+  const EmbreeScene& scene_;
+  const NormalQuery& query_;
+  const bool nearest_;
+  const float first_sign_;
+  RTCIntersectContext context_;
+  Caster caster_;
+  const Float3* o_ = nullptr;
+  const Float3* d_ = nullptr;
+  std::uint64_t rays_ = 0, repair_rays_ = 0;
+  int list_[kBlock], list2_[kBlock], second_ids_[kBlock], suspects_[kBlock];
+  float tfar_[kBlock];
+  float reach_plus_[kBlock], reach_minus_[kBlock], segment_start_[kBlock];
+  float kept_sign_[kBlock], saved_sign_[kBlock];
+  Candidate first_[kBlock], second_[kBlock], kept_[kBlock], saved_[kBlock];
+};
+
+template <class Caster>
+void TraceNormalsWith(const EmbreeScene& scene, std::span<const Float3> origins,
+                      std::span<const Float3> normals, const NormalQuery& query,
+                      const NormalHits& out, TraceCounters& counters) {
+  static_assert(kBlock % Caster::kWidth == 0);
+  NormalBlock<Caster> block(scene, query);
+  const std::size_t n = origins.size();
+  for (std::size_t base = 0; base < n; base += kBlock) {
+    const int m = static_cast<int>(std::min<std::size_t>(kBlock, n - base));
+    block.Run(origins.data() + base, normals.data() + base, m, out, base, counters);
+  }
+  counters.queries += n;
+}
+
+template <class Caster>
+void IntersectWith(const EmbreeScene& scene, std::span<const Ray> rays, std::span<RayHit> hits,
+                   TraceCounters& counters) {
+  static_assert(kBlock % Caster::kWidth == 0);
+  constexpr int W = Caster::kWidth;
+  Caster caster;
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float scale = scene.scale();
+
+  int list[kBlock], repair[kBlock];
+  float tfar[kBlock];
+  std::uint64_t cast = 0, repairs = 0, found = 0, invalid = 0;
+  const std::size_t n = rays.size();
+  for (std::size_t base = 0; base < n; base += kBlock) {
+    const int m = static_cast<int>(std::min<std::size_t>(kBlock, n - base));
+    const Ray* block = rays.data() + base;
+    RayHit* out = hits.data() + base;
+
+    // Casts rays ids[0..count) over [tnear, tfar[j]] from their origin (moved sideways when
+    // `sideways`); on_hit(j, lane) for each ray that hits.
+    auto cast_rays = [&](const int* ids, int count, bool sideways, auto on_hit) {
+      for (int k0 = 0; k0 < count; k0 += W) {
+        const int width = std::min(W, count - k0);
+        for (int lane = 0; lane < width; ++lane) {
+          const int j = ids[k0 + lane];
+          const Ray& ray = block[j];
+          Float3 o = ray.origin;
+          if (sideways) o = Sideways(o, ray.direction, scale);
+          caster.Set(lane, o, ray.direction, ray.tnear, tfar[j]);
+        }
+        caster.Cast(scene.scene(), &context, width);
+        for (int lane = 0; lane < width; ++lane) {
+          if (caster.Hit(lane)) on_hit(ids[k0 + lane], lane);
+        }
+      }
+      (sideways ? repairs : cast) += static_cast<std::uint64_t>(count);
+    };
+    auto store = [&](int j, int lane) {
+      const Float3 ng = caster.Ng(lane);
+      const float length = std::sqrt(Dot(ng, ng));
+      const float inv = length > 0 ? 1.0f / length : 0.0f;
+      out[j].t = caster.T(lane);
+      out[j].prim = SculptPrimId(scene.FaceOf(caster.Geom(lane), caster.Prim(lane)));
+      out[j].normal = Float3{ng.x * inv, ng.y * inv, ng.z * inv};
+    };
+
+    int count = 0;
+    for (int j = 0; j < m; ++j) {
+      const Ray& ray = block[j];
+      out[j] = RayHit{nan, SculptPrimId(), Float3{}};
+      tfar[j] = ray.tfar;
+      const bool valid = Finite(ray.origin) && Finite(ray.direction) && NonZero(ray.direction) &&
+                         std::isfinite(ray.tnear) && ray.tnear >= 0 && ray.tnear <= ray.tfar;
+      if (valid) {
+        list[count++] = j;
+      } else {
+        ++invalid;
+      }
+    }
+    cast_rays(list, count, false, store);
+
+    // The vertex guard (see the file comment): misses, and hits with a surface before them
+    // that a sideways ray over [tnear, t) finds, are cast again from sideways.
+    int suspects = 0;
+    if (scene.retry_misses()) {
+      for (int k = 0; k < count; ++k) {
+        if (!out[list[k]].hit()) repair[suspects++] = list[k];
+      }
+    }
+    if (scene.verify_hits()) {
+      int segments = 0;
+      int segment_ids[kBlock];
+      for (int k = 0; k < count; ++k) {
+        const int j = list[k];
+        const float t = out[j].t;
+        if (!out[j].hit() || !(t > block[j].tnear)) continue;
+        const Float3& o = block[j].origin;
+        const Float3& dir = block[j].direction;
+        const float step = std::max({scale, std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)}) *
+                           0x1p-19f / std::sqrt(Dot(dir, dir));
+        tfar[j] = t - std::max(1e-4f * (t - block[j].tnear), 64 * step);
+        if (tfar[j] > block[j].tnear) segment_ids[segments++] = j;
+      }
+      // Segments start at tnear: move the origin there, sideways, and cast over [0, length).
+      for (int k = 0; k < segments; ++k) {
+        const int j = segment_ids[k];
+        tfar[j] -= block[j].tnear;
+      }
+      for (int k0 = 0; k0 < segments; k0 += W) {
+        const int width = std::min(W, segments - k0);
+        for (int lane = 0; lane < width; ++lane) {
+          const int j = segment_ids[k0 + lane];
+          const Ray& ray = block[j];
+          const Float3 s = Sideways(ray.origin, ray.direction, scale);
+          const float a = ray.tnear;
+          caster.Set(lane,
+                     Float3{s.x + a * ray.direction.x, s.y + a * ray.direction.y,
+                            s.z + a * ray.direction.z},
+                     ray.direction, 0.0f, tfar[j]);
+        }
+        caster.Cast(scene.scene(), &context, width);
+        for (int lane = 0; lane < width; ++lane) {
+          if (caster.Hit(lane)) repair[suspects++] = segment_ids[k0 + lane];
+        }
+      }
+      repairs += static_cast<std::uint64_t>(segments);
+    }
+    for (int k = 0; k < suspects; ++k) tfar[repair[k]] = block[repair[k]].tfar;
+    cast_rays(repair, suspects, true, store);
+
+    for (int k = 0; k < count; ++k) found += out[list[k]].hit() ? 1 : 0;
+  }
+  counters.queries += n;
+  counters.invalid += invalid;
+  counters.rays_cast += cast + repairs;
+  counters.repair_rays += repairs;
+  counters.hits += found;
+}
+
+}  // namespace dispex::trace

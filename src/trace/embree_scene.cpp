@@ -1,0 +1,183 @@
+#include "trace/embree_scene.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <new>
+
+#include "trace/sculpt_check.h"
+
+namespace dispex::trace {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+RTCBuildQuality ToRtc(BuildQuality quality) {
+  switch (quality) {
+    case BuildQuality::kLow:
+      return RTC_BUILD_QUALITY_LOW;
+    case BuildQuality::kMedium:
+      return RTC_BUILD_QUALITY_MEDIUM;
+    case BuildQuality::kHigh:
+      return RTC_BUILD_QUALITY_HIGH;
+  }
+  return RTC_BUILD_QUALITY_MEDIUM;
+}
+
+}  // namespace
+
+StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Mesh& mesh,
+                                                          const TracerOptions& options) {
+  std::unique_ptr<EmbreeScene> scene(new EmbreeScene());
+  Status status;
+  try {
+    status = scene->Setup(mesh, options);
+  } catch (const std::bad_alloc&) {
+    status = Status::Error("out of memory setting up the sculpt's ray-tracing scene");
+  }
+  if (!status.ok()) {
+    const std::string& source = mesh.source;
+    // Validation messages already start with the file name; Embree's do not.
+    if (!source.empty() && status.message().rfind(source, 0) != 0) return status.WithPrefix(source);
+    return status;
+  }
+  return scene;
+}
+
+EmbreeScene::~EmbreeScene() {
+  if (scene_ != nullptr) rtcReleaseScene(scene_);
+  // device_ (declared first) is released after the scene that refers to it.
+}
+
+Status EmbreeScene::AddGeometry(unsigned geom_id, RTCGeometryType type, const std::int32_t* indices,
+                                std::size_t count, std::size_t num_vertices,
+                                RTCBuildQuality quality) {
+  RTCGeometry geometry = rtcNewGeometry(device_->get(), type);
+  if (geometry == nullptr) return device_->TakeError();
+  const bool quads = type == RTC_GEOMETRY_TYPE_QUAD;
+  // Embree only reads these buffers; its API takes them as non-const.
+  rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                             const_cast<Float3*>(positions_), 0, sizeof(Float3), num_vertices);
+  rtcSetSharedGeometryBuffer(
+      geometry, RTC_BUFFER_TYPE_INDEX, 0, quads ? RTC_FORMAT_UINT4 : RTC_FORMAT_UINT3,
+      const_cast<std::int32_t*>(indices), 0, (quads ? 4 : 3) * sizeof(std::int32_t), count);
+  rtcSetGeometryBuildQuality(geometry, quality);
+  rtcCommitGeometry(geometry);
+  rtcAttachGeometryByID(scene_, geometry, geom_id);
+  rtcReleaseGeometry(geometry);  // the scene holds its own reference
+  geometries_[geom_id] = GeometryView{indices, nullptr, count, quads ? 4 : 3};
+  return device_->TakeError();
+}
+
+Status EmbreeScene::Setup(const Mesh& mesh, const TracerOptions& options) {
+  const auto setup_start = Clock::now();
+  SculptCounts counts;
+  DISPEX_RETURN_IF_ERROR(CheckSculpt(mesh, &counts));
+
+  DISPEX_ASSIGN_OR_RETURN(device_, EmbreeDevice::Create(options.memory_limit_bytes));
+  scene_ = rtcNewScene(device_->get());
+  if (scene_ == nullptr) return device_->TakeError();
+  int flags = RTC_SCENE_FLAG_NONE;
+  if (options.robust) flags |= RTC_SCENE_FLAG_ROBUST;
+  if (options.compact) flags |= RTC_SCENE_FLAG_COMPACT;
+  rtcSetSceneFlags(scene_, static_cast<RTCSceneFlags>(flags));
+  const RTCBuildQuality quality = ToRtc(options.quality);
+  rtcSetSceneBuildQuality(scene_, quality);
+
+  // Embree may read 16 bytes at the last vertex: share the mesh's vector when its capacity
+  // covers that, else make one padded copy.
+  const std::size_t num_vertices = mesh.num_vertices();
+  if (mesh.positions.capacity() >= num_vertices + 1) {
+    positions_ = mesh.positions.data();
+    stats_.shared_vertices = true;
+  } else {
+    vertex_copy_.reserve(num_vertices + 1);
+    vertex_copy_.assign(mesh.positions.begin(), mesh.positions.end());
+    positions_ = vertex_copy_.data();
+    stats_.copied_bytes += vertex_copy_.capacity() * sizeof(Float3);
+  }
+
+  const std::size_t num_faces = mesh.num_faces();
+  const bool all_quads = counts.quads == num_faces;
+  const bool all_triangles = counts.triangle_faces == num_faces;
+  const std::int32_t* quad_indices = nullptr;
+  const std::int32_t* triangle_indices = nullptr;
+  if (all_quads) {
+    quad_indices = mesh.face_indices.data();
+    stats_.shared_indices = true;
+  } else if (all_triangles) {
+    triangle_indices = mesh.face_indices.data();
+    stats_.shared_indices = true;
+  } else {
+    // Mixed: quads keep their 4 indices, other faces are fanned from their first vertex.
+    quad_indices_.reserve(4 * counts.quads);
+    quad_faces_.reserve(counts.quads);
+    triangle_indices_.reserve(3 * counts.triangles);
+    triangle_faces_.reserve(counts.triangles);
+    for (std::size_t f = 0; f < num_faces; ++f) {
+      const auto face = mesh.face(f);
+      const auto face_id = static_cast<std::int32_t>(f);
+      if (face.size() == 4) {
+        quad_indices_.insert(quad_indices_.end(), face.begin(), face.end());
+        quad_faces_.push_back(face_id);
+        continue;
+      }
+      for (std::size_t k = 1; k + 1 < face.size(); ++k) {
+        triangle_indices_.insert(triangle_indices_.end(), {face[0], face[k], face[k + 1]});
+        triangle_faces_.push_back(face_id);
+      }
+    }
+    quad_indices = quad_indices_.data();
+    triangle_indices = triangle_indices_.data();
+    stats_.copied_bytes += (quad_indices_.capacity() + quad_faces_.capacity() +
+                            triangle_indices_.capacity() + triangle_faces_.capacity()) *
+                           sizeof(std::int32_t);
+  }
+
+  if (counts.quads > 0) {
+    DISPEX_RETURN_IF_ERROR(AddGeometry(kQuadGeometry, RTC_GEOMETRY_TYPE_QUAD, quad_indices,
+                                       counts.quads, num_vertices, quality));
+    if (!quad_faces_.empty()) geometries_[kQuadGeometry].face_of_prim = quad_faces_.data();
+  }
+  if (counts.triangles > 0) {
+    DISPEX_RETURN_IF_ERROR(AddGeometry(kTriangleGeometry, RTC_GEOMETRY_TYPE_TRIANGLE,
+                                       triangle_indices, counts.triangles, num_vertices, quality));
+    if (!triangle_faces_.empty()) {
+      geometries_[kTriangleGeometry].face_of_prim = triangle_faces_.data();
+    }
+  }
+  stats_.setup_seconds = Seconds(setup_start);
+
+  const auto build_start = Clock::now();
+  rtcCommitScene(scene_);
+  stats_.build_seconds = Seconds(build_start);
+  DISPEX_RETURN_IF_ERROR(device_->TakeError());
+
+  RTCBounds bounds;
+  rtcGetSceneBounds(scene_, &bounds);
+  for (const float c : {bounds.lower_x, bounds.lower_y, bounds.lower_z, bounds.upper_x,
+                        bounds.upper_y, bounds.upper_z}) {
+    if (std::isfinite(c)) scale_ = std::max(scale_, std::fabs(c));
+  }
+  retry_misses_ = options.retry_misses;
+  verify_hits_ = options.verify_hits;
+
+  stats_.faces = num_faces;
+  stats_.quads = counts.quads;
+  stats_.triangles = counts.triangles;
+  stats_.backend_bytes = device_->bytes();
+  stats_.backend_peak_bytes = device_->peak_bytes();
+  stats_.backend = fmt::format(
+      "{}, {} build{}{}{}{}", device_->Describe(), ToString(options.quality),
+      options.robust ? ", robust" : "", options.compact ? ", compact" : "",
+      options.retry_misses ? ", retry misses" : "", options.verify_hits ? ", verify hits" : "");
+  return Status::Ok();
+}
+
+}  // namespace dispex::trace
