@@ -36,3 +36,15 @@ format:
 
 clean:
 	rm -rf $(BUILD) $(BUILD)-sanitize
+
+# libFuzzer targets for the OBJ, PLY and Ptex readers (clang; see fuzz/README.md). `fuzz`
+# runs each target for FUZZ_SECONDS, `fuzz-ci` for 60 s; a crash fails the run and its input
+# is copied to tests/fuzz_regressions/.
+FUZZ_SECONDS ?= 300
+.PHONY: fuzz-ci
+
+fuzz:
+	@FUZZ_JOBS=$(JOBS) scripts/fuzz.sh $(FUZZ_SECONDS)
+
+fuzz-ci:
+	@FUZZ_JOBS=$(JOBS) scripts/fuzz.sh 60

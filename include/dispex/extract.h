@@ -1,0 +1,143 @@
+// dispex::Extract: a base cage and its sculpt in, a Ptex displacement map out.
+//
+// For every Ptex face of the base's Catmull-Clark limit surface: an oversampled grid of
+// limit points and unit normals, rays along +n and -n into the sculpt, signed distances,
+// holes filled, the fewest texels that keep the error within the tolerance (DCT analysis),
+// and the face's compressed Ptex block. Faces run in parallel and each face's buffers live
+// only while it is processed. The output file is byte-identical for the same inputs and
+// options whatever the thread count, and appears only when complete.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "dispex/ptex.h"
+#include "dispex/spectral.h"
+#include "dispex/status.h"
+#include "dispex/trace.h"
+
+namespace dispex {
+
+// What to do with samples whose rays missed the sculpt.
+enum class HolePolicy : std::uint8_t {
+  kFill,  // interpolate from the face's valid samples (pull-push), or from neighbouring faces
+  kFail,  // any miss is an error
+  kZero,  // write 0
+};
+std::string_view HolePolicyName(HolePolicy policy);  // "fill", "fail", "zero"
+StatusOr<HolePolicy> ParseHolePolicy(std::string_view name);
+
+struct ExtractOptions {
+  std::string base_path;
+  std::string sculpt_path;
+  std::string output_path;
+
+  // Samples per side of each Ptex face's grid: a power of two 4..512, or 0 for automatic
+  // (from the sculpt's density over each face: a face covered by k sculpt quads is sampled at
+  // the power of two >= 2 sqrt(k), i.e. 2^(L+1) for a level-L subdivided sculpt), capped by
+  // max_oversample.
+  int oversample = 0;
+  int max_oversample = 128;
+  int min_oversample = 4;
+
+  SearchDistanceSpec search_distance;  // auto, absolute, or a fraction of the base diagonal
+  HitPolicy ray_policy = HitPolicy::kNearest;
+
+  // Largest allowed error of a stored face against its samples, in object units; 0: automatic,
+  // tolerance_fraction times the sculpt's median edge length.
+  double tolerance = 0;
+  double tolerance_fraction = 0.05;
+  ResolutionRule resolution_rule = ResolutionRule::kErrorBound;
+  double nonzero_threshold = 0;  // for ResolutionRule::kNonzero
+  int fixed_ulog2 = 6;           // for ResolutionRule::kFixed
+  int fixed_vlog2 = 6;
+
+  PtexDataType data_type = PtexDataType::kFloat;  // kFloat or kHalf
+  int compression_level = -1;                     // -1: the writer's default
+  HolePolicy holes = HolePolicy::kFill;
+  BuildQuality bvh_quality = BuildQuality::kLow;  // measured: same ray speed, a third of the build
+
+  int threads = 0;        // 0: all cores; the output does not depend on it
+  bool progress = false;  // draw a progress bar on stderr
+
+  // Refuse, before the work starts, an extraction estimated to need more memory than this
+  // (bytes; 0: the memory the machine has available). See EstimateExtractMemory.
+  std::uint64_t max_memory = 0;
+};
+
+// Checks ranges and combinations; the message names the option.
+Status ValidateExtractOptions(const ExtractOptions& options);
+
+struct ExtractReport {
+  std::string version;
+  std::string base_path, sculpt_path, output_path;
+  std::string base_fingerprint, sculpt_fingerprint;
+  ExtractOptions options;  // as given
+
+  // Resolved automatic values.
+  double tolerance = 0;
+  bool tolerance_auto = false;
+  double sculpt_median_edge = 0;
+  double search_distance = 0;
+  bool search_distance_auto = false;
+  SearchDistanceEstimate search_estimate;  // when automatic
+  double base_diagonal = 0;
+  int threads = 0;
+
+  // Inputs.
+  std::size_t base_vertices = 0, base_faces = 0, ptex_faces = 0, hole_faces = 0;
+  std::size_t sculpt_vertices = 0, sculpt_faces = 0;
+  int inf_sharp_edges = 0;
+  std::vector<std::string> warnings;
+
+  // Phases, wall seconds.
+  double t_read_base = 0, t_read_sculpt = 0, t_topology = 0, t_bvh = 0, t_search = 0,
+         t_sample_trace = 0, t_write = 0, t_total = 0;
+  // Within sample+trace (summed over threads, CPU seconds): limit evaluation, rays, spectral.
+  double cpu_limit = 0, cpu_trace = 0, cpu_spectral = 0, cpu_compress = 0;
+
+  // Sampling and rays.
+  std::array<std::int64_t, 10> oversample_faces{};  // faces by log2 of the samples per side
+  std::int64_t samples = 0;
+  std::uint64_t rays_cast = 0;
+  std::int64_t hits_positive = 0, hits_negative = 0, hits_back_face = 0;
+  // With an automatic search distance, samples that miss are searched again this far (0 when
+  // the distance was given).
+  double retry_search_distance = 0;
+  std::int64_t misses_recovered = 0;   // samples that hit on that second search
+  std::int64_t misses = 0;             // samples whose rays found nothing
+  std::int64_t holes_filled = 0;       // of those, filled within their face
+  std::int64_t faces_with_misses = 0;
+  std::int64_t faces_filled_from_neighbours = 0;
+  std::int64_t faces_unreachable = 0;  // missed entirely, no neighbour to fill from: 0 written
+  std::int64_t fallback_normals = 0;
+
+  // Spectral step.
+  SpectralTotals spectral;
+  double displacement_min = 0, displacement_max = 0, displacement_rms = 0;
+
+  // Output.
+  std::uint64_t bytes_written = 0;
+  std::uint64_t peak_rss_bytes = 0;
+};
+
+// Memory an extraction is estimated to need, in bytes: before reading, from the input file
+// sizes (mesh arrays take about half an OBJ's bytes); after reading, from the sculpt's
+// arrays, its BVH (about 80 bytes per primitive at medium quality) and the output's compressed
+// blocks. The check fails with a message giving the estimate and the limit.
+Status CheckMemoryBeforeReading(const ExtractOptions& options, std::uint64_t limit);
+Status CheckMemoryForSculpt(std::size_t sculpt_vertices, std::size_t sculpt_faces,
+                            std::size_t sculpt_indices, std::uint64_t base_texels,
+                            std::uint64_t limit);
+
+// Runs the whole pipeline. Errors (bad inputs, nothing hit, a miss under HolePolicy::kFail,
+// cancellation) leave no output file.
+StatusOr<ExtractReport> Extract(const ExtractOptions& options);
+
+// The report as JSON (pretty-printed) and as a short human summary.
+std::string ExtractReportJson(const ExtractReport& report);
+std::string ExtractReportSummary(const ExtractReport& report);
+
+}  // namespace dispex

@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Prints, for each class of bad input or option, the command run, its exit status and the
+# one line dispex prints (the table of docs/ROBUSTNESS.md).
+#   scripts/robustness-table.sh [build-dir]
+set -uo pipefail
+build="${1:-build}"
+root="$(cd "$(dirname "$0")/.." && pwd)"
+dispex="$root/$build/tools/dispex"
+w="$(mktemp -d)"
+trap 'chmod -R u+w "$w"; rm -rf "$w"' EXIT
+cd "$w"
+cage="$root/tests/data/meshes/keenan_blub/blub_control_mesh.obj"
+"$dispex" make-sculpt "$cage" --levels 2 --amplitude 0.004 -o sculpt.obj -q
+printf '' > empty.obj
+printf '\x7fELF\x02\x01\x01\x00\xff\xfe\x00\x13' > garbage.obj
+printf 'solid x\nendsolid x\n' > mesh.stl
+printf 'v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n' > nan.obj
+printf 'v 0 0 0\nv 1 0 0\nv 0 inf 0\nv 1 1 0\nf 1 2 4 3\n' > inf.obj
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 2 4\nf 1 2 3 4\n' > degenerate.obj
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n' > points.obj
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nf 1 2 3 4\nf 2 1 5 6\nf 1 2 6 5\nf 2 1 3 4\n' > nonmanifold.obj
+printf 'v 100 100 100\nv 101 100 100\nv 101 101 100\nv 100 101 100\nf 1 2 3 4\n' > far.obj
+printf 'ply\nformat binary_little_endian 1.0\nelement vertex 4294967295\nproperty float x\nend_header\n' > huge.ply
+printf 'Ptex garbage' > garbage.ptx
+mkdir -p adir
+run() {
+  local what="$1"; shift
+  local err
+  err=$("$dispex" "$@" 2>&1 >/dev/null | head -n 3)
+  local code=${PIPESTATUS[0]}
+  printf '| %s | `dispex %s` | %s | `%s` |\n' "$what" "$*" "$code" "$err"
+}
+x() { echo "extract $1 $2 -o out.ptx ${3:-}"; }
+echo "| input class | command | exit | message |"
+echo "|---|---|---|---|"
+run "missing file" extract "$cage" missing.obj -o out.ptx
+run "directory instead of a file" extract "$cage" adir -o out.ptx
+run "empty file" extract "$cage" empty.obj -o out.ptx
+run "binary garbage" extract "$cage" garbage.obj -o out.ptx
+run "wrong extension / unknown format" extract "$cage" mesh.stl -o out.ptx
+run "NaN coordinate" extract "$cage" nan.obj -o out.ptx
+run "Inf coordinate" extract inf.obj sculpt.obj -o out.ptx
+run "degenerate base face" extract degenerate.obj sculpt.obj -o out.ptx
+run "base without faces" extract points.obj sculpt.obj -o out.ptx
+run "non-manifold base" extract nonmanifold.obj sculpt.obj -o out.ptx
+run "PLY claiming 4 billion vertices" info huge.ply
+run "garbage Ptex" info garbage.ptx
+run "sculpt not overlapping the base" extract "$cage" far.obj -o out.ptx
+run "zero search distance" extract "$cage" sculpt.obj -o out.ptx --search-distance 0
+run "negative tolerance" extract "$cage" sculpt.obj -o out.ptx --tolerance -1
+run "unknown option" extract "$cage" sculpt.obj -o out.ptx --frobnicate
+run "too little memory" extract "$cage" sculpt.obj -o out.ptx --max-memory 1K
+run "output in a missing directory" extract "$cage" sculpt.obj -o nodir/out.ptx
+run "output equal to an input" extract "$cage" sculpt.obj -o sculpt.obj
+run "output is a directory" extract "$cage" sculpt.obj -o adir
+if [[ $(id -u) -ne 0 ]]; then
+  chmod 555 adir
+  run "read-only output directory" extract "$cage" sculpt.obj -o adir/out.ptx
+fi
+ls "$w" | grep -E '\.tmp\.|out\.ptx' && echo "LEFT OVER FILES" >&2

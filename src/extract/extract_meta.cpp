@@ -1,0 +1,113 @@
+#include "extract/extract_meta.h"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+
+namespace dispex {
+
+namespace {
+std::string FileName(const std::string& path) {
+  return std::filesystem::path(path).filename().string();
+}
+
+const char* SearchKindName(SearchDistanceSpec::Kind kind) {
+  switch (kind) {
+    case SearchDistanceSpec::Kind::kAuto: return "auto";
+    case SearchDistanceSpec::Kind::kAbsolute: return "absolute";
+    case SearchDistanceSpec::Kind::kRelative: return "relative";
+  }
+  return "auto";
+}
+}  // namespace
+
+nlohmann::json ExtractOptionsJson(const ExtractOptions& o) {
+  nlohmann::json j;
+  j["oversample"] = o.oversample == 0 ? nlohmann::json("auto") : nlohmann::json(o.oversample);
+  j["max_oversample"] = o.max_oversample;
+  j["min_oversample"] = o.min_oversample;
+  j["search_distance"] = {{"kind", SearchKindName(o.search_distance.kind)},
+                          {"value", o.search_distance.value}};
+  j["ray_policy"] = std::string(ToString(o.ray_policy));
+  j["tolerance"] = o.tolerance == 0 ? nlohmann::json("auto") : nlohmann::json(o.tolerance);
+  j["tolerance_fraction"] = o.tolerance_fraction;
+  j["resolution_rule"] = std::string(ResolutionRuleName(o.resolution_rule));
+  j["nonzero_threshold"] = o.nonzero_threshold;
+  j["fixed_resolution"] = {1 << o.fixed_ulog2, 1 << o.fixed_vlog2};
+  j["data_type"] = PtexName(o.data_type);
+  j["compression_level"] = o.compression_level;
+  j["holes"] = std::string(HolePolicyName(o.holes));
+  j["bvh_quality"] = std::string(ToString(o.bvh_quality));
+  return j;
+}
+
+nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
+  nlohmann::json j;
+  j["tolerance"] = r.tolerance;
+  j["tolerance_auto"] = r.tolerance_auto;
+  j["sculpt_median_edge"] = r.sculpt_median_edge;
+  j["search_distance"] = r.search_distance;
+  j["search_distance_auto"] = r.search_distance_auto;
+  j["base_diagonal"] = r.base_diagonal;
+  j["base"] = {{"vertices", r.base_vertices}, {"faces", r.base_faces},
+               {"ptex_faces", r.ptex_faces}, {"hole_faces", r.hole_faces},
+               {"inf_sharp_edges", r.inf_sharp_edges}};
+  j["sculpt"] = {{"vertices", r.sculpt_vertices}, {"faces", r.sculpt_faces}};
+  nlohmann::json oversample = nlohmann::json::object();
+  for (std::size_t k = 0; k < r.oversample_faces.size(); ++k) {
+    if (r.oversample_faces[k]) oversample[std::to_string(1 << k)] = r.oversample_faces[k];
+  }
+  j["oversample_faces"] = oversample;
+  j["samples"] = r.samples;
+  j["rays_cast"] = r.rays_cast;
+  j["hits"] = {{"positive", r.hits_positive}, {"negative", r.hits_negative},
+               {"back_face", r.hits_back_face}};
+  j["retry_search_distance"] = r.retry_search_distance;
+  j["misses_recovered"] = r.misses_recovered;
+  j["misses"] = r.misses;
+  j["holes_filled"] = r.holes_filled;
+  j["faces_with_misses"] = r.faces_with_misses;
+  j["faces_filled_from_neighbours"] = r.faces_filled_from_neighbours;
+  j["faces_unreachable"] = r.faces_unreachable;
+  j["fallback_normals"] = r.fallback_normals;
+  const SpectralTotals& s = r.spectral;
+  nlohmann::json resolutions = nlohmann::json::object();
+  for (std::size_t k = 0; k < s.ulog2_faces.size(); ++k) {
+    if (s.ulog2_faces[k] || s.vlog2_faces[k]) {
+      resolutions[std::to_string(1 << k)] = {{"u", s.ulog2_faces[k]}, {"v", s.vlog2_faces[k]}};
+    }
+  }
+  j["texels"] = {{"oversampled", s.texels_before},
+                 {"written", s.texels_after},
+                 {"written_fraction",
+                  s.texels_before ? double(s.texels_after) / double(s.texels_before) : 0.0}};
+  j["spectral"] = {{"faces", s.faces},
+                   {"constant_faces", s.constant_faces},
+                   {"stepped_up_faces", s.stepped_up_faces},
+                   {"max_bound", s.max_bound},
+                   {"max_measured_error", s.max_measured_error},
+                   {"faces_by_resolution", resolutions}};
+  j["displacement"] = {{"min", r.displacement_min}, {"max", r.displacement_max},
+                       {"rms", r.displacement_rms}};
+  return j;
+}
+
+Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractReport& report) {
+  DISPEX_RETURN_IF_ERROR(AddMeshMetaData(writer, base));
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:version", report.version));
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:base", FileName(report.base_path)));
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:base_fingerprint", report.base_fingerprint));
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:sculpt", FileName(report.sculpt_path)));
+  DISPEX_RETURN_IF_ERROR(
+      writer.AddMetaData("dispex:sculpt_fingerprint", report.sculpt_fingerprint));
+  DISPEX_RETURN_IF_ERROR(
+      writer.AddMetaData("dispex:options", ExtractOptionsJson(report.options).dump()));
+  DISPEX_RETURN_IF_ERROR(
+      writer.AddMetaData("dispex:statistics", ExtractStatisticsJson(report).dump()));
+  const double tolerance = report.tolerance, distance = report.search_distance;
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:tolerance", std::span(&tolerance, 1)));
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:search_distance", std::span(&distance, 1)));
+  return Status::Ok();
+}
+
+}  // namespace dispex

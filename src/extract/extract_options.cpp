@@ -1,0 +1,77 @@
+#include <fmt/format.h>
+
+#include <bit>
+#include <cmath>
+
+#include "dispex/extract.h"
+
+namespace dispex {
+
+std::string_view HolePolicyName(HolePolicy policy) {
+  switch (policy) {
+    case HolePolicy::kFill: return "fill";
+    case HolePolicy::kFail: return "fail";
+    case HolePolicy::kZero: return "zero";
+  }
+  return "fill";
+}
+
+StatusOr<HolePolicy> ParseHolePolicy(std::string_view name) {
+  for (HolePolicy p : {HolePolicy::kFill, HolePolicy::kFail, HolePolicy::kZero}) {
+    if (name == HolePolicyName(p)) return p;
+  }
+  return Status::Error(fmt::format("unknown hole policy '{}' (expected fill, fail or zero)", name));
+}
+
+namespace {
+bool IsPowerOfTwoIn(int v, int lo, int hi) {
+  return v >= lo && v <= hi && std::has_single_bit(static_cast<unsigned>(v));
+}
+}  // namespace
+
+Status ValidateExtractOptions(const ExtractOptions& o) {
+  if (o.base_path.empty()) return Status::Error("no base mesh given");
+  if (o.sculpt_path.empty()) return Status::Error("no sculpt mesh given");
+  if (o.output_path.empty()) return Status::Error("no output file given (-o OUT.ptx)");
+  if (o.output_path == o.base_path || o.output_path == o.sculpt_path) {
+    return Status::Error(fmt::format("output {} is also an input; refusing to overwrite it",
+                                     o.output_path));
+  }
+  if (o.oversample != 0 && !IsPowerOfTwoIn(o.oversample, 1, kMaxSpectralSize)) {
+    return Status::Error(fmt::format(
+        "--oversample {}: must be 'auto' or a power of two from 1 to {}", o.oversample,
+        kMaxSpectralSize));
+  }
+  if (!IsPowerOfTwoIn(o.max_oversample, 1, kMaxSpectralSize)) {
+    return Status::Error(fmt::format("--max-oversample {}: must be a power of two from 1 to {}",
+                                     o.max_oversample, kMaxSpectralSize));
+  }
+  if (!IsPowerOfTwoIn(o.min_oversample, 1, o.max_oversample)) {
+    return Status::Error(fmt::format(
+        "--min-oversample {}: must be a power of two from 1 to --max-oversample ({})",
+        o.min_oversample, o.max_oversample));
+  }
+  if (!(std::isfinite(o.tolerance) && o.tolerance >= 0)) {
+    return Status::Error(fmt::format("--tolerance {}: must be a finite length > 0", o.tolerance));
+  }
+  if (!(std::isfinite(o.tolerance_fraction) && o.tolerance_fraction > 0)) {
+    return Status::Error(fmt::format("--tolerance-fraction {}: must be > 0", o.tolerance_fraction));
+  }
+  if (o.search_distance.kind != SearchDistanceSpec::Kind::kAuto &&
+      !(std::isfinite(o.search_distance.value) && o.search_distance.value > 0)) {
+    return Status::Error(fmt::format("--search-distance {}: must be > 0", o.search_distance.value));
+  }
+  if (o.data_type != PtexDataType::kFloat && o.data_type != PtexDataType::kHalf) {
+    return Status::Error("--data-type: must be float or half");
+  }
+  if (o.threads < 0) return Status::Error(fmt::format("--threads {}: must be >= 0", o.threads));
+  SpectralOptions spectral;
+  spectral.rule = o.resolution_rule;
+  spectral.tolerance = o.tolerance > 0 ? o.tolerance : 1.0;
+  spectral.nonzero_threshold = o.nonzero_threshold;
+  spectral.fixed_ulog2 = o.fixed_ulog2;
+  spectral.fixed_vlog2 = o.fixed_vlog2;
+  return ValidateSpectralOptions(spectral);
+}
+
+}  // namespace dispex

@@ -1,0 +1,73 @@
+#include <fmt/format.h>
+
+#include "dispex/extract.h"
+#include "extract/extract_meta.h"
+
+namespace dispex {
+
+std::string ExtractReportJson(const ExtractReport& r) {
+  nlohmann::json j;
+  j["version"] = r.version;
+  j["inputs"] = {{"base", r.base_path},
+                 {"base_fingerprint", r.base_fingerprint},
+                 {"sculpt", r.sculpt_path},
+                 {"sculpt_fingerprint", r.sculpt_fingerprint}};
+  j["output"] = {{"path", r.output_path}, {"bytes", r.bytes_written}};
+  j["options"] = ExtractOptionsJson(r.options);
+  j["threads"] = r.threads;
+  j["statistics"] = ExtractStatisticsJson(r);
+  if (r.search_distance_auto) {
+    const SearchDistanceEstimate& e = r.search_estimate;
+    j["search_estimate"] = {{"samples", e.samples},
+                            {"hits", e.hits},
+                            {"ray_length", e.ray_length},
+                            {"percentile", e.percentile},
+                            {"percentile_abs_t", e.percentile_abs_t},
+                            {"median_abs_t", e.median_abs_t},
+                            {"max_abs_t", e.max_abs_t},
+                            {"floored", e.floored},
+                            {"capped", e.capped}};
+  }
+  j["phases_seconds"] = {{"read_base", r.t_read_base},   {"read_sculpt", r.t_read_sculpt},
+                         {"topology", r.t_topology},     {"bvh", r.t_bvh},
+                         {"auto_settings", r.t_search},  {"sample_trace", r.t_sample_trace},
+                         {"write", r.t_write},           {"total", r.t_total}};
+  j["cpu_seconds"] = {{"limit", r.cpu_limit},
+                      {"trace", r.cpu_trace},
+                      {"spectral", r.cpu_spectral},
+                      {"compress", r.cpu_compress}};
+  j["mrays_per_second"] =
+      r.t_sample_trace > 0 ? double(r.rays_cast) / r.t_sample_trace / 1e6 : 0.0;
+  j["peak_rss_bytes"] = r.peak_rss_bytes;
+  j["warnings"] = r.warnings;
+  return j.dump(2) + "\n";
+}
+
+std::string ExtractReportSummary(const ExtractReport& r) {
+  const SpectralTotals& s = r.spectral;
+  std::string out;
+  out += fmt::format("dispex: {} ({} Ptex faces) <- {} ({} faces)\n", r.output_path, r.ptex_faces,
+                     r.sculpt_path, r.sculpt_faces);
+  out += fmt::format("  tolerance {:.4g}{}  search distance {:.4g}{}\n", r.tolerance,
+                     r.tolerance_auto ? " (auto)" : "", r.search_distance,
+                     r.search_distance_auto ? " (auto)" : "");
+  out += fmt::format("  samples {}  rays {}  misses {} ({} filled in-face, {} faces from "
+                     "neighbours; {} more found by the {:.4g} search)\n",
+                     r.samples, r.rays_cast, r.misses, r.holes_filled,
+                     r.faces_filled_from_neighbours, r.misses_recovered,
+                     r.retry_search_distance);
+  out += fmt::format("  texels {} -> {} ({:.1f}%)  constant faces {}  max error {:.3g}\n",
+                     s.texels_before, s.texels_after,
+                     s.texels_before ? 100.0 * double(s.texels_after) / double(s.texels_before) : 0,
+                     s.constant_faces, s.max_measured_error);
+  out += fmt::format("  displacement [{:.4g}, {:.4g}] rms {:.4g}\n", r.displacement_min,
+                     r.displacement_max, r.displacement_rms);
+  out += fmt::format("  time {:.2f}s (read {:.2f}+{:.2f}, bvh {:.2f}, sample+trace {:.2f}, "
+                     "write {:.2f})  {:.1f} MB  peak {:.0f} MB\n",
+                     r.t_total, r.t_read_base, r.t_read_sculpt, r.t_bvh, r.t_sample_trace,
+                     r.t_write, double(r.bytes_written) / 1e6, double(r.peak_rss_bytes) / 1e6);
+  for (const std::string& w : r.warnings) out += "  warning: " + w + "\n";
+  return out;
+}
+
+}  // namespace dispex

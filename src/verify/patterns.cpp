@@ -1,0 +1,122 @@
+// Displacement patterns with known values, for ground-truth sculpts. Each is a closed-form
+// function of the position, so the exact displacement at any point is known.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
+
+#include "dispex/verify.h"
+
+namespace dispex {
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586;
+
+struct Wave {
+  double dir[3];
+  double wavelength;
+  double phase;
+  double weight;
+};
+
+double Dot(const double d[3], const double p[3]) { return d[0] * p[0] + d[1] * p[1] + d[2] * p[2]; }
+
+double Smooth(const double p[3], double diagonal) {
+  static const double d1[3] = {0.6, 0.64, 0.48}, d2[3] = {-0.48, 0.6, 0.64},
+                      d3[3] = {0.64, -0.48, 0.6};
+  return 0.5 * std::sin(kTwoPi * Dot(d1, p) / (0.6 * diagonal) + 0.3) +
+         0.3 * std::sin(kTwoPi * Dot(d2, p) / (0.35 * diagonal) + 1.1) +
+         0.2 * std::sin(kTwoPi * Dot(d3, p) / (0.25 * diagonal) + 2.0);
+}
+
+double SmoothStep(double edge0, double edge1, double x) {
+  double t = std::clamp((x - edge0) / (edge1 - edge0), 0.0, 1.0);
+  return t * t * (3 - 2 * t);
+}
+
+const std::array<Wave, 24>& NoiseWaves(std::uint32_t seed, double edge) {
+  thread_local std::uint32_t cached_seed = 0;
+  thread_local double cached_edge = -1;
+  thread_local std::array<Wave, 24> waves;
+  if (cached_seed != seed || cached_edge != edge) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (Wave& w : waves) {
+      double z = 2 * unit(rng) - 1, a = kTwoPi * unit(rng), r = std::sqrt(1 - z * z);
+      w.dir[0] = r * std::cos(a);
+      w.dir[1] = r * std::sin(a);
+      w.dir[2] = z;
+      w.wavelength = edge * (6 + 18 * unit(rng));
+      w.phase = kTwoPi * unit(rng);
+      w.weight = 1.0 / std::sqrt(double(waves.size()));
+    }
+    cached_seed = seed;
+    cached_edge = edge;
+  }
+  return waves;
+}
+
+}  // namespace
+
+std::string_view PatternName(Pattern pattern) {
+  switch (pattern) {
+    case Pattern::kSmooth: return "smooth";
+    case Pattern::kDetail: return "detail";
+    case Pattern::kRidges: return "ridges";
+    case Pattern::kNoise: return "noise";
+    case Pattern::kNone: return "none";
+  }
+  return "smooth";
+}
+
+StatusOr<Pattern> ParsePattern(std::string_view name) {
+  for (Pattern p : {Pattern::kSmooth, Pattern::kDetail, Pattern::kRidges, Pattern::kNoise,
+                    Pattern::kNone}) {
+    if (name == PatternName(p)) return p;
+  }
+  return Status::Error(
+      fmt::format("unknown pattern '{}' (expected smooth, detail, ridges, noise or none)", name));
+}
+
+double EvaluatePattern(Pattern pattern, const PatternFrame& f, const float point[3]) {
+  const double p[3] = {double(point[0]) - f.center[0], double(point[1]) - f.center[1],
+                       double(point[2]) - f.center[2]};
+  const double D = f.diagonal, A = f.amplitude;
+  switch (pattern) {
+    case Pattern::kSmooth: return A * Smooth(p, D);
+    case Pattern::kDetail: {
+      // Two balls of fine bumps, fading out smoothly over their outer third.
+      static const double axis[3] = {0.8, 0.36, 0.48};
+      double weight = 0;
+      for (double side : {-1.0, 1.0}) {
+        double q[3] = {p[0] - side * 0.2 * D * axis[0], p[1] - side * 0.2 * D * axis[1],
+                       p[2] - side * 0.2 * D * axis[2]};
+        double r = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+        weight += 1 - SmoothStep(0.15 * D, 0.22 * D, r);
+      }
+      double k = kTwoPi / (8 * f.edge);
+      double bumps = std::sin(k * p[0]) * std::sin(k * p[1]) * std::sin(k * p[2]);
+      return A * (Smooth(p, D) + 0.5 * std::min(weight, 1.0) * bumps);
+    }
+    case Pattern::kRidges: {
+      static const double d[3] = {0.36, 0.48, 0.8};
+      double s = Dot(d, p) / (0.12 * D);
+      double tri = 2 * std::abs(s - std::floor(s) - 0.5);  // 0..1, kinks at integers and halves
+      return A * (0.5 * Smooth(p, D) + (tri - 0.5));
+    }
+    case Pattern::kNoise: {
+      double h = 0;
+      for (const Wave& w : NoiseWaves(f.seed, f.edge)) {
+        h += w.weight * std::sin(kTwoPi * Dot(w.dir, p) / w.wavelength + w.phase);
+      }
+      return A * h;
+    }
+    case Pattern::kNone: return 0;
+  }
+  return 0;
+}
+
+}  // namespace dispex

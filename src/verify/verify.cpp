@@ -1,0 +1,376 @@
+// dispex verify: how far a displacement map is from the sculpt it was made from.
+//
+// The base limit surface displaced by the map (read bilinearly per face, as a renderer reads
+// it) is sampled densely on every Ptex face. Map -> sculpt: each sample's distance to the
+// nearest point of the sculpt. Sculpt -> map: each sculpt vertex's distance to the nearest
+// point of the displaced surface, tessellated on the same grid. Truth: the map against the
+// exact displacement of a generated sculpt at each of its vertices' (face, u, v).
+#include <fmt/format.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <numeric>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "core/system.h"
+#include "dispex/mesh.h"
+#include "dispex/ptex.h"
+#include "dispex/subdiv.h"
+#include "dispex/trace.h"
+#include "dispex/verify.h"
+
+namespace dispex {
+
+namespace {
+
+// Statistics of absolute values; sums in index order, so the result is deterministic.
+ErrorStats Summarise(std::vector<float>& values) {
+  ErrorStats s;
+  s.count = values.size();
+  if (values.empty()) return s;
+  double sum = 0, sum_sq = 0;
+  for (float v : values) {
+    sum += v;
+    sum_sq += double(v) * v;
+  }
+  s.mean = sum / double(values.size());
+  s.rms = std::sqrt(sum_sq / double(values.size()));
+  std::size_t k = static_cast<std::size_t>(std::ceil(0.99 * double(values.size()))) - 1;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  s.p99 = values[k];
+  s.max = *std::max_element(values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return s;
+}
+
+struct DisplacedSurface {
+  Mesh mesh;                       // (k+1)^2 vertices and k^2 quads per face
+  std::vector<Float3> samples;     // k^2 points per face at cell centres
+  std::vector<std::int32_t> sample_face;
+  std::vector<int> k;              // per face, 0 for holes
+};
+
+StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const PtexFile& map,
+                                    int fixed_k) {
+  const int n = surface.num_ptex_faces();
+  DisplacedSurface d;
+  d.k.assign(static_cast<std::size_t>(n), 0);
+  std::vector<std::size_t> vertex_start(static_cast<std::size_t>(n) + 1, 0);
+  std::vector<std::size_t> sample_start(static_cast<std::size_t>(n) + 1, 0);
+  for (int f = 0; f < n; ++f) {
+    PtexFaceId face(f);
+    int k = 0;
+    if (!surface.is_hole(face)) {
+      const PtexFaceInfo& info = map.face_info(face);
+      k = fixed_k > 0 ? fixed_k : std::clamp(2 * std::max(info.ures(), info.vres()), 8, 64);
+    }
+    d.k[static_cast<std::size_t>(f)] = k;
+    vertex_start[f + 1] = vertex_start[f] + (k ? std::size_t(k + 1) * (k + 1) : 0);
+    sample_start[f + 1] = sample_start[f] + std::size_t(k) * k;
+  }
+  d.mesh.source = map.name() + " (displaced)";
+  d.mesh.positions.reserve(vertex_start[n] + 1);
+  d.mesh.positions.resize(vertex_start[n]);
+  d.samples.resize(sample_start[n]);
+  d.sample_face.resize(sample_start[n]);
+  d.mesh.face_offsets.resize(sample_start[n] + 1);
+  d.mesh.face_indices.resize(4 * sample_start[n]);
+  for (std::size_t q = 0; q <= sample_start[n]; ++q) d.mesh.face_offsets[q] = std::uint32_t(4 * q);
+
+  struct Scratch {
+    std::vector<float> uv, p, nrm;
+  };
+  tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
+  tbb::enumerable_thread_specific<Scratch> scratch;
+  std::mutex mutex;
+  Status error;
+  tbb::parallel_for(0, n, [&](int f) {
+    const int k = d.k[static_cast<std::size_t>(f)];
+    if (k == 0) return;
+    PtexFaceId face(f);
+    auto& evaluator = evaluators.local();
+    if (!evaluator) evaluator.emplace(surface);
+    Scratch& s = scratch.local();
+    // Corner grid (for the mesh) then cell centres (for the samples), in one evaluation.
+    const std::size_t corners = std::size_t(k + 1) * (k + 1), centres = std::size_t(k) * k;
+    s.uv.resize(2 * (corners + centres));
+    std::size_t i = 0;
+    for (int y = 0; y <= k; ++y) {
+      for (int x = 0; x <= k; ++x) {
+        s.uv[i++] = float(x) / float(k);
+        s.uv[i++] = float(y) / float(k);
+      }
+    }
+    for (int y = 0; y < k; ++y) {
+      for (int x = 0; x < k; ++x) {
+        s.uv[i++] = (float(x) + 0.5f) / float(k);
+        s.uv[i++] = (float(y) + 0.5f) / float(k);
+      }
+    }
+    s.p.resize(3 * (corners + centres));
+    s.nrm.resize(s.p.size());
+    Status st = evaluator->EvaluatePoints(face, s.uv, s.p, s.nrm);
+    if (!st.ok()) {
+      std::lock_guard lock(mutex);
+      if (error.ok()) error = st;
+      return;
+    }
+    auto displaced = [&](std::size_t j) {
+      float h = map.Sample(face, s.uv[2 * j], s.uv[2 * j + 1]);
+      return Float3{s.p[3 * j] + h * s.nrm[3 * j], s.p[3 * j + 1] + h * s.nrm[3 * j + 1],
+                    s.p[3 * j + 2] + h * s.nrm[3 * j + 2]};
+    };
+    Float3* vertices = d.mesh.positions.data() + vertex_start[f];
+    for (std::size_t j = 0; j < corners; ++j) vertices[j] = displaced(j);
+    for (std::size_t j = 0; j < centres; ++j) {
+      d.samples[sample_start[f] + j] = displaced(corners + j);
+      d.sample_face[sample_start[f] + j] = f;
+    }
+    std::int32_t* quads = d.mesh.face_indices.data() + 4 * sample_start[f];
+    const auto base = static_cast<std::int32_t>(vertex_start[f]);
+    for (int y = 0; y < k; ++y) {
+      for (int x = 0; x < k; ++x) {
+        std::int32_t v0 = base + y * (k + 1) + x;
+        *quads++ = v0;
+        *quads++ = v0 + 1;
+        *quads++ = v0 + k + 2;
+        *quads++ = v0 + k + 1;
+      }
+    }
+  });
+  DISPEX_RETURN_IF_ERROR(error);
+  for (const Float3& p : d.mesh.positions) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      return Status::Error(map.name() + ": the map holds values that are not finite");
+    }
+  }
+  return d;
+}
+
+std::vector<float> ClosestDistances(const Tracer& tracer, std::span<const Float3> points) {
+  std::vector<float> distances(points.size());
+  constexpr std::size_t kBatch = 4096;
+  tbb::enumerable_thread_specific<std::vector<ClosestPoint>> results;
+  tbb::parallel_for(std::size_t{0}, (points.size() + kBatch - 1) / kBatch, [&](std::size_t b) {
+    std::size_t begin = b * kBatch, end = std::min(points.size(), begin + kBatch);
+    auto& out = results.local();
+    out.resize(end - begin);
+    TraceCounters counters;
+    tracer.ClosestPoints(points.subspan(begin, end - begin),
+                         std::numeric_limits<float>::infinity(), out, counters);
+    for (std::size_t i = begin; i < end; ++i) distances[i] = out[i - begin].distance;
+  });
+  return distances;
+}
+
+void Threshold(VerifyReport& r, const char* what, const ErrorStats& s, double limit,
+               const char* option) {
+  if (!r.passed || limit <= 0 || s.max <= limit) return;
+  r.passed = false;
+  r.failure = fmt::format("{} max error {:.6g} exceeds {} {:.6g}", what, s.max, option, limit);
+}
+
+void RmsThreshold(VerifyReport& r, const char* what, const ErrorStats& s, double limit) {
+  if (!r.passed || limit <= 0 || s.rms <= limit) return;
+  r.passed = false;
+  r.failure = fmt::format("{} RMS error {:.6g} exceeds --max-rms {:.6g}", what, s.rms, limit);
+}
+
+}  // namespace
+
+StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
+  Stopwatch clock;
+  if (options.sculpt_path.empty() && options.truth_path.empty()) {
+    return Status::Error("nothing to compare the map with: give a sculpt or --truth");
+  }
+  if (options.samples_per_face < 0 || options.samples_per_face > 512) {
+    return Status::Error(fmt::format("--samples {}: must be 0..512", options.samples_per_face));
+  }
+  std::optional<tbb::global_control> limit;
+  if (options.threads > 0) {
+    limit.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(options.threads));
+  }
+  DISPEX_ASSIGN_OR_RETURN(Mesh base, ReadMesh(options.base_path));
+  DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
+  DISPEX_ASSIGN_OR_RETURN(PtexFile map, PtexFile::Open(options.map_path));
+  VerifyReport r;
+  r.ptex_faces = static_cast<std::size_t>(surface.num_ptex_faces());
+  r.diagonal = ComputeBounds(base).diagonal();
+  if (map.num_faces() != surface.num_ptex_faces()) {
+    return Status::Error(fmt::format("{}: {} faces, but {} has {} Ptex faces: not a map of this "
+                                     "base mesh", options.map_path, map.num_faces(),
+                                     options.base_path, surface.num_ptex_faces()));
+  }
+  if (map.header().num_channels < 1) return Status::Error(options.map_path + ": no channels");
+  if (const PtexMetaItem* stats = map.FindMetaData("dispex:statistics")) {
+    auto j = nlohmann::json::parse(stats->AsString(), nullptr, false);
+    if (j.is_object()) {
+      r.map_misses = j.value("misses", std::int64_t{-1});
+      r.map_holes_filled = j.value("holes_filled", std::int64_t{-1});
+      r.map_faces_filled_from_neighbours = j.value("faces_filled_from_neighbours", std::int64_t{-1});
+      r.map_tolerance = j.value("tolerance", 0.0);
+    }
+  }
+
+  if (!options.truth_path.empty()) {
+    DISPEX_ASSIGN_OR_RETURN(GroundTruth truth, ReadGroundTruth(options.truth_path));
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      int f = truth.faces[i].value;
+      float u = truth.uvs[2 * i], v = truth.uvs[2 * i + 1];
+      if (f < 0 || f >= map.num_faces() || !(u >= 0 && u <= 1 && v >= 0 && v <= 1)) {
+        return Status::Error(fmt::format("{}: record {} names face {} at ({}, {}), outside {}",
+                                         options.truth_path, i, f, u, v, options.map_path));
+      }
+    }
+    std::vector<float> errors(truth.size()), signed_errors(truth.size());
+    tbb::parallel_for(std::size_t{0}, truth.size(), [&](std::size_t i) {
+      float value = map.Sample(truth.faces[i], truth.uvs[2 * i], truth.uvs[2 * i + 1]);
+      signed_errors[i] = value - truth.h[i];
+      errors[i] = std::abs(signed_errors[i]);
+    });
+    double sum = 0;
+    for (float e : signed_errors) sum += e;
+    r.truth_signed_mean = truth.size() ? sum / double(truth.size()) : 0;
+    r.truth = Summarise(errors);
+    r.measured_truth = true;
+    if (r.truth.count && !std::isfinite(r.truth.max)) {
+      return Status::Error(options.map_path + ": the map holds values that are not finite");
+    }
+  }
+
+  if (!options.sculpt_path.empty()) {
+    DISPEX_ASSIGN_OR_RETURN(Mesh sculpt, ReadMesh(options.sculpt_path));
+    DISPEX_ASSIGN_OR_RETURN(DisplacedSurface displaced,
+                            Displace(surface, map, options.samples_per_face));
+    r.samples_per_face_min = 1 << 30;
+    for (int k : displaced.k) {
+      if (k == 0) continue;
+      r.samples_per_face_min = std::min(r.samples_per_face_min, k);
+      r.samples_per_face_max = std::max(r.samples_per_face_max, k);
+    }
+    if (displaced.samples.empty()) return Status::Error(options.base_path + ": no surface");
+    {
+      DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> sculpt_tracer, MakeEmbreeTracer(sculpt));
+      std::vector<float> d = ClosestDistances(*sculpt_tracer, displaced.samples);
+      std::vector<double> face_max(r.ptex_faces, 0.0);
+      for (std::size_t i = 0; i < d.size(); ++i) {
+        double& m = face_max[static_cast<std::size_t>(displaced.sample_face[i])];
+        m = std::max(m, double(d[i]));
+      }
+      std::vector<int> order(r.ptex_faces);
+      std::iota(order.begin(), order.end(), 0);
+      std::stable_sort(order.begin(), order.end(),
+                       [&](int a, int b) { return face_max[a] > face_max[b]; });
+      for (std::size_t i = 0; i < std::min<std::size_t>(10, order.size()); ++i) {
+        if (face_max[order[i]] > 0) r.worst_faces.push_back({order[i], face_max[order[i]]});
+      }
+      r.map_to_sculpt = Summarise(d);
+    }
+    {
+      DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> map_tracer,
+                              MakeEmbreeTracer(displaced.mesh));
+      std::size_t stride = 1;
+      if (options.max_sculpt_points > 0 && sculpt.num_vertices() > options.max_sculpt_points) {
+        stride = (sculpt.num_vertices() + options.max_sculpt_points - 1) / options.max_sculpt_points;
+      }
+      std::vector<Float3> points;
+      points.reserve(sculpt.num_vertices() / stride + 1);
+      for (std::size_t v = 0; v < sculpt.num_vertices(); v += stride) {
+        points.push_back(sculpt.positions[v]);
+      }
+      std::vector<float> d = ClosestDistances(*map_tracer, points);
+      r.sculpt_to_map = Summarise(d);
+    }
+    r.measured_distances = true;
+  }
+
+  double limit_abs = options.max_error;
+  if (options.max_error_rel > 0) {
+    double rel = options.max_error_rel * r.diagonal;
+    limit_abs = limit_abs > 0 ? std::min(limit_abs, rel) : rel;
+  }
+  const char* option = options.max_error_rel > 0 ? "--max-error-rel" : "--max-error";
+  if (r.measured_truth) Threshold(r, "truth", r.truth, limit_abs, option);
+  if (r.measured_distances) {
+    Threshold(r, "map->sculpt", r.map_to_sculpt, limit_abs, option);
+    Threshold(r, "sculpt->map", r.sculpt_to_map, limit_abs, option);
+  }
+  if (r.measured_truth) RmsThreshold(r, "truth", r.truth, options.max_rms);
+  if (r.measured_distances) {
+    RmsThreshold(r, "map->sculpt", r.map_to_sculpt, options.max_rms);
+    RmsThreshold(r, "sculpt->map", r.sculpt_to_map, options.max_rms);
+  }
+  r.seconds = clock.seconds();
+  return r;
+}
+
+namespace {
+nlohmann::json StatsJson(const ErrorStats& s, double diagonal) {
+  return {{"count", s.count}, {"mean", s.mean}, {"rms", s.rms}, {"p99", s.p99},
+          {"max", s.max},     {"rms_rel", s.rms / diagonal},    {"p99_rel", s.p99 / diagonal},
+          {"max_rel", s.max / diagonal}};
+}
+std::string StatsLine(const char* what, const ErrorStats& s, double diagonal) {
+  return fmt::format("  {:<12} rms {:.4g}  p99 {:.4g}  max {:.4g}  (max {:.3g} of the diagonal; "
+                     "{} points)\n",
+                     what, s.rms, s.p99, s.max, s.max / diagonal, s.count);
+}
+}  // namespace
+
+std::string VerifyReportJson(const VerifyReport& r) {
+  nlohmann::json j;
+  j["diagonal"] = r.diagonal;
+  j["ptex_faces"] = r.ptex_faces;
+  if (r.measured_distances) {
+    j["samples_per_face"] = {r.samples_per_face_min, r.samples_per_face_max};
+    j["map_to_sculpt"] = StatsJson(r.map_to_sculpt, r.diagonal);
+    j["sculpt_to_map"] = StatsJson(r.sculpt_to_map, r.diagonal);
+    nlohmann::json worst = nlohmann::json::array();
+    for (const auto& w : r.worst_faces) worst.push_back({{"face", w.face}, {"max", w.max}});
+    j["worst_faces"] = worst;
+  }
+  if (r.measured_truth) {
+    j["truth"] = StatsJson(r.truth, r.diagonal);
+    j["truth"]["signed_mean"] = r.truth_signed_mean;
+  }
+  j["map"] = {{"misses", r.map_misses},
+              {"holes_filled", r.map_holes_filled},
+              {"faces_filled_from_neighbours", r.map_faces_filled_from_neighbours},
+              {"tolerance", r.map_tolerance}};
+  j["passed"] = r.passed;
+  if (!r.passed) j["failure"] = r.failure;
+  j["seconds"] = r.seconds;
+  return j.dump(2) + "\n";
+}
+
+std::string VerifyReportSummary(const VerifyReport& r) {
+  std::string out = fmt::format("verify: {} Ptex faces, bounding-box diagonal {:.4g}\n",
+                                r.ptex_faces, r.diagonal);
+  if (r.measured_distances) {
+    out += StatsLine("map->sculpt", r.map_to_sculpt, r.diagonal);
+    out += StatsLine("sculpt->map", r.sculpt_to_map, r.diagonal);
+    if (!r.worst_faces.empty()) {
+      out += "  worst faces:";
+      for (const auto& w : r.worst_faces) out += fmt::format(" {} ({:.3g})", w.face, w.max);
+      out += "\n";
+    }
+  }
+  if (r.measured_truth) {
+    out += StatsLine("truth", r.truth, r.diagonal);
+  }
+  if (r.map_misses >= 0) {
+    out += fmt::format("  map: {} misses ({} filled in-face, {} faces from neighbours), "
+                       "tolerance {:.4g}\n",
+                       r.map_misses, r.map_holes_filled, r.map_faces_filled_from_neighbours,
+                       r.map_tolerance);
+  }
+  out += r.passed ? "  passed\n" : "  FAILED: " + r.failure + "\n";
+  return out;
+}
+
+}  // namespace dispex

@@ -1,0 +1,272 @@
+// End-to-end extraction on real cages with generated sculpts of known displacement.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+
+#include "dispex/extract.h"
+#include "dispex/mesh.h"
+#include "dispex/ptex.h"
+#include "dispex/verify.h"
+#include "e2e_support.h"
+
+namespace dispex {
+namespace {
+
+using testing::DataPath;
+using testing::RunDispex;
+using testing::TempDir;
+
+struct Case {
+  const char* cage;
+  const char* what;
+};
+
+class ExtractRealCages : public ::testing::TestWithParam<Case> {};
+
+TEST_P(ExtractRealCages, MapMatchesTheKnownDisplacementAndTheReportAddsUp) {
+  TempDir dir;
+  const std::string cage = DataPath(GetParam().cage);
+  auto base = ReadMesh(cage);
+  ASSERT_TRUE(base.ok()) << base.status().message();
+  const double diagonal = ComputeBounds(*base).diagonal();
+
+  MakeSculptOptions make;
+  make.cage_path = cage;
+  make.output_path = dir / "sculpt.obj";
+  make.levels = 3;
+  make.pattern = Pattern::kSmooth;
+  make.amplitude = 0.002 * diagonal;
+  auto made = MakeSculpt(make);
+  ASSERT_TRUE(made.ok()) << made.status().message();
+  ASSERT_EQ(made->folded_faces, 0u);
+
+  ExtractOptions options;
+  options.base_path = cage;
+  options.sculpt_path = make.output_path;
+  options.output_path = dir / "map.ptx";
+  auto report = Extract(options);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+
+  // The file: one face per Ptex face, with OpenSubdiv's adjacency.
+  auto map = PtexFile::Open(options.output_path);
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  auto faces = ComputeSubdivPtexFaces(*base);
+  ASSERT_TRUE(faces.ok());
+  ASSERT_EQ(map->num_faces(), faces->num_faces());
+  EXPECT_EQ(map->header().data_type, PtexDataType::kFloat);
+  EXPECT_EQ(map->header().mesh_type, PtexMeshType::kQuad);
+  std::int64_t texels = 0;
+  for (int f = 0; f < map->num_faces(); ++f) {
+    const PtexFaceInfo& info = map->face_info(PtexFaceId(f));
+    EXPECT_EQ(info.adjfaces, faces->faces[f].adjfaces) << "face " << f;
+    EXPECT_EQ(info.subface, faces->faces[f].subface) << "face " << f;
+    texels += info.constant ? 1 : static_cast<std::int64_t>(info.num_texels());
+  }
+  ASSERT_NE(map->FindMetaData("dispex:options"), nullptr);
+  ASSERT_NE(map->FindMetaData("PtexFaceVertCounts"), nullptr);
+
+  // The report adds up.
+  EXPECT_EQ(report->ptex_faces, static_cast<std::size_t>(faces->num_faces()));
+  EXPECT_EQ(report->spectral.texels_after, texels);
+  std::int64_t samples = 0;
+  for (std::size_t k = 0; k < report->oversample_faces.size(); ++k) {
+    samples += report->oversample_faces[k] << (2 * k);
+  }
+  EXPECT_EQ(report->samples, samples);
+  EXPECT_EQ(report->spectral.texels_before, samples);
+  EXPECT_GE(report->rays_cast, static_cast<std::uint64_t>(samples));
+  EXPECT_LE(report->rays_cast, static_cast<std::uint64_t>(3 * samples));
+  EXPECT_EQ(report->hits_positive + report->hits_negative + report->misses, samples);
+  EXPECT_EQ(report->misses, 0);
+  EXPECT_LE(report->spectral.max_measured_error, report->tolerance);
+  // A level-3 sculpt of the cage: 2^4 samples per side on quads, 2^3 on n-gon sub-faces.
+  EXPECT_EQ(report->oversample_faces[0] + report->oversample_faces[1] +
+                report->oversample_faces[2] + report->oversample_faces[5],
+            0);
+
+  // Sign and magnitude: the map against the exact displacement.
+  VerifyOptions verify;
+  verify.base_path = cage;
+  verify.map_path = options.output_path;
+  verify.truth_path = make.output_path + ".truth";
+  auto checked = Verify(verify);
+  ASSERT_TRUE(checked.ok()) << checked.status().message();
+  EXPECT_LE(checked->truth.max, report->tolerance + 2 * made->linear_error)
+      << GetParam().what;
+  EXPECT_LT(checked->truth.rms, 0.25 * make.amplitude) << GetParam().what;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cages, ExtractRealCages,
+    ::testing::Values(Case{"meshes/keenan_spot/spot_control_mesh.obj", "n-gons"},
+                      Case{"meshes/stanford_bunny/bun_zipper_quadriflow_1000.obj", "quads"},
+                      Case{"meshes/opensubdiv/catmark_torus_creases0.obj", "creases"},
+                      Case{"meshes/opensubdiv/catmark_tent.obj", "boundaries"}),
+    [](const auto& param_info) {
+      std::string name = param_info.param.what;
+      for (char& c : name) {
+        if (c == '-') c = '_';
+      }
+      return name;
+    });
+
+class ExtractTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    cage_ = DataPath("meshes/keenan_blub/blub_control_mesh.obj");
+    MakeSculptOptions make;
+    make.cage_path = cage_;
+    make.output_path = dir_ / "sculpt.obj";
+    make.levels = 3;
+    make.pattern = Pattern::kDetail;
+    make.amplitude = 0.005;
+    auto made = MakeSculpt(make);
+    ASSERT_TRUE(made.ok()) << made.status().message();
+    sculpt_ = make.output_path;
+  }
+  ExtractOptions Options(const std::string& out) const {
+    ExtractOptions o;
+    o.base_path = cage_;
+    o.sculpt_path = sculpt_;
+    o.output_path = dir_ / out;
+    return o;
+  }
+
+  TempDir dir_;
+  std::string cage_, sculpt_;
+};
+
+TEST_F(ExtractTest, OneAndTwoThreadsGiveIdenticalBytes) {
+  ExtractOptions one = Options("one.ptx"), two = Options("two.ptx");
+  one.threads = 1;
+  two.threads = 2;
+  ASSERT_TRUE(Extract(one).ok());
+  ASSERT_TRUE(Extract(two).ok());
+  std::string a = testing::Slurp(one.output_path), b = testing::Slurp(two.output_path);
+  ASSERT_GT(a.size(), 1000u);
+  EXPECT_TRUE(a == b) << "the map depends on the thread count";
+}
+
+TEST_F(ExtractTest, HalfFloatAndFixedResolution) {
+  ExtractOptions o = Options("half.ptx");
+  o.data_type = PtexDataType::kHalf;
+  o.resolution_rule = ResolutionRule::kFixed;
+  o.fixed_ulog2 = 3;
+  o.fixed_vlog2 = 2;
+  auto report = Extract(o);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  auto map = PtexFile::Open(o.output_path);
+  ASSERT_TRUE(map.ok());
+  EXPECT_EQ(map->header().data_type, PtexDataType::kHalf);
+  for (int f = 0; f < map->num_faces(); ++f) {
+    const PtexFaceInfo& info = map->face_info(PtexFaceId(f));
+    if (info.constant) continue;
+    EXPECT_EQ(info.ulog2, 3);
+    EXPECT_EQ(info.vlog2, 2);
+  }
+}
+
+TEST_F(ExtractTest, SculptFarAwayIsAClearErrorAndWritesNothing) {
+  auto sculpt = ReadMesh(sculpt_);
+  ASSERT_TRUE(sculpt.ok());
+  // Moved by ten bounding-box diagonals: no ray can reach it.
+  std::string moved = dir_ / "moved.obj";
+  {
+    std::ofstream out(moved);
+    for (const Float3& p : sculpt->positions) out << "v " << p.x + 30 << ' ' << p.y << ' ' << p.z << '\n';
+    for (std::size_t f = 0; f < sculpt->num_faces(); ++f) {
+      out << 'f';
+      for (int v : sculpt->face(f)) out << ' ' << v + 1;
+      out << '\n';
+    }
+  }
+  ExtractOptions o = Options("far.ptx");
+  o.sculpt_path = moved;
+  auto report = Extract(o);
+  ASSERT_FALSE(report.ok());
+  EXPECT_NE(report.status().message().find("do not overlap"), std::string::npos)
+      << report.status().message();
+  EXPECT_FALSE(testing::fs::exists(o.output_path));
+  // Only the inputs: sculpt.obj, its truth file and moved.obj.
+  EXPECT_EQ(std::distance(testing::fs::directory_iterator(dir_.path()), {}), 3);
+
+  o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0.01};
+  report = Extract(o);
+  ASSERT_FALSE(report.ok());
+  EXPECT_NE(report.status().message().find("do not overlap"), std::string::npos);
+  EXPECT_FALSE(testing::fs::exists(o.output_path));
+}
+
+TEST_F(ExtractTest, BadInputsAreClearErrors) {
+  std::string empty = dir_ / "empty.obj", no_faces = dir_ / "points.obj";
+  std::ofstream(empty).close();
+  std::ofstream(no_faces) << "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  struct Bad {
+    std::string base, sculpt, out, expect;
+  };
+  const Bad cases[] = {
+      {cage_, empty, dir_ / "a.ptx", "empty.obj"},
+      {cage_, no_faces, dir_ / "a.ptx", "points.obj"},
+      {no_faces, sculpt_, dir_ / "a.ptx", "points.obj"},
+      {cage_, dir_ / "missing.obj", dir_ / "a.ptx", "missing.obj: no such file"},
+      {cage_, sculpt_, (dir_.path() / "nodir" / "a.ptx").string(), "does not exist"},
+      {cage_, sculpt_, sculpt_, "also an input"},
+  };
+  for (const Bad& bad : cases) {
+    ExtractOptions o;
+    o.base_path = bad.base;
+    o.sculpt_path = bad.sculpt;
+    o.output_path = bad.out;
+    auto report = Extract(o);
+    ASSERT_FALSE(report.ok()) << bad.expect;
+    EXPECT_NE(report.status().message().find(bad.expect), std::string::npos)
+        << report.status().message();
+    EXPECT_EQ(report.status().message().find('\n'), std::string::npos);
+  }
+  EXPECT_FALSE(testing::fs::exists(dir_ / "a.ptx"));
+}
+
+TEST_F(ExtractTest, HolesFailMakesAnyMissAnError) {
+  ExtractOptions o = Options("fail.ptx");
+  o.holes = HolePolicy::kFail;
+  o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 1e-5};
+  auto report = Extract(o);
+  ASSERT_FALSE(report.ok());
+  EXPECT_NE(report.status().message().find("--holes fail"), std::string::npos)
+      << report.status().message();
+  EXPECT_FALSE(testing::fs::exists(o.output_path));
+}
+
+TEST_F(ExtractTest, CommandLineWritesMapAndJsonReport) {
+  std::string map = dir_ / "cli.ptx", json = dir_ / "report.json";
+  auto r = RunDispex("extract " + cage_ + " " + sculpt_ + " -o " + map + " --report " + json +
+                         " --tolerance 0.0002",
+                     dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("texels"), std::string::npos);  // the summary
+  auto report = nlohmann::json::parse(testing::Slurp(json));
+  EXPECT_EQ(report["statistics"]["tolerance"].get<double>(), 0.0002);
+  EXPECT_FALSE(report["statistics"]["tolerance_auto"].get<bool>());
+  EXPECT_TRUE(report["statistics"]["search_distance_auto"].get<bool>());
+  for (const char* phase : {"read_base", "read_sculpt", "topology", "bvh", "sample_trace",
+                            "write", "total"}) {
+    EXPECT_TRUE(report["phases_seconds"].contains(phase)) << phase;
+  }
+  EXPECT_GT(report["output"]["bytes"].get<std::uint64_t>(), 0u);
+  EXPECT_GT(report["peak_rss_bytes"].get<std::uint64_t>(), 0u);
+
+  auto quiet = RunDispex("extract " + cage_ + " " + sculpt_ + " -o " + map + " -q", dir_);
+  EXPECT_EQ(quiet.exit_code, 0);
+  EXPECT_EQ(quiet.err, "");
+  EXPECT_EQ(quiet.out, "");
+
+  auto bad = RunDispex("extract " + cage_ + " " + sculpt_ + " -o " + map + " --tolerance -1",
+                       dir_);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--tolerance"), std::string::npos) << bad.err;
+}
+
+}  // namespace
+}  // namespace dispex

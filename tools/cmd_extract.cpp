@@ -1,0 +1,203 @@
+// dispex extract BASE SCULPT -o OUT.ptx [options]
+#include <fmt/format.h>
+
+#include <cstdio>
+
+#include "command.h"
+#include "core/atomic_output.h"
+#include "core/cancel.h"
+#include "dispex/extract.h"
+
+namespace dispex::cli {
+namespace {
+
+struct ExtractArgs {
+  ExtractOptions options;
+  std::string oversample = "auto";
+  std::string search_distance = "auto";
+  double search_distance_rel = 0;
+  std::string ray_policy = "nearest";
+  std::string resolution_rule = "bound";
+  std::string fixed_resolution = "64x64";
+  std::string data_type = "float";
+  std::string holes = "fill";
+  std::string bvh_quality = "low";
+  std::string report_path;
+  std::string max_memory;
+  bool quiet = false;
+};
+
+// "8G", "512M", "300K" or a number of bytes.
+StatusOr<std::uint64_t> ParseBytes(const std::string& text) {
+  double value = 0;
+  char unit = 0, extra = 0;
+  int n = std::sscanf(text.c_str(), "%lf%c%c", &value, &unit, &extra);
+  if (n < 1 || n > 2 || !(value > 0)) {
+    return Status::Error(fmt::format("--max-memory {}: expected a size such as 8G or 512M", text));
+  }
+  double scale = 1;
+  switch (n == 2 ? unit : 'B') {
+    case 'B': case 'b': break;
+    case 'K': case 'k': scale = 1024.0; break;
+    case 'M': case 'm': scale = 1024.0 * 1024; break;
+    case 'G': case 'g': scale = 1024.0 * 1024 * 1024; break;
+    case 'T': case 't': scale = 1024.0 * 1024 * 1024 * 1024; break;
+    default:
+      return Status::Error(fmt::format("--max-memory {}: unknown unit '{}' (K, M, G, T)", text, unit));
+  }
+  return static_cast<std::uint64_t>(value * scale);
+}
+
+Status Resolve(ExtractArgs& a) {
+  ExtractOptions& o = a.options;
+  if (a.oversample != "auto") {
+    try {
+      std::size_t used = 0;
+      o.oversample = std::stoi(a.oversample, &used);
+      if (used != a.oversample.size() || o.oversample <= 0) throw std::invalid_argument("");
+    } catch (...) {
+      return Status::Error(fmt::format("--oversample {}: expected 'auto' or a power of two",
+                                       a.oversample));
+    }
+  }
+  if (a.search_distance_rel != 0) {
+    if (a.search_distance != "auto") {
+      return Status::Error("give --search-distance or --search-distance-rel, not both");
+    }
+    if (!(a.search_distance_rel > 0)) {
+      return Status::Error(fmt::format("--search-distance-rel {}: must be > 0",
+                                       a.search_distance_rel));
+    }
+    o.search_distance = {SearchDistanceSpec::Kind::kRelative, a.search_distance_rel};
+  } else {
+    auto spec = ParseSearchDistance(a.search_distance);
+    if (!spec.ok()) return spec.status().WithPrefix("--search-distance");
+    o.search_distance = *spec;
+  }
+  auto policy = ParseHitPolicy(a.ray_policy);
+  if (!policy.ok()) return policy.status().WithPrefix("--ray-policy");
+  o.ray_policy = *policy;
+  auto rule = ParseResolutionRule(a.resolution_rule);
+  if (!rule.ok()) return rule.status().WithPrefix("--resolution-rule");
+  o.resolution_rule = *rule;
+  int rx = 0, ry = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(a.fixed_resolution.c_str(), "%d%c%d%c", &rx, &x, &ry, &extra) != 3 || x != 'x' ||
+      rx < 1 || ry < 1 || (rx & (rx - 1)) || (ry & (ry - 1))) {
+    return Status::Error(fmt::format(
+        "--fixed-resolution {}: expected WxH with powers of two, e.g. 64x64", a.fixed_resolution));
+  }
+  o.fixed_ulog2 = __builtin_ctz(static_cast<unsigned>(rx));
+  o.fixed_vlog2 = __builtin_ctz(static_cast<unsigned>(ry));
+  if (a.data_type == "float") {
+    o.data_type = PtexDataType::kFloat;
+  } else if (a.data_type == "half") {
+    o.data_type = PtexDataType::kHalf;
+  } else {
+    return Status::Error(fmt::format("--data-type {}: expected float or half", a.data_type));
+  }
+  auto holes = ParseHolePolicy(a.holes);
+  if (!holes.ok()) return holes.status().WithPrefix("--holes");
+  o.holes = *holes;
+  auto quality = ParseBuildQuality(a.bvh_quality);
+  if (!quality.ok()) return quality.status().WithPrefix("--bvh-quality");
+  o.bvh_quality = *quality;
+  o.progress = !a.quiet && StderrIsInteractive();
+  if (!a.max_memory.empty()) {
+    auto bytes = ParseBytes(a.max_memory);
+    if (!bytes.ok()) return bytes.status();
+    o.max_memory = *bytes;
+  }
+  if (!a.report_path.empty() &&
+      (a.report_path == o.base_path || a.report_path == o.sculpt_path ||
+       a.report_path == o.output_path)) {
+    return Status::Error(fmt::format("--report {}: must differ from the inputs and the output",
+                                     a.report_path));
+  }
+  return ValidateExtractOptions(o);
+}
+
+int RunExtract(ExtractArgs& args) {
+  Status resolved = Resolve(args);
+  if (!resolved.ok()) return ReportFailure(resolved, 2);
+  InstallCancelSignalHandlers();
+  auto report = Extract(args.options);
+  if (!report.ok()) {
+    int sig = CancelSignal();
+    return ReportFailure(report.status(), sig ? 128 + sig : 1);
+  }
+  if (!args.report_path.empty()) {
+    std::string json = ExtractReportJson(*report);
+    Status written = WriteFileAtomically(args.report_path, json.data(), json.size());
+    if (!written.ok()) return ReportFailure(written.WithPrefix("--report"));
+  }
+  if (!args.quiet) std::fputs(ExtractReportSummary(*report).c_str(), stderr);
+  return 0;
+}
+
+void SetupExtract(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<ExtractArgs>();
+  ExtractOptions& o = args->options;
+  CLI::App* cmd = app.add_subcommand(
+      "extract", "Extract a Ptex displacement map: BASE cage + SCULPT -> OUT.ptx");
+  cmd->add_option("base", o.base_path, "base mesh: the Catmull-Clark cage (.obj, .ply)")
+      ->required();
+  cmd->add_option("sculpt", o.sculpt_path, "sculpted high-resolution mesh (.obj, .ply)")
+      ->required();
+  cmd->add_option("-o,--output", o.output_path, "output Ptex file (.ptx)")->required();
+  cmd->add_option("--oversample", args->oversample,
+                  "samples per side of each face: 'auto' (from the sculpt's density) or a "
+                  "power of two 1..512")
+      ->capture_default_str();
+  cmd->add_option("--max-oversample", o.max_oversample, "cap for automatic oversampling")
+      ->capture_default_str();
+  cmd->add_option("--min-oversample", o.min_oversample, "floor for automatic oversampling")
+      ->capture_default_str();
+  cmd->add_option("--search-distance", args->search_distance,
+                  "how far along ±normal to look: 'auto', a length, or N% of the base "
+                  "bounding-box diagonal")
+      ->capture_default_str();
+  cmd->add_option("--search-distance-rel", args->search_distance_rel,
+                  "search distance as a fraction of the base bounding-box diagonal");
+  cmd->add_option("--ray-policy", args->ray_policy,
+                  "hit kept when both directions hit: nearest, outside-first, inside-first")
+      ->capture_default_str();
+  cmd->add_option("--tolerance", o.tolerance,
+                  "largest allowed error per face, object units (default: "
+                  "--tolerance-fraction x the sculpt's median edge length)");
+  cmd->add_option("--tolerance-fraction", o.tolerance_fraction,
+                  "automatic tolerance as a fraction of the sculpt's median edge length")
+      ->capture_default_str();
+  cmd->add_option("--resolution-rule", args->resolution_rule,
+                  "per-face resolution: bound (error bound), nonzero (published rule), fixed")
+      ->capture_default_str();
+  cmd->add_option("--nonzero-threshold", o.nonzero_threshold,
+                  "|DCT coefficient| counted as non-zero by --resolution-rule nonzero")
+      ->capture_default_str();
+  cmd->add_option("--fixed-resolution", args->fixed_resolution,
+                  "WxH for --resolution-rule fixed")
+      ->capture_default_str();
+  cmd->add_option("--data-type", args->data_type, "texel type: float or half")
+      ->capture_default_str();
+  cmd->add_option("--compression-level", o.compression_level,
+                  "deflate level 0..12 (-1: default, 1)")
+      ->capture_default_str();
+  cmd->add_option("--holes", args->holes,
+                  "samples whose rays miss: fill (interpolate), fail (error), zero")
+      ->capture_default_str();
+  cmd->add_option("--bvh-quality", args->bvh_quality, "BVH build quality: low, medium, high")
+      ->capture_default_str();
+  cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")->capture_default_str();
+  cmd->add_option("--max-memory", args->max_memory,
+                  "refuse work estimated to need more memory than this (e.g. 8G; default: the "
+                  "memory available)");
+  cmd->add_option("--report", args->report_path, "write a JSON report to this file");
+  cmd->add_flag("-q,--quiet", args->quiet, "no progress bar and no summary");
+  cmd->callback([args, &exit_code] { exit_code = RunExtract(*args); });
+}
+
+}  // namespace
+
+DISPEX_REGISTER_COMMAND(20, SetupExtract);
+
+}  // namespace dispex::cli

@@ -1,0 +1,84 @@
+// dispex verify BASE [SCULPT] MAP.ptx [--truth FILE] [--max-error E]
+#include <fmt/format.h>
+
+#include <cstdio>
+
+#include "command.h"
+#include "core/atomic_output.h"
+#include "dispex/verify.h"
+
+namespace dispex::cli {
+namespace {
+
+struct VerifyArgs {
+  std::vector<std::string> files;
+  VerifyOptions options;
+  std::string report_path;
+  bool quiet = false;
+};
+
+int RunVerify(VerifyArgs& args) {
+  VerifyOptions& o = args.options;
+  if (args.files.size() == 3) {
+    o.base_path = args.files[0];
+    o.sculpt_path = args.files[1];
+    o.map_path = args.files[2];
+  } else if (args.files.size() == 2 && !o.truth_path.empty()) {
+    o.base_path = args.files[0];
+    o.map_path = args.files[1];
+  } else {
+    return ReportFailure(
+        Status::Error("expected BASE SCULPT MAP.ptx (or BASE MAP.ptx with --truth)"), 2);
+  }
+  if (!(o.max_error >= 0) || !(o.max_error_rel >= 0) || !(o.max_rms >= 0)) {
+    return ReportFailure(Status::Error("--max-error, --max-error-rel and --max-rms must be >= 0"),
+                         2);
+  }
+  auto report = Verify(o);
+  if (!report.ok()) return ReportFailure(report.status());
+  if (!args.report_path.empty()) {
+    std::string json = VerifyReportJson(*report);
+    Status written = WriteFileAtomically(args.report_path, json.data(), json.size());
+    if (!written.ok()) return ReportFailure(written.WithPrefix("--report"));
+  }
+  if (!args.quiet) std::fputs(VerifyReportSummary(*report).c_str(), stdout);
+  if (!report->passed) {
+    return ReportFailure(Status::Error(o.map_path + ": " + report->failure), 3);
+  }
+  return 0;
+}
+
+void SetupVerify(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<VerifyArgs>();
+  VerifyOptions& o = args->options;
+  CLI::App* cmd = app.add_subcommand(
+      "verify",
+      "Measure a displacement map: the base limit surface displaced by MAP against the "
+      "sculpt, both ways (and/or against a make-sculpt truth file)");
+  cmd->add_option("files", args->files, "BASE SCULPT MAP.ptx, or BASE MAP.ptx with --truth")
+      ->required()
+      ->expected(2, 3);
+  cmd->add_option("--truth", o.truth_path, "make-sculpt truth file: compare with the exact h");
+  cmd->add_option("--samples", o.samples_per_face,
+                  "samples per side of each face (0: twice the map resolution, 8..64)")
+      ->capture_default_str();
+  cmd->add_option("--max-sculpt-points", o.max_sculpt_points,
+                  "sculpt vertices measured (evenly strided; 0: all)")
+      ->capture_default_str();
+  cmd->add_option("--max-error", o.max_error,
+                  "fail (exit 3) when a max error exceeds this, object units");
+  cmd->add_option("--max-error-rel", o.max_error_rel,
+                  "fail when a max error exceeds this fraction of the bounding-box diagonal");
+  cmd->add_option("--max-rms", o.max_rms,
+                  "fail (exit 3) when an RMS error exceeds this, object units");
+  cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")->capture_default_str();
+  cmd->add_option("--report", args->report_path, "write a JSON report to this file");
+  cmd->add_flag("-q,--quiet", args->quiet, "no summary on stdout");
+  cmd->callback([args, &exit_code] { exit_code = RunVerify(*args); });
+}
+
+}  // namespace
+
+DISPEX_REGISTER_COMMAND(30, SetupVerify);
+
+}  // namespace dispex::cli
