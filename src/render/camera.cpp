@@ -1,0 +1,217 @@
+// Views and framing: a look-at camera on a sphere of directions around the box (azimuth about
+// +y, elevation towards +y), moved back (perspective) or zoomed (orthographic) until the
+// eight corners of the box fit in the image less the margin.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "dispex/render.h"
+
+namespace dispex {
+
+namespace {
+
+struct V3 {
+  double x = 0, y = 0, z = 0;
+};
+V3 operator+(V3 a, V3 b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+V3 operator-(V3 a, V3 b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+V3 operator*(V3 a, double s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+double Dot(V3 a, V3 b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+V3 Cross(V3 a, V3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+V3 Normalize(V3 a) {
+  return a * (1.0 / std::sqrt(Dot(a, a)));
+}
+V3 ToV3(const Float3& f) {
+  return {f.x, f.y, f.z};
+}
+Float3 ToFloat3(V3 v) {
+  return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
+}
+
+void PresetAngles(ViewPreset preset, double& azimuth, double& elevation) {
+  switch (preset) {
+    case ViewPreset::kFront:
+      azimuth = 0, elevation = 0;
+      return;
+    case ViewPreset::kBack:
+      azimuth = 180, elevation = 0;
+      return;
+    case ViewPreset::kRight:
+      azimuth = 90, elevation = 0;
+      return;
+    case ViewPreset::kLeft:
+      azimuth = -90, elevation = 0;
+      return;
+    case ViewPreset::kTop:
+      azimuth = 0, elevation = 90;
+      return;
+    case ViewPreset::kIso:
+      azimuth = 45;
+      elevation = std::atan(1.0 / std::sqrt(2.0)) * 180.0 / std::numbers::pi;
+      return;
+  }
+}
+
+}  // namespace
+
+void Camera::RayThrough(double px, double py, Float3& origin, Float3& direction) const {
+  const double aspect = double(width) / double(height);
+  const double sx = (2.0 * px / width - 1.0) * aspect * half_height + shift_x;
+  const double sy = (1.0 - 2.0 * py / height) * half_height + shift_y;
+  const V3 e = ToV3(eye), f = ToV3(forward), r = ToV3(right), u = ToV3(up);
+  if (projection == Projection::kOrthographic) {
+    origin = ToFloat3(e + r * sx + u * sy);
+    direction = forward;
+  } else {
+    origin = eye;
+    direction = ToFloat3(Normalize(f + r * sx + u * sy));
+  }
+}
+
+bool Camera::Project(const Float3& point, double& px, double& py) const {
+  const double aspect = double(width) / double(height);
+  const V3 rel = ToV3(point) - ToV3(eye);
+  double x = Dot(rel, ToV3(right)), y = Dot(rel, ToV3(up));
+  if (projection == Projection::kPerspective) {
+    const double z = Dot(rel, ToV3(forward));
+    if (!(z > 0)) return false;
+    x /= z;
+    y /= z;
+  }
+  px = ((x - shift_x) / (half_height * aspect) + 1.0) * 0.5 * width;
+  py = (1.0 - (y - shift_y) / half_height) * 0.5 * height;
+  return true;
+}
+
+StatusOr<Camera> FrameCamera(std::span<const Float3> points, const ViewOptions& view, int width,
+                             int height) {
+  if (width < 1 || height < 1) {
+    return Status::Error(fmt::format("image size {}x{}: both sides must be >= 1", width, height));
+  }
+  double azimuth = 0, elevation = 0;
+  PresetAngles(view.preset, azimuth, elevation);
+  if (!std::isnan(view.azimuth)) azimuth = view.azimuth;
+  if (!std::isnan(view.elevation)) elevation = view.elevation;
+  if (!std::isfinite(azimuth)) return Status::Error("--azimuth: must be a finite angle");
+  if (!(elevation >= -90 && elevation <= 90)) {
+    return Status::Error(
+        fmt::format("--elevation {}: must be within [-90, 90] degrees", elevation));
+  }
+  if (!(view.fov_degrees >= 1 && view.fov_degrees <= 120)) {
+    return Status::Error(fmt::format("--fov {}: must be 1..120 degrees", view.fov_degrees));
+  }
+  if (!(view.margin >= 0 && view.margin <= 0.45)) {
+    return Status::Error(fmt::format("margin {}: must be 0..0.45", view.margin));
+  }
+  if (points.empty()) return Status::Error("nothing to frame: no points");
+  V3 lo = ToV3(points[0]), hi = lo;
+  for (const Float3& p : points) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      return Status::Error("cannot frame a point that is not finite");
+    }
+    lo = {std::min(lo.x, double(p.x)), std::min(lo.y, double(p.y)), std::min(lo.z, double(p.z))};
+    hi = {std::max(hi.x, double(p.x)), std::max(hi.y, double(p.y)), std::max(hi.z, double(p.z))};
+  }
+
+  const double a = azimuth * std::numbers::pi / 180.0, e = elevation * std::numbers::pi / 180.0;
+  const V3 towards_eye = {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)};
+  const V3 right = {std::cos(a), 0.0, -std::sin(a)};
+  const V3 up = Cross(towards_eye, right);
+  const V3 centre = (lo + hi) * 0.5;
+  const double radius = std::max(0.5 * std::sqrt(Dot(hi - lo, hi - lo)), 1e-30);
+  const double aspect = double(width) / double(height);
+  const double usable = 1.0 - 2.0 * view.margin;
+
+  Camera camera;
+  camera.projection = view.projection;
+  camera.width = width;
+  camera.height = height;
+  camera.forward = ToFloat3(towards_eye * -1.0);
+  camera.right = ToFloat3(right);
+  camera.up = ToFloat3(up);
+
+  // The extent of the points seen from distance `distance` (perspective: x / depth; ortho:
+  // x), as [min, max] along right and up.
+  struct Extent {
+    double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+    double half(double asp) const { return std::max((x1 - x0) / (2 * asp), (y1 - y0) / 2); }
+  };
+  auto extent = [&](double distance) {
+    Extent ext;
+    for (const Float3& p : points) {
+      const V3 rel = ToV3(p) - centre;
+      double x = Dot(rel, right), y = Dot(rel, up);
+      if (distance > 0) {
+        const double depth = distance - Dot(rel, towards_eye);
+        x /= depth;
+        y /= depth;
+      }
+      ext.x0 = std::min(ext.x0, x), ext.x1 = std::max(ext.x1, x);
+      ext.y0 = std::min(ext.y0, y), ext.y1 = std::max(ext.y1, y);
+    }
+    return ext;
+  };
+
+  Extent ext;
+  if (view.projection == Projection::kOrthographic) {
+    ext = extent(0);
+    camera.half_height = std::max(ext.half(aspect) / usable, 1e-9 * radius);
+    camera.eye = ToFloat3(centre + towards_eye * (2.0 * radius));
+  } else {
+    const double tan_half = std::tan(0.5 * view.fov_degrees * std::numbers::pi / 180.0);
+    const double target = tan_half * usable;
+    // Far enough that the points fit even around the centre; then the nearest distance at
+    // which their (shifted) extent still fits, by bisection.
+    double max_depth_offset = -radius, far = 0;
+    for (const Float3& p : points) {
+      const V3 rel = ToV3(p) - centre;
+      const double z = Dot(rel, towards_eye);
+      max_depth_offset = std::max(max_depth_offset, z);
+      far = std::max({far, z + std::fabs(Dot(rel, up)) / target,
+                      z + std::fabs(Dot(rel, right)) / (target * aspect)});
+    }
+    double near = max_depth_offset + 1e-3 * radius;
+    far = std::max(far, near);
+    for (int i = 0; i < 60; ++i) {
+      const double mid = 0.5 * (near + far);
+      if (extent(mid).half(aspect) <= target) {
+        far = mid;
+      } else {
+        near = mid;
+      }
+    }
+    ext = extent(far);
+    camera.half_height = tan_half;
+    camera.eye = ToFloat3(centre + towards_eye * far);
+  }
+  camera.shift_x = 0.5 * (ext.x0 + ext.x1);
+  camera.shift_y = 0.5 * (ext.y0 + ext.y1);
+  return camera;
+}
+
+StatusOr<Camera> FrameCamera(const BoundingBox& box, const ViewOptions& view, int width,
+                             int height) {
+  std::array<Float3, 8> corners;
+  for (int c = 0; c < 8; ++c) {
+    corners[static_cast<std::size_t>(c)] = {c & 1 ? box.max.x : box.min.x,
+                                            c & 2 ? box.max.y : box.min.y,
+                                            c & 4 ? box.max.z : box.min.z};
+  }
+  return FrameCamera(corners, view, width, height);
+}
+
+}  // namespace dispex

@@ -1,0 +1,651 @@
+// Crack-free tessellation of the displaced limit surface.
+//
+// Each Ptex face is a kx x ky grid of its (u, v) square. The face's four sides lie on "lines"
+// of the cage: a cage edge (quads cover it whole, n-gon sub-faces one half each) or, inside an
+// n-gon, a spoke from an edge midpoint to the face centre. Every point a face puts on a line
+// is named exactly, by the line and a reduced fraction along it (or, at a line's ends, by the
+// cage vertex, edge midpoint or face centre there), so the faces around a point find the same
+// name and share one vertex: position and normal from the lowest-numbered face, displacement
+// averaged over all of them. Along a line the points of all its faces are merged, and a cell
+// whose side received points from a finer neighbour becomes a fan around the cell centre, as
+// in the usual crack-free stitching of adaptive tessellations (e.g. Moreton, "Watertight
+// tessellation using forward differencing", 2001, and OpenSubdiv's Bfr::Tessellation with
+// per-edge rates). Every stage is a flat array filled in parallel in a fixed order, or a
+// sort under a total order, so the mesh does not depend on the thread count.
+#include "render/tessellation.h"
+
+#include <fmt/format.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <numeric>
+#include <optional>
+
+#include "core/check.h"
+
+namespace dispex::render {
+
+namespace {
+
+constexpr std::int32_t kBaseEdge = 0, kSpoke = 1;
+enum : std::int32_t { kVertexPoint = 0, kEdgePoint = 1, kSpokePoint = 2, kCentrePoint = 3 };
+
+// A line of the cage: a base edge (a < b, its vertices) or a spoke (a = base face, b = corner
+// q: from the midpoint of the face's edge q to its centre). Parameters along a line run 0..2.
+struct LineKey {
+  std::int32_t kind = 0, a = 0, b = 0;
+  auto operator<=>(const LineKey&) const = default;
+};
+
+// One side of one Ptex face on its line: from parameter p0 (the side's start, in the face's
+// counter-clockwise order) to p1, cut into `segs` equal segments.
+struct SideEntry {
+  LineKey line;
+  std::int32_t p0 = 0, p1 = 0;
+  std::int32_t segs = 0;
+  std::int32_t face = -1, side = 0;
+};
+
+// An exact parameter num / den on a line, reduced (0 / 1 for zero).
+struct Frac {
+  std::int32_t num = 0, den = 1;
+};
+bool FracLess(Frac x, Frac y) {
+  return std::int64_t(x.num) * y.den < std::int64_t(y.num) * x.den;
+}
+Frac Reduce(std::int32_t num, std::int32_t den) {
+  const std::int32_t g = std::gcd(num, den);
+  return {num / g, den / g};
+}
+
+struct PointKey {
+  std::int32_t kind = 0, a = 0, b = 0, num = 0, den = 0;
+  auto operator<=>(const PointKey&) const = default;
+};
+
+// One face's view of one shared point.
+struct Record {
+  PointKey key;
+  std::int32_t face = 0;
+  float u = 0, v = 0;
+  std::int64_t line_point = 0;  // the point's index in the flat array of line points
+};
+bool RecordLess(const Record& x, const Record& y) {
+  if (x.key != y.key) return x.key < y.key;
+  if (x.face != y.face) return x.face < y.face;
+  if (x.u != y.u) return x.u < y.u;
+  if (x.v != y.v) return x.v < y.v;
+  return x.line_point < y.line_point;
+}
+
+void SideUv(int side, double s, float& u, float& v) {
+  switch (side) {
+    case 0:
+      u = static_cast<float>(s), v = 0;
+      return;
+    case 1:
+      u = 1, v = static_cast<float>(s);
+      return;
+    case 2:
+      u = static_cast<float>(1.0 - s), v = 1;
+      return;
+    default:
+      u = 0, v = static_cast<float>(1.0 - s);
+      return;
+  }
+}
+
+PointKey KeyOf(const Mesh& cage, const LineKey& line, Frac t) {
+  if (line.kind == kBaseEdge) {
+    if (t.num == 0) return {kVertexPoint, line.a, 0, 0, 0};
+    if (t.num == 2 * t.den) return {kVertexPoint, line.b, 0, 0, 0};
+    return {kEdgePoint, line.a, line.b, t.num, t.den};
+  }
+  if (t.num == 0) {  // the midpoint of the face's edge q
+    const auto verts = cage.face(static_cast<std::size_t>(line.a));
+    const int n = static_cast<int>(verts.size());
+    const std::int32_t va = verts[static_cast<std::size_t>(line.b)];
+    const std::int32_t vb = verts[static_cast<std::size_t>((line.b + 1) % n)];
+    return {kEdgePoint, std::min(va, vb), std::max(va, vb), 1, 1};
+  }
+  if (t.num == 2 * t.den) return {kCentrePoint, line.a, 0, 0, 0};
+  return {kSpokePoint, line.a, line.b, t.num, t.den};
+}
+
+LineKey EdgeLine(std::int32_t va, std::int32_t vb) {
+  return {kBaseEdge, std::min(va, vb), std::max(va, vb)};
+}
+
+// The four sides of Ptex face f (see the conventions in include/dispex/subdiv.h: a quad's
+// corners are its vertices 0..3; sub-face q of an n-gon runs from vertex q (0,0) to the
+// midpoint of edge q (1,0), the centre (1,1) and the midpoint of edge q-1 (0,1)).
+void FaceSides(const Mesh& cage, const LimitSurface& surface, int f, int kx, int ky,
+               SideEntry out[4]) {
+  const BaseFaceId base = surface.base_face(PtexFaceId(f));
+  const auto verts = cage.face(static_cast<std::size_t>(base.value));
+  const int n = static_cast<int>(verts.size());
+  for (int s = 0; s < 4; ++s) {
+    out[s].face = f;
+    out[s].side = s;
+    out[s].segs = (s % 2 == 0) ? kx : ky;
+  }
+  if (n == 4) {
+    for (int s = 0; s < 4; ++s) {
+      const std::int32_t va = verts[static_cast<std::size_t>(s)];
+      const std::int32_t vb = verts[static_cast<std::size_t>((s + 1) % 4)];
+      out[s].line = EdgeLine(va, vb);
+      out[s].p0 = va < vb ? 0 : 2;
+      out[s].p1 = 2 - out[s].p0;
+    }
+    return;
+  }
+  const int q = surface.sub_face(PtexFaceId(f));
+  const std::int32_t vq = verts[static_cast<std::size_t>(q)];
+  const std::int32_t vnext = verts[static_cast<std::size_t>((q + 1) % n)];
+  const std::int32_t vprev = verts[static_cast<std::size_t>((q + n - 1) % n)];
+  out[0].line = EdgeLine(vq, vnext);  // vertex q to the midpoint of edge q
+  out[0].p0 = vq < vnext ? 0 : 2;
+  out[0].p1 = 1;
+  out[1].line = {kSpoke, base.value, q};  // midpoint of edge q to the centre
+  out[1].p0 = 0;
+  out[1].p1 = 2;
+  out[2].line = {kSpoke, base.value, (q + n - 1) % n};  // centre to the midpoint of edge q-1
+  out[2].p0 = 2;
+  out[2].p1 = 0;
+  out[3].line = EdgeLine(vprev, vq);  // midpoint of edge q-1 to vertex q
+  out[3].p0 = 1;
+  out[3].p1 = vprev < vq ? 2 : 0;
+}
+
+Frac PointOnSide(const SideEntry& e, int i) {
+  return Reduce(e.p0 * e.segs + (e.p1 - e.p0) * i, e.segs);
+}
+
+bool Covers(const SideEntry& e, Frac t) {
+  const std::int64_t lo = std::min(e.p0, e.p1), hi = std::max(e.p0, e.p1);
+  return std::int64_t(t.num) >= lo * t.den && std::int64_t(t.num) <= hi * t.den;
+}
+
+double SigmaOf(const SideEntry& e, Frac t) {
+  return double(std::int64_t(t.num) - std::int64_t(e.p0) * t.den) /
+         double(std::int64_t(t.den) * (e.p1 - e.p0));
+}
+
+Float3 Sub(const Float3& a, const Float3& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+double Length2(const Float3& a) {
+  return double(a.x) * a.x + double(a.y) * a.y + double(a.z) * a.z;
+}
+
+// The lowest failing face's status, whatever the thread count.
+class FirstError {
+ public:
+  void Set(int face, Status status) {
+    std::lock_guard lock(mutex_);
+    if (face < face_) {
+      face_ = face;
+      status_ = std::move(status);
+    }
+  }
+  bool failed() const { return face_ != std::numeric_limits<int>::max(); }
+  Status status() const { return status_; }
+
+ private:
+  std::mutex mutex_;
+  int face_ = std::numeric_limits<int>::max();
+  Status status_;
+};
+
+Status MapValueError(const PtexFile& map, int face) {
+  std::vector<float> texels;
+  Status read = map.ReadFace(PtexFaceId(face), 0, texels);
+  if (!read.ok()) return read;
+  return Status::Error(
+      fmt::format("{}: face {} holds a value that is not finite", map.name(), face));
+}
+
+// Vertex normals: for each vertex the sum of its faces' (area-weighted) normals, in face
+// order, normalised; `fallback` (or +z) where the sum vanishes.
+void VertexNormals(std::size_t num_vertices, std::span<const std::uint32_t> face_offsets,
+                   std::span<const std::int32_t> face_indices, std::span<const Float3> face_normals,
+                   std::span<const Float3> fallback, std::vector<Float3>& normals) {
+  const std::size_t num_faces = face_offsets.size() - 1;
+  std::vector<std::uint32_t> start(num_vertices + 1, 0);
+  for (std::int32_t v : face_indices) ++start[static_cast<std::size_t>(v) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+  std::vector<std::uint32_t> faces_of(face_indices.size());
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    for (std::uint32_t k = face_offsets[f]; k < face_offsets[f + 1]; ++k) {
+      faces_of[fill[static_cast<std::size_t>(face_indices[k])]++] = static_cast<std::uint32_t>(f);
+    }
+  }
+  normals.resize(num_vertices);
+  tbb::parallel_for(std::size_t{0}, num_vertices, [&](std::size_t v) {
+    double x = 0, y = 0, z = 0;
+    std::uint32_t previous = std::numeric_limits<std::uint32_t>::max();
+    for (std::uint32_t k = start[v]; k < start[v + 1]; ++k) {
+      if (faces_of[k] == previous) continue;  // a face listing the vertex twice counts once
+      previous = faces_of[k];
+      const Float3& n = face_normals[faces_of[k]];
+      x += n.x, y += n.y, z += n.z;
+    }
+    const double len = std::sqrt(x * x + y * y + z * z);
+    if (len > 0 && std::isfinite(len)) {
+      normals[v] = {float(x / len), float(y / len), float(z / len)};
+    } else {
+      normals[v] = v < fallback.size() ? fallback[v] : Float3{0, 0, 1};
+    }
+  });
+}
+
+}  // namespace
+
+StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface& surface,
+                                            std::span<const std::array<int, 2>> density,
+                                            const PtexFile* map, int channel) {
+  const int n = surface.num_ptex_faces();
+  DISPEX_CHECK_EQ(density.size(), static_cast<std::size_t>(n));
+  auto active = [&](int f) {
+    return density[static_cast<std::size_t>(f)][0] > 0 && !surface.is_hole(PtexFaceId(f));
+  };
+
+  // 1. Sides of every face, sorted by line.
+  std::vector<SideEntry> entries(4 * static_cast<std::size_t>(n));
+  tbb::parallel_for(0, n, [&](int f) {
+    if (!active(f)) return;
+    const auto& d = density[static_cast<std::size_t>(f)];
+    DISPEX_CHECK(d[0] >= 1 && d[0] <= 1024 && d[1] >= 1 && d[1] <= 1024);
+    FaceSides(cage, surface, f, d[0], d[1], &entries[4 * static_cast<std::size_t>(f)]);
+  });
+  entries.erase(
+      std::remove_if(entries.begin(), entries.end(), [](const SideEntry& e) { return e.face < 0; }),
+      entries.end());
+  tbb::parallel_sort(entries.begin(), entries.end(), [](const SideEntry& x, const SideEntry& y) {
+    if (x.line != y.line) return x.line < y.line;
+    if (x.face != y.face) return x.face < y.face;
+    return x.side < y.side;
+  });
+  const std::size_t num_entries = entries.size();
+  std::vector<std::int64_t> entry_of(4 * static_cast<std::size_t>(n), -1);
+  std::vector<std::int64_t> grid_offset(num_entries + 1, 0);
+  std::vector<std::size_t> line_start;  // entries of line g: [line_start[g], line_start[g + 1])
+  for (std::size_t e = 0; e < num_entries; ++e) {
+    entry_of[4 * static_cast<std::size_t>(entries[e].face) + entries[e].side] =
+        static_cast<std::int64_t>(e);
+    grid_offset[e + 1] = grid_offset[e] + entries[e].segs + 1;
+    if (e == 0 || entries[e].line != entries[e - 1].line) line_start.push_back(e);
+  }
+  line_start.push_back(num_entries);
+  const std::size_t num_lines = line_start.size() - 1;
+
+  // 2. The merged points of each line (at most the sum of its sides' points), and the records
+  // of every face side that covers each point.
+  std::vector<std::int64_t> entry_grid_point(static_cast<std::size_t>(grid_offset[num_entries]));
+  std::vector<Frac> line_point_frac(entry_grid_point.size());
+  std::vector<std::int64_t> line_point_count(num_lines, 0), record_count(num_lines + 1, 0);
+  struct Candidate {
+    Frac t;
+    std::int64_t grid;  // index into entry_grid_point
+  };
+  tbb::enumerable_thread_specific<std::vector<Candidate>> candidates;
+  tbb::parallel_for(std::size_t{0}, num_lines, [&](std::size_t g) {
+    auto& c = candidates.local();
+    c.clear();
+    for (std::size_t e = line_start[g]; e < line_start[g + 1]; ++e) {
+      for (int i = 0; i <= entries[e].segs; ++i) {
+        c.push_back({PointOnSide(entries[e], i), grid_offset[e] + i});
+      }
+    }
+    std::sort(c.begin(), c.end(), [](const Candidate& x, const Candidate& y) {
+      if (FracLess(x.t, y.t)) return true;
+      if (FracLess(y.t, x.t)) return false;
+      return x.grid < y.grid;
+    });
+    const std::int64_t base = grid_offset[line_start[g]];
+    std::int64_t m = -1;
+    for (std::size_t k = 0; k < c.size(); ++k) {
+      if (k == 0 || FracLess(c[k - 1].t, c[k].t)) {
+        line_point_frac[static_cast<std::size_t>(base + ++m)] = c[k].t;
+      }
+      entry_grid_point[static_cast<std::size_t>(c[k].grid)] = base + m;
+    }
+    line_point_count[g] = m + 1;
+    std::int64_t records = 0;
+    for (std::int64_t p = 0; p <= m; ++p) {
+      for (std::size_t e = line_start[g]; e < line_start[g + 1]; ++e) {
+        records += Covers(entries[e], line_point_frac[static_cast<std::size_t>(base + p)]);
+      }
+    }
+    record_count[g + 1] = records;
+  });
+  std::partial_sum(record_count.begin(), record_count.end(), record_count.begin());
+  std::vector<Record> records(static_cast<std::size_t>(record_count[num_lines]));
+  tbb::parallel_for(std::size_t{0}, num_lines, [&](std::size_t g) {
+    const std::int64_t base = grid_offset[line_start[g]];
+    std::size_t r = static_cast<std::size_t>(record_count[g]);
+    const LineKey& line = entries[line_start[g]].line;
+    for (std::int64_t p = 0; p < line_point_count[g]; ++p) {
+      const Frac t = line_point_frac[static_cast<std::size_t>(base + p)];
+      const PointKey key = KeyOf(cage, line, t);
+      for (std::size_t e = line_start[g]; e < line_start[g + 1]; ++e) {
+        if (!Covers(entries[e], t)) continue;
+        Record& rec = records[r++];
+        rec.key = key;
+        rec.face = entries[e].face;
+        rec.line_point = base + p;
+        SideUv(entries[e].side, SigmaOf(entries[e], t), rec.u, rec.v);
+      }
+    }
+  });
+
+  // 3. One vertex per distinct point.
+  tbb::parallel_sort(records.begin(), records.end(), RecordLess);
+  std::vector<std::int32_t> line_point_vertex(line_point_frac.size(), -1);
+  std::vector<std::size_t> vertex_records;  // records of vertex i: [vertex_records[i], [i + 1])
+  for (std::size_t r = 0; r < records.size(); ++r) {
+    if (r == 0 || records[r].key != records[r - 1].key) vertex_records.push_back(r);
+    line_point_vertex[static_cast<std::size_t>(records[r].line_point)] =
+        static_cast<std::int32_t>(vertex_records.size() - 1);
+  }
+  vertex_records.push_back(records.size());
+  const std::size_t num_shared = vertex_records.size() - 1;
+
+  // 4. Per face: interior grid points and the centres of stitched cells.
+  auto grid_point = [&](int f, int side, int i) {
+    const std::int64_t e = entry_of[4 * static_cast<std::size_t>(f) + side];
+    return entry_grid_point[static_cast<std::size_t>(grid_offset[static_cast<std::size_t>(e)] + i)];
+  };
+  auto extra_points = [&](int f, int side, int i) {  // between grid points i and i + 1
+    const std::int64_t a = grid_point(f, side, i), b = grid_point(f, side, i + 1);
+    return static_cast<int>(std::abs(b - a) - 1);
+  };
+  auto cell_extras = [&](int f, int kx, int ky, int i, int j) {
+    int extra = 0;
+    if (j == 0) extra += extra_points(f, 0, i);
+    if (i == kx - 1) extra += extra_points(f, 1, j);
+    if (j == ky - 1) extra += extra_points(f, 2, kx - 1 - i);
+    if (i == 0) extra += extra_points(f, 3, ky - 1 - j);
+    return extra;
+  };
+  std::vector<std::int64_t> vertex_start(static_cast<std::size_t>(n) + 1, 0);
+  std::vector<std::int64_t> triangle_start(static_cast<std::size_t>(n) + 1, 0);
+  tbb::parallel_for(0, n, [&](int f) {
+    if (!active(f)) return;
+    const int kx = density[static_cast<std::size_t>(f)][0];
+    const int ky = density[static_cast<std::size_t>(f)][1];
+    std::int64_t vertices = std::int64_t(kx - 1) * (ky - 1), triangles = 0;
+    for (int j = 0; j < ky; ++j) {
+      for (int i = 0; i < kx; ++i) {
+        const bool border = i == 0 || j == 0 || i == kx - 1 || j == ky - 1;
+        const int extra = border ? cell_extras(f, kx, ky, i, j) : 0;
+        if (extra == 0) {
+          triangles += 2;
+        } else {
+          vertices += 1;
+          triangles += 4 + extra;
+        }
+      }
+    }
+    vertex_start[static_cast<std::size_t>(f) + 1] = vertices;
+    triangle_start[static_cast<std::size_t>(f) + 1] = triangles;
+  });
+  vertex_start[0] = static_cast<std::int64_t>(num_shared);
+  std::partial_sum(vertex_start.begin(), vertex_start.end(), vertex_start.begin());
+  std::partial_sum(triangle_start.begin(), triangle_start.end(), triangle_start.begin());
+  const std::int64_t num_vertices = vertex_start[static_cast<std::size_t>(n)];
+  const std::int64_t num_triangles = triangle_start[static_cast<std::size_t>(n)];
+  if (num_vertices >= std::numeric_limits<std::int32_t>::max() ||
+      3 * num_triangles >= std::numeric_limits<std::int32_t>::max()) {
+    return Status::Error(fmt::format(
+        "{}: the tessellation would have {} triangles, more than 32-bit indices hold; lower the "
+        "density",
+        surface.source(), num_triangles));
+  }
+
+  ShadedMesh out;
+  Mesh& mesh = out.mesh;
+  mesh.source = surface.source() + (map ? " displaced by " + map->name() : " (limit surface)");
+  mesh.positions.reserve(static_cast<std::size_t>(num_vertices) + 1);
+  mesh.positions.resize(static_cast<std::size_t>(num_vertices));
+  std::vector<Float3> limit_normals(static_cast<std::size_t>(num_vertices));
+  mesh.face_indices.resize(3 * static_cast<std::size_t>(num_triangles));
+  mesh.face_offsets.resize(static_cast<std::size_t>(num_triangles) + 1);
+  tbb::parallel_for(std::size_t{0}, mesh.face_offsets.size(), [&](std::size_t t) {
+    mesh.face_offsets[t] = static_cast<std::uint32_t>(3 * t);
+  });
+
+  struct Scratch {
+    std::vector<float> uv, p, nrm;
+    std::vector<std::int32_t> polygon;
+  };
+  tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
+  tbb::enumerable_thread_specific<Scratch> scratch;
+  FirstError error;
+  auto evaluator_for_thread = [&]() -> LimitEvaluator& {
+    auto& e = evaluators.local();
+    if (!e) e.emplace(surface);
+    return *e;
+  };
+
+  // 5. Shared vertices: evaluated on their first face, displaced by the mean of all faces.
+  std::vector<std::pair<std::int32_t, std::int32_t>> owners(num_shared);  // (face, vertex)
+  for (std::size_t v = 0; v < num_shared; ++v) {
+    owners[v] = {records[vertex_records[v]].face, static_cast<std::int32_t>(v)};
+  }
+  std::sort(owners.begin(), owners.end());
+  std::vector<std::size_t> owner_start;
+  for (std::size_t k = 0; k < owners.size(); ++k) {
+    if (k == 0 || owners[k].first != owners[k - 1].first) owner_start.push_back(k);
+  }
+  owner_start.push_back(owners.size());
+  tbb::parallel_for(std::size_t{0}, owner_start.size() - 1, [&](std::size_t g) {
+    const std::size_t begin = owner_start[g], end = owner_start[g + 1];
+    const int f = owners[begin].first;
+    Scratch& s = scratch.local();
+    s.uv.resize(2 * (end - begin));
+    s.p.resize(3 * (end - begin));
+    s.nrm.resize(3 * (end - begin));
+    for (std::size_t k = begin; k < end; ++k) {
+      const Record& r = records[vertex_records[static_cast<std::size_t>(owners[k].second)]];
+      s.uv[2 * (k - begin)] = r.u;
+      s.uv[2 * (k - begin) + 1] = r.v;
+    }
+    Status st = evaluator_for_thread().EvaluatePoints(PtexFaceId(f), s.uv, s.p, s.nrm);
+    if (!st.ok()) return error.Set(f, st);
+    for (std::size_t k = begin; k < end; ++k) {
+      const auto v = static_cast<std::size_t>(owners[k].second);
+      float h = 0;
+      if (map) {
+        double sum = 0;
+        for (std::size_t r = vertex_records[v]; r < vertex_records[v + 1]; ++r) {
+          const float value =
+              map->Sample(PtexFaceId(records[r].face), records[r].u, records[r].v, channel);
+          if (!std::isfinite(value))
+            return error.Set(records[r].face, MapValueError(*map, records[r].face));
+          sum += value;
+        }
+        h = static_cast<float>(sum / double(vertex_records[v + 1] - vertex_records[v]));
+      }
+      const std::size_t i = 3 * (k - begin);
+      limit_normals[v] = {s.nrm[i], s.nrm[i + 1], s.nrm[i + 2]};
+      mesh.positions[v] = {s.p[i] + h * s.nrm[i], s.p[i + 1] + h * s.nrm[i + 1],
+                           s.p[i + 2] + h * s.nrm[i + 2]};
+    }
+  });
+  if (error.failed()) return error.status();
+
+  // 6. Interior points and triangles, face by face.
+  tbb::parallel_for(0, n, [&](int f) {
+    if (!active(f)) return;
+    const int kx = density[static_cast<std::size_t>(f)][0];
+    const int ky = density[static_cast<std::size_t>(f)][1];
+    Scratch& s = scratch.local();
+    // Points to evaluate: interior grid points, then the centres of stitched cells.
+    s.uv.clear();
+    for (int j = 1; j < ky; ++j) {
+      for (int i = 1; i < kx; ++i) {
+        s.uv.push_back(float(i) / float(kx));
+        s.uv.push_back(float(j) / float(ky));
+      }
+    }
+    for (int j = 0; j < ky; ++j) {
+      for (int i = 0; i < kx; ++i) {
+        const bool border = i == 0 || j == 0 || i == kx - 1 || j == ky - 1;
+        if (border && cell_extras(f, kx, ky, i, j) > 0) {
+          s.uv.push_back((float(i) + 0.5f) / float(kx));
+          s.uv.push_back((float(j) + 0.5f) / float(ky));
+        }
+      }
+    }
+    const std::size_t count = s.uv.size() / 2;
+    const auto first = static_cast<std::size_t>(vertex_start[static_cast<std::size_t>(f)]);
+    DISPEX_CHECK_EQ(first + count,
+                    static_cast<std::size_t>(vertex_start[static_cast<std::size_t>(f) + 1]));
+    if (count > 0) {
+      s.p.resize(3 * count);
+      s.nrm.resize(3 * count);
+      Status st = evaluator_for_thread().EvaluatePoints(PtexFaceId(f), s.uv, s.p, s.nrm);
+      if (!st.ok()) return error.Set(f, st);
+      for (std::size_t k = 0; k < count; ++k) {
+        float h = 0;
+        if (map) {
+          h = map->Sample(PtexFaceId(f), s.uv[2 * k], s.uv[2 * k + 1], channel);
+          if (!std::isfinite(h)) return error.Set(f, MapValueError(*map, f));
+        }
+        const std::size_t i = 3 * k;
+        limit_normals[first + k] = {s.nrm[i], s.nrm[i + 1], s.nrm[i + 2]};
+        mesh.positions[first + k] = {s.p[i] + h * s.nrm[i], s.p[i + 1] + h * s.nrm[i + 1],
+                                     s.p[i + 2] + h * s.nrm[i + 2]};
+      }
+    }
+
+    auto shared = [&](int side, int i) {
+      return line_point_vertex[static_cast<std::size_t>(grid_point(f, side, i))];
+    };
+    auto grid_vertex = [&](int i, int j) -> std::int32_t {
+      if (j == 0) return shared(0, i);
+      if (i == kx) return shared(1, j);
+      if (j == ky) return shared(2, kx - i);
+      if (i == 0) return shared(3, ky - j);
+      return static_cast<std::int32_t>(first + std::size_t(j - 1) * (kx - 1) + (i - 1));
+    };
+    // Appends the points strictly between grid points i and i + 1 of a side.
+    auto append_between = [&](int side, int i) {
+      const std::int64_t a = grid_point(f, side, i), b = grid_point(f, side, i + 1);
+      const std::int64_t step = b > a ? 1 : -1;
+      for (std::int64_t p = a + step; p != b; p += step) {
+        s.polygon.push_back(line_point_vertex[static_cast<std::size_t>(p)]);
+      }
+    };
+    std::int32_t* tri = mesh.face_indices.data() + 3 * triangle_start[static_cast<std::size_t>(f)];
+    auto emit = [&](std::int32_t a, std::int32_t b, std::int32_t c) {
+      *tri++ = a;
+      *tri++ = b;
+      *tri++ = c;
+    };
+    auto centre = static_cast<std::int32_t>(first + std::size_t(kx - 1) * (ky - 1));
+    for (int j = 0; j < ky; ++j) {
+      for (int i = 0; i < kx; ++i) {
+        const std::int32_t a = grid_vertex(i, j), b = grid_vertex(i + 1, j);
+        const std::int32_t c = grid_vertex(i + 1, j + 1), d = grid_vertex(i, j + 1);
+        const bool border = i == 0 || j == 0 || i == kx - 1 || j == ky - 1;
+        if (!border || cell_extras(f, kx, ky, i, j) == 0) {
+          const auto& P = mesh.positions;
+          if (Length2(Sub(P[static_cast<std::size_t>(a)], P[static_cast<std::size_t>(c)])) <=
+              Length2(Sub(P[static_cast<std::size_t>(b)], P[static_cast<std::size_t>(d)]))) {
+            emit(a, b, c);
+            emit(a, c, d);
+          } else {
+            emit(a, b, d);
+            emit(b, c, d);
+          }
+          continue;
+        }
+        s.polygon.clear();
+        s.polygon.push_back(a);
+        if (j == 0) append_between(0, i);
+        s.polygon.push_back(b);
+        if (i == kx - 1) append_between(1, j);
+        s.polygon.push_back(c);
+        if (j == ky - 1) append_between(2, kx - 1 - i);
+        s.polygon.push_back(d);
+        if (i == 0) append_between(3, ky - 1 - j);
+        for (std::size_t k = 0; k < s.polygon.size(); ++k) {
+          emit(centre, s.polygon[k], s.polygon[(k + 1) % s.polygon.size()]);
+        }
+        ++centre;
+      }
+    }
+    DISPEX_CHECK(tri ==
+                 mesh.face_indices.data() + 3 * triangle_start[static_cast<std::size_t>(f) + 1]);
+  });
+  if (error.failed()) return error.status();
+
+  // 7. Smooth normals.
+  std::vector<Float3> triangle_normals(static_cast<std::size_t>(num_triangles));
+  tbb::parallel_for(std::size_t{0}, triangle_normals.size(), [&](std::size_t t) {
+    const Float3& a = mesh.positions[static_cast<std::size_t>(mesh.face_indices[3 * t])];
+    const Float3& b = mesh.positions[static_cast<std::size_t>(mesh.face_indices[3 * t + 1])];
+    const Float3& c = mesh.positions[static_cast<std::size_t>(mesh.face_indices[3 * t + 2])];
+    const Float3 e1 = Sub(b, a), e2 = Sub(c, a);
+    triangle_normals[t] = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z,
+                           e1.x * e2.y - e1.y * e2.x};
+  });
+  VertexNormals(mesh.positions.size(), mesh.face_offsets, mesh.face_indices, triangle_normals,
+                limit_normals, out.normals);
+  return out;
+}
+
+ShadedMesh ShadePolygonMesh(const Mesh& mesh) {
+  ShadedMesh out;
+  const std::size_t num_faces = mesh.num_faces();
+  // Newell normals of the polygons (twice the area times the unit normal for planar ones).
+  std::vector<Float3> face_normals(num_faces);
+  std::vector<std::uint32_t> triangle_start(num_faces + 1, 0);
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    triangle_start[f + 1] = triangle_start[f] + static_cast<std::uint32_t>(mesh.face_size(f) - 2);
+  }
+  tbb::parallel_for(std::size_t{0}, num_faces, [&](std::size_t f) {
+    const auto verts = mesh.face(f);
+    double x = 0, y = 0, z = 0;
+    for (std::size_t k = 0; k < verts.size(); ++k) {
+      const Float3& p = mesh.positions[static_cast<std::size_t>(verts[k])];
+      const Float3& q = mesh.positions[static_cast<std::size_t>(verts[(k + 1) % verts.size()])];
+      x += (double(p.y) - q.y) * (double(p.z) + q.z);
+      y += (double(p.z) - q.z) * (double(p.x) + q.x);
+      z += (double(p.x) - q.x) * (double(p.y) + q.y);
+    }
+    face_normals[f] = {float(x), float(y), float(z)};
+  });
+  VertexNormals(mesh.num_vertices(), mesh.face_offsets, mesh.face_indices, face_normals, {},
+                out.normals);
+
+  Mesh& tri = out.mesh;
+  tri.source = mesh.source;
+  tri.positions.reserve(mesh.positions.size() + 1);  // Embree reads 16 bytes at the last one
+  tri.positions.assign(mesh.positions.begin(), mesh.positions.end());
+  const std::size_t num_triangles = triangle_start[num_faces];
+  tri.face_offsets.resize(num_triangles + 1);
+  tri.face_indices.resize(3 * num_triangles);
+  tbb::parallel_for(std::size_t{0}, num_faces, [&](std::size_t f) {
+    const auto verts = mesh.face(f);
+    for (std::size_t k = 1; k + 1 < verts.size(); ++k) {
+      const std::size_t t = triangle_start[f] + k - 1;
+      tri.face_offsets[t] = static_cast<std::uint32_t>(3 * t);
+      tri.face_indices[3 * t] = verts[0];
+      tri.face_indices[3 * t + 1] = verts[k];
+      tri.face_indices[3 * t + 2] = verts[k + 1];
+    }
+  });
+  tri.face_offsets[num_triangles] = static_cast<std::uint32_t>(3 * num_triangles);
+  return out;
+}
+
+}  // namespace dispex::render
