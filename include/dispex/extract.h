@@ -102,7 +102,10 @@ struct ExtractReport {
   std::array<std::int64_t, 10> oversample_faces{};  // faces by log2 of the samples per side
   std::int64_t samples = 0;
   std::uint64_t rays_cast = 0;
-  std::int64_t hits_positive = 0, hits_negative = 0, hits_back_face = 0;
+  std::int64_t hits_positive = 0, hits_negative = 0;
+  // Hits on sculpt faces that face against the limit normal: the sculpt folds there or the
+  // ray met another sheet (|displacement| x curvature >= 1, thin parts).
+  std::int64_t hits_opposed = 0;
   // With an automatic search distance, samples that miss are searched again this far (0 when
   // the distance was given).
   double retry_search_distance = 0;

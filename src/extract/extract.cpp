@@ -42,7 +42,7 @@ struct FaceResult {
   std::int32_t recovered = 0;  // misses found by the longer search
   std::int32_t filled = 0;
   std::int32_t hits_negative = 0;
-  std::int32_t hits_back = 0;
+  std::int32_t hits_opposed = 0;
   bool all_missed = false;
   float min = 0, max = 0;
   double sum_squares = 0;
@@ -381,7 +381,10 @@ StatusOr<ExtractReport> Extract(const ExtractOptions& options) {
       w.values[i] = hit ? w.t[i] : 0.0f;
       r.misses += !hit;
       r.hits_negative += hit && (fl & HitFlags::kNegative);
-      r.hits_back += hit && (fl & HitFlags::kBackFace);
+      // The sculpt faces the limit normal's way where it is met from behind along +n or from
+      // the front along -n; the other way round it faces against it: a fold or another sheet.
+      const bool negative = fl & HitFlags::kNegative, back = fl & HitFlags::kBackFace;
+      r.hits_opposed += hit && (negative == back);
     }
     if (r.misses > 0) {
       if (options.holes == HolePolicy::kFail) {
@@ -487,7 +490,7 @@ StatusOr<ExtractReport> Extract(const ExtractOptions& options) {
     report.faces_with_misses += r.misses > 0;
     report.hits_negative += r.hits_negative;
     report.hits_positive += r.samples - r.misses - r.hits_negative;
-    report.hits_back_face += r.hits_back;
+    report.hits_opposed += r.hits_opposed;
     if (r.all_missed) {
       SpectralFaceStats constant;
       constant.texels_before = r.samples;

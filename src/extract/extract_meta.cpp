@@ -61,7 +61,7 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
   j["samples"] = r.samples;
   j["rays_cast"] = r.rays_cast;
   j["hits"] = {{"positive", r.hits_positive}, {"negative", r.hits_negative},
-               {"back_face", r.hits_back_face}};
+               {"opposed", r.hits_opposed}};
   j["retry_search_distance"] = r.retry_search_distance;
   j["misses_recovered"] = r.misses_recovered;
   j["misses"] = r.misses;

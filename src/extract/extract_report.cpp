@@ -56,6 +56,10 @@ std::string ExtractReportSummary(const ExtractReport& r) {
                      r.samples, r.rays_cast, r.misses, r.holes_filled,
                      r.faces_filled_from_neighbours, r.misses_recovered,
                      r.retry_search_distance);
+  if (r.hits_opposed > 0) {
+    out += fmt::format("  {} hits on sculpt faces facing against the normal (folds or other "
+                       "sheets)\n", r.hits_opposed);
+  }
   out += fmt::format("  texels {} -> {} ({:.1f}%)  constant faces {}  max error {:.3g}\n",
                      s.texels_before, s.texels_after,
                      s.texels_before ? 100.0 * double(s.texels_after) / double(s.texels_before) : 0,

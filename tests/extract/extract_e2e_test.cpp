@@ -80,6 +80,7 @@ TEST_P(ExtractRealCages, MapMatchesTheKnownDisplacementAndTheReportAddsUp) {
   EXPECT_LE(report->rays_cast, static_cast<std::uint64_t>(3 * samples));
   EXPECT_EQ(report->hits_positive + report->hits_negative + report->misses, samples);
   EXPECT_EQ(report->misses, 0);
+  EXPECT_EQ(report->hits_opposed, 0);  // the sculpt does not fold
   EXPECT_LE(report->spectral.max_measured_error, report->tolerance);
   // A level-3 sculpt of the cage: 2^4 samples per side on quads, 2^3 on n-gon sub-faces.
   EXPECT_EQ(report->oversample_faces[0] + report->oversample_faces[1] +
@@ -226,6 +227,28 @@ TEST_F(ExtractTest, BadInputsAreClearErrors) {
     EXPECT_EQ(report.status().message().find('\n'), std::string::npos);
   }
   EXPECT_FALSE(testing::fs::exists(dir_ / "a.ptx"));
+}
+
+TEST(ExtractFolds, HitsOnAFoldedSculptAreCounted) {
+  TempDir dir;
+  const std::string cage = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
+  MakeSculptOptions make;
+  make.cage_path = cage;
+  make.output_path = dir / "folded.obj";
+  make.levels = 3;
+  make.pattern = Pattern::kSmooth;
+  make.amplitude = 0.03;  // about 1% of the diagonal: folds in Spot's tight creases
+  auto made = MakeSculpt(make);
+  ASSERT_TRUE(made.ok()) << made.status().message();
+  ASSERT_GT(made->folded_faces, 0u);
+  ExtractOptions options;
+  options.base_path = cage;
+  options.sculpt_path = make.output_path;
+  options.output_path = dir / "map.ptx";
+  auto report = Extract(options);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  EXPECT_GT(report->hits_opposed, 0);
+  EXPECT_LT(report->hits_opposed, report->samples / 10);
 }
 
 TEST_F(ExtractTest, HolesFailMakesAnyMissAnError) {
