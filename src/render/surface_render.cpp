@@ -164,7 +164,8 @@ StatusOr<Image> RenderComparison(const Mesh& base, const PtexFile& map, const Me
     return Status::Error(fmt::format("--size {}x{}: {} panels need at least {} pixels of width",
                                      options.width, options.height, panels, 16 * panels));
   }
-  const int scale = options.height >= 240 ? 2 : 1;
+  // Label size: 2x the font from 240 rows, growing with the image (4x at 720 rows).
+  const int scale = options.height >= 240 ? std::clamp(options.height / 180, 2, 4) : 1;
   const int strip = render::TextHeight(render::FontSize::kSmall, scale) + 6 * scale;
   const int panel_height = options.height - strip;
   if (panel_height < 16) {
