@@ -51,6 +51,15 @@ std::string Shown(std::string_view token) {
   return text::TokenForMessage(token.data(), token.data() + token.size(), 32);
 }
 
+// Element and property names end up in error messages: a control byte in one (binary bytes
+// in a damaged header) would break the message's single line.
+bool HasControlByte(std::string_view token) {
+  return std::any_of(token.begin(), token.end(), [](char c) {
+    const auto byte = static_cast<unsigned char>(c);
+    return byte < 0x20 || byte == 0x7f;
+  });
+}
+
 bool ParseCount(std::string_view token, std::uint64_t& count) {
   if (token.empty() || token.size() > 19) return false;
   std::uint64_t value = 0;
@@ -155,6 +164,9 @@ StatusOr<Header> ParseHeader(std::string_view bytes, const std::string& name) {
       have_format = true;
     } else if (keyword == "element") {
       if (tokens.size() != 3) return error("element line needs a name and a count");
+      if (HasControlByte(tokens[1])) {
+        return error(fmt::format("element name '{}' has a control character", Shown(tokens[1])));
+      }
       Element element;
       element.name = std::string(tokens[1]);
       if (!ParseCount(tokens[2], element.count)) {
@@ -186,6 +198,10 @@ StatusOr<Header> ParseHeader(std::string_view bytes, const std::string& name) {
           return error(fmt::format("unsupported property type '{}'", Shown(tokens[1])));
         }
         property.name = std::string(tokens[2]);
+      }
+      if (HasControlByte(property.name)) {
+        return error(
+            fmt::format("property name '{}' has a control character", Shown(property.name)));
       }
       header.elements.back().properties.push_back(std::move(property));
     } else if (keyword == "end_header") {

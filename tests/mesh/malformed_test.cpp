@@ -59,6 +59,8 @@ const std::vector<Case>& Cases() {
       {"obj_vertex_two_coordinates.obj", ":1: vertex has 2 coordinates (3 needed)"},
       {"obj_zero_index.obj", ":4: face index 0 (OBJ indices start at 1)"},
       {"ply_ascii_bad_number.ply", ":11: vertex 1: bad float value 'abc' for 'y'"},
+      // Found by the PLY fuzzer: binary bytes in a name must not reach a message raw.
+      {"ply_element_name_control_bytes.ply", ":3: element name 'ver?"},
       {"ply_ascii_count_does_not_fit.ply",
        ":13: face 0: value 300 of 'vertex_indices' does not fit its type uchar"},
       {"ply_ascii_ends_early.ply", ":15: face 1: file ends before its 'vertex_indices' value"},
