@@ -7,6 +7,7 @@
 #include "core/atomic_output.h"
 #include "core/cancel.h"
 #include "dispex/extract.h"
+#include "dispex/render.h"
 
 namespace dispex::cli {
 namespace {
@@ -23,6 +24,7 @@ struct ExtractArgs {
   std::string holes = "fill";
   std::string bvh_quality = "low";
   std::string report_path;
+  std::string preview_dir;
   std::string max_memory;
   bool quiet = false;
 };
@@ -132,6 +134,11 @@ int RunExtract(ExtractArgs& args) {
     if (!written.ok()) return ReportFailure(written.WithPrefix("--report"));
   }
   if (!args.quiet) std::fputs(ExtractReportSummary(*report).c_str(), stderr);
+  if (!args.preview_dir.empty()) {
+    Status previews = WritePreviews(args.options.base_path, args.options.output_path,
+                                    args.preview_dir);
+    if (!previews.ok()) return ReportFailure(previews.WithPrefix("--preview"));
+  }
   return 0;
 }
 
@@ -192,6 +199,9 @@ void SetupExtract(CLI::App& app, int& exit_code) {
                   "refuse work estimated to need more memory than this (e.g. 8G; default: the "
                   "memory available)");
   cmd->add_option("--report", args->report_path, "write a JSON report to this file");
+  cmd->add_option("--preview", args->preview_dir,
+                  "also write DIR/<map>_atlas.png and DIR/<map>_compare.png (base and base + "
+                  "map side by side)");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress bar and no summary");
   cmd->callback([args, &exit_code] { exit_code = RunExtract(*args); });
 }

@@ -280,6 +280,17 @@ TEST_F(ExtractTest, CommandLineWritesMapAndJsonReport) {
   EXPECT_GT(report["output"]["bytes"].get<std::uint64_t>(), 0u);
   EXPECT_GT(report["peak_rss_bytes"].get<std::uint64_t>(), 0u);
 
+  // --preview writes the atlas and the comparison render beside the map.
+  auto previewed = RunDispex("extract " + cage_ + " " + sculpt_ + " -o " + map + " -q --preview " +
+                                 (dir_ / "previews"),
+                             dir_);
+  ASSERT_EQ(previewed.exit_code, 0) << previewed.err;
+  for (const char* png : {"previews/cli_atlas.png", "previews/cli_compare.png"}) {
+    std::string bytes = testing::Slurp(dir_ / png);
+    ASSERT_GT(bytes.size(), 1000u) << png;
+    EXPECT_EQ(bytes.substr(1, 3), "PNG") << png;
+  }
+
   auto quiet = RunDispex("extract " + cage_ + " " + sculpt_ + " -o " + map + " -q", dir_);
   EXPECT_EQ(quiet.exit_code, 0);
   EXPECT_EQ(quiet.err, "");
