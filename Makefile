@@ -13,7 +13,8 @@ deps:
 	@scripts/install-deps.sh
 
 build: deps
-	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DDISPEX_WERROR=$(WERROR) $(CMAKE_FLAGS) >/dev/null
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DDISPEX_BUILD_BENCH=ON \
+	  -DDISPEX_WERROR=$(WERROR) $(CMAKE_FLAGS) >/dev/null
 	@cmake --build $(BUILD) -j$(JOBS)
 
 demo: build
@@ -21,6 +22,11 @@ demo: build
 
 test: build
 	@cd $(BUILD) && ctest --output-on-failure -j$(JOBS) --timeout 900
+
+# The production-scale benchmark (bench/run): assets generated on first use in
+# $$DISPEX_BENCH_CACHE (default ~/.cache/dispex/bench), table on stdout, JSON in out/bench/.
+bench: build
+	@DISPEX_BUILD=$(BUILD) bench/run $(BENCH_ARGS)
 
 # Unit tests built with AddressSanitizer and UndefinedBehaviorSanitizer.
 test-sanitize: deps
