@@ -154,23 +154,17 @@ StatusOr<CoarseSampling> SampleCoarsely(const LimitSurface& surface) {
 
 }  // namespace
 
-StatusOr<ExtractReport> Extract(const ExtractOptions& options) {
+namespace {
+
+StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int threads) {
   Stopwatch total_clock;
-  DISPEX_RETURN_IF_ERROR(ValidateExtractOptions(options));
   ExtractReport report;
   report.version = DISPEX_VERSION_STRING;
   report.options = options;
   report.base_path = options.base_path;
   report.sculpt_path = options.sculpt_path;
   report.output_path = options.output_path;
-
-  std::optional<tbb::global_control> thread_limit;
-  if (options.threads > 0) {
-    thread_limit.emplace(tbb::global_control::max_allowed_parallelism,
-                         static_cast<std::size_t>(options.threads));
-  }
-  report.threads = static_cast<int>(
-      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  report.threads = threads;
 
   const std::uint64_t memory_limit =
       options.max_memory > 0 ? options.max_memory : AvailableMemoryBytes();
@@ -527,6 +521,26 @@ StatusOr<ExtractReport> Extract(const ExtractOptions& options) {
   report.peak_rss_bytes = PeakResidentBytes();
   report.t_total = total_clock.seconds();
   return report;
+}
+
+}  // namespace
+
+StatusOr<ExtractReport> Extract(const ExtractOptions& options) {
+  DISPEX_RETURN_IF_ERROR(ValidateExtractOptions(options));
+  // --threads N runs every parallel loop (Embree's BVH build included) in an arena of N
+  // threads, more than the machine's cores if asked: the map is the same at any count.
+  std::optional<tbb::global_control> thread_limit;
+  if (options.threads > 0) {
+    thread_limit.emplace(tbb::global_control::max_allowed_parallelism,
+                         static_cast<std::size_t>(options.threads));
+  }
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  arena.initialize();
+  const int threads = std::min(
+      arena.max_concurrency(),
+      static_cast<int>(
+          tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+  return arena.execute([&] { return ExtractInArena(options, threads); });
 }
 
 }  // namespace dispex
