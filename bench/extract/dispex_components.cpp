@@ -54,18 +54,24 @@ int main(int argc, char** argv) {
   Mesh sculpt = Must(ReadMesh(sculpt_path));
   double read = clock.seconds();
   double mb = double(std::filesystem::file_size(sculpt_path)) / 1e6;
-  out["OBJ read (sculpt)"] = fmt::format("{:.2f} s, {:.0f} MB/s", read, mb / read);
+  out["obj_read"] = {{"what", "OBJ read of the sculpt"}, {"seconds", read}, {"mb_per_s", mb / read}};
 
   Mesh base = Must(ReadMesh(base_path));
   LimitSurface surface = Must(LimitSurface::Build(base));
 
-  for (BuildQuality q : {BuildQuality::kLow, BuildQuality::kMedium}) {
+  // The first build in a process pays for first touch of its memory (slow on virtual
+  // machines); the second low-quality build shows the builder alone.
+  const std::pair<BuildQuality, const char*> builds[] = {
+      {BuildQuality::kLow, "bvh_low_first"},
+      {BuildQuality::kMedium, "bvh_medium"},
+      {BuildQuality::kLow, "bvh_low_again"}};
+  for (const auto& [q, key] : builds) {
     TracerOptions o;
     o.quality = q;
     auto tracer = Must(MakeEmbreeTracer(sculpt, o));
-    out[fmt::format("BVH build, {} quality", ToString(q))] =
-        fmt::format("{:.2f} s, {:.0f} MB", tracer->stats().build_seconds,
-                    double(tracer->stats().backend_bytes) / 1e6);
+    out[key] = {{"what", fmt::format("BVH build, {} quality", ToString(q))},
+                {"seconds", tracer->stats().build_seconds},
+                {"bytes", tracer->stats().backend_bytes}};
   }
 
   // The samples extract takes: per face the automatic oversampling.
@@ -87,8 +93,9 @@ int main(int argc, char** argv) {
     (void)e->EvaluateGrid(PtexFaceId(f), r, r, p, q);
   });
   double eval = clock.seconds();
-  out["limit evaluation"] = fmt::format("{:.2f} s for {:.1f}M samples, {:.1f} M/s", eval,
-                                        double(start[n]) / 1e6, double(start[n]) / 1e6 / eval);
+  out["limit_evaluation"] = {{"what", "limit evaluation of the samples"},
+                             {"seconds", eval},
+                             {"samples", start[n]}};
 
   auto tracer = Must(MakeEmbreeTracer(sculpt));
   std::vector<Float3> sparse;
@@ -118,9 +125,11 @@ int main(int argc, char** argv) {
     double seconds = clock.seconds();
     std::uint64_t rays = 0;
     for (auto& c : counters) rays += c.rays_cast;
-    out[fmt::format("rays alone, {}", ToString(mode))] =
-        fmt::format("{:.2f} s, {:.1f}M rays, {:.1f} Mrays/s", seconds, double(rays) / 1e6,
-                    double(rays) / 1e6 / seconds);
+    out[fmt::format("rays_{}", ToString(mode))] = {
+        {"what", fmt::format("the same rays alone, {}", ToString(mode))},
+        {"seconds", seconds},
+        {"rays", rays},
+        {"mrays_per_s", double(rays) / 1e6 / seconds}};
   }
   std::string text = out.dump(2);
   fmt::print("{}\n", text);
