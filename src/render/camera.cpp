@@ -9,38 +9,18 @@
 #include <numbers>
 
 #include "dispex/render.h"
+#include "render/vec3.h"
 
 namespace dispex {
 
 namespace {
 
-struct V3 {
-  double x = 0, y = 0, z = 0;
-};
-V3 operator+(V3 a, V3 b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-V3 operator-(V3 a, V3 b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-V3 operator*(V3 a, double s) {
-  return {a.x * s, a.y * s, a.z * s};
-}
-double Dot(V3 a, V3 b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-V3 Cross(V3 a, V3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-V3 Normalize(V3 a) {
-  return a * (1.0 / std::sqrt(Dot(a, a)));
-}
-V3 ToV3(const Float3& f) {
-  return {f.x, f.y, f.z};
-}
-Float3 ToFloat3(V3 v) {
-  return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
-}
+using render::Cross;
+using render::Dot;
+using render::Normalize;
+using render::ToFloat3;
+using render::ToV3;
+using render::V3;
 
 void PresetAngles(ViewPreset preset, double& azimuth, double& elevation) {
   switch (preset) {

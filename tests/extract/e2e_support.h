@@ -1,7 +1,9 @@
-// Shared helpers of the end-to-end tests: temporary folders, generated sculpts, CLI runs.
+// Shared helpers of the end-to-end tests (extract, verify, cli, render): test data paths,
+// temporary folders, running the dispex binary, reading files whole.
 #pragma once
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
@@ -24,9 +26,11 @@ class TempDir {
  public:
   TempDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() /
-            ("dispex_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
-             std::to_string(::getpid()));
+    std::string name = std::string(info->test_suite_name()) + "_" + info->name();
+    for (char& c : name) {
+      if (c == '/') c = '_';  // parameterised tests
+    }
+    path_ = fs::temp_directory_path() / ("dispex_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(path_);
     fs::create_directories(path_);
   }
@@ -37,6 +41,13 @@ class TempDir {
  private:
   fs::path path_;
 };
+
+inline std::string Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
 
 struct CommandResult {
   int exit_code = -1;
@@ -50,24 +61,11 @@ inline CommandResult RunDispex(const std::string& args, const TempDir& dir) {
   int status = std::system(command.c_str());
   CommandResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  auto slurp = [](const std::string& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  };
-  r.out = slurp(out);
-  r.err = slurp(err);
+  r.out = Slurp(out);
+  r.err = Slurp(err);
   fs::remove(out);
   fs::remove(err);
   return r;
-}
-
-inline std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 }  // namespace dispex::testing

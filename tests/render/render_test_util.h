@@ -3,8 +3,6 @@
 #pragma once
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -12,42 +10,22 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "dispex/ptex.h"
 #include "dispex/render.h"
+#include "../extract/e2e_support.h"
 
 namespace dispex::render_test {
 
 namespace fs = std::filesystem;
 
-inline std::string DataPath(const std::string& relative) {
-  return std::string(DISPEX_TEST_DATA_DIR) + "/" + relative;
-}
-
-// A fresh folder per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = std::string(info->test_suite_name()) + "_" + info->name();
-    for (char& c : name) {
-      if (c == '/') c = '_';
-    }
-    path_ =
-        fs::temp_directory_path() / ("dispex_render_" + std::to_string(::getpid()) + "_" + name);
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  std::string operator/(const std::string& name) const { return (path_ / name).string(); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using testing::CommandResult;
+using testing::DataPath;
+using testing::RunDispex;
+using testing::Slurp;
+using testing::TempDir;
 
 inline void WriteText(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
@@ -103,32 +81,6 @@ inline int MaxChannelDifference(const std::array<std::uint8_t, 3>& a,
   int d = 0;
   for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(a[c]) - int(b[c])));
   return d;
-}
-
-struct CommandResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-inline std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// Runs the dispex binary with `args` (already shell-quoted where needed).
-inline CommandResult RunDispex(const std::string& args, const TempDir& dir) {
-  const std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string command = std::string(DISPEX_EXE) + " " + args + " >" + out + " 2>" + err;
-  const int status = std::system(command.c_str());
-  CommandResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  r.out = Slurp(out);
-  r.err = Slurp(err);
-  fs::remove(out);
-  fs::remove(err);
-  return r;
 }
 
 }  // namespace dispex::render_test
