@@ -86,6 +86,36 @@ std::string CheckGroups(const Mesh& mesh) {
   return {};
 }
 
+// Mesh::uvs: both arrays empty, or one in-range index per corner and finite (u, v) pairs; UVs
+// dropped (faces_without_uvs > 0) only for some, not all, faces and with both arrays empty.
+std::string CheckUvs(const Mesh& mesh) {
+  if (mesh.uvs.size() % 2 != 0) return "uvs holds an odd number of floats";
+  if (mesh.face_uv_indices.empty()) {
+    if (!mesh.uvs.empty()) return "uvs without face_uv_indices";
+  } else {
+    if (mesh.face_uv_indices.size() != mesh.face_indices.size()) {
+      return Num(mesh.face_uv_indices.size()) + " face uv indices for " +
+             Num(mesh.face_indices.size()) + " face corners";
+    }
+    const auto nuv = static_cast<std::int64_t>(mesh.uvs.size() / 2);
+    for (std::size_t i = 0; i < mesh.face_uv_indices.size(); ++i) {
+      if (mesh.face_uv_indices[i] < 0 || mesh.face_uv_indices[i] >= nuv) {
+        return "face uv index " + std::to_string(mesh.face_uv_indices[i]) + " at corner " +
+               Num(i) + " out of range (" + Num(mesh.uvs.size() / 2) + " uvs)";
+      }
+    }
+    if (mesh.faces_without_uvs != 0) return "faces_without_uvs set while UVs are kept";
+  }
+  for (std::size_t i = 0; i < mesh.uvs.size(); ++i) {
+    if (!std::isfinite(mesh.uvs[i])) return "uv " + Num(i / 2) + " is not finite";
+  }
+  if (mesh.faces_without_uvs >= mesh.num_faces() && mesh.faces_without_uvs != 0) {
+    return "faces_without_uvs " + Num(mesh.faces_without_uvs) + " is not fewer than the " +
+           Num(mesh.num_faces()) + " faces";
+  }
+  return {};
+}
+
 // The measures a caller runs right after reading must accept any mesh a reader returns.
 std::string CheckMeasures(const Mesh& mesh) {
   const MeshValidation v = ValidateMesh(mesh);
@@ -148,8 +178,10 @@ std::string CheckErrorMessage(const Status& status, const std::string& name) {
 }
 
 std::string CheckMeshResult(const StatusOr<Mesh>& result, const std::string& name) {
-  if (!result.ok()) return CheckErrorMessage(result.status(), name);
-  const Mesh& mesh = *result;
+  return result.ok() ? CheckMesh(*result, name) : CheckErrorMessage(result.status(), name);
+}
+
+std::string CheckMesh(const Mesh& mesh, const std::string& name) {
   if (mesh.source != name) return "source is \"" + mesh.source + "\", not \"" + name + "\"";
   if (mesh.num_faces() == 0) return "a mesh without faces";
   if (mesh.face_offsets.front() != 0) return "face_offsets does not start at 0";
@@ -180,6 +212,7 @@ std::string CheckMeshResult(const StatusOr<Mesh>& result, const std::string& nam
   }
   if (std::string why = CheckGroups(mesh); !why.empty()) return why;
   if (std::string why = CheckTags(mesh); !why.empty()) return why;
+  if (std::string why = CheckUvs(mesh); !why.empty()) return why;
   return CheckMeasures(mesh);
 }
 
@@ -208,6 +241,12 @@ std::string CompareMeshResults(const StatusOr<Mesh>& a, const StatusOr<Mesh>& b)
     return "different groups";
   }
   if (!SameTags(x.tags, y.tags)) return "different tags";
+  if (x.uvs.size() != y.uvs.size() ||
+      (!x.uvs.empty() &&
+       std::memcmp(x.uvs.data(), y.uvs.data(), x.uvs.size() * sizeof(float)) != 0) ||
+      x.face_uv_indices != y.face_uv_indices || x.faces_without_uvs != y.faces_without_uvs) {
+    return "different uvs";
+  }
   return {};
 }
 

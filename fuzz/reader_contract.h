@@ -27,13 +27,18 @@ std::string CheckErrorMessage(const Status& status, const std::string& name);
 // face has >= 3 corners, face_offsets starts at 0, grows and ends at face_indices.size(),
 // every index in [0, num_vertices()), every position finite, positions.capacity() >
 // positions.size(), source == name; face_groups empty or one valid group id per face, every
-// listed group owning a face; tag vertex and face ids in range, sharpness finite and >= 0.
+// listed group owning a face; tag vertex and face ids in range, sharpness finite and >= 0;
+// UVs absent, or one in-range UV index per corner and finite UVs (Mesh::uvs).
 // A successful mesh is also run through ValidateMesh, ComputeBounds and MedianEdgeLength
 // (their results must be consistent with the mesh). On failure: CheckErrorMessage.
 std::string CheckMeshResult(const StatusOr<Mesh>& result, const std::string& name);
 
+// The success half of CheckMeshResult, for a mesh in hand (tests that break one promise by
+// hand; a copy into a StatusOr would lose the spare capacity the contract asks for).
+std::string CheckMesh(const Mesh& mesh, const std::string& name);
+
 // "" when `a` and `b` are the same result: both failed with the same message, or both
-// succeeded with bit-identical meshes (positions, faces, groups, tags). The OBJ reader
+// succeeded with bit-identical meshes (positions, faces, groups, tags, UVs). The OBJ reader
 // promises this for any ReadOptions (chunk size, threads).
 std::string CompareMeshResults(const StatusOr<Mesh>& a, const StatusOr<Mesh>& b);
 

@@ -1,4 +1,4 @@
-// dispex make-sculpt CAGE --levels L --pattern P [--amplitude A] -o SCULPT.obj
+// dispex make-sculpt CAGE --levels L --pattern P|image:FILE.png [--amplitude A] -o SCULPT.obj
 #include <fmt/format.h>
 
 #include "command.h"
@@ -14,9 +14,10 @@ struct MakeSculptArgs {
 };
 
 int RunMakeSculpt(MakeSculptArgs& args) {
-  auto pattern = ParsePattern(args.pattern);
+  auto pattern = ParsePatternArgument(args.pattern);
   if (!pattern.ok()) return ReportFailure(pattern.status().WithPrefix("--pattern"), 2);
-  args.options.pattern = *pattern;
+  args.options.pattern = pattern->pattern;
+  args.options.image_path = pattern->image_path;
   auto report = MakeSculpt(args.options);
   if (!report.ok()) return ReportFailure(report.status());
   if (!args.quiet) {
@@ -43,7 +44,9 @@ void SetupMakeSculpt(CLI::App& app, int& exit_code) {
   cmd->add_option("-o,--output", o.output_path, "sculpt to write (.obj)")->required();
   cmd->add_option("--levels", o.levels, "Catmull-Clark refinement levels (1..8)")
       ->capture_default_str();
-  cmd->add_option("--pattern", args->pattern, "smooth, detail, ridges, noise or none")
+  cmd->add_option("--pattern", args->pattern,
+                  "smooth, detail, ridges, noise, none, or image:FILE.png (h = A (2 L - 1), L "
+                  "the PNG's luminance at the cage's UVs; v = 0 at the image's bottom row)")
       ->capture_default_str();
   cmd->add_option("--amplitude", o.amplitude,
                   "pattern amplitude in object units (default: 1% of the bounding-box diagonal)");

@@ -72,6 +72,14 @@ void PrintText(const InfoOptions& options, const Mesh& mesh, const Summary& s) {
   out += fmt::format("faces         {} ({})\n", mesh.num_faces(), sizes);
   out += fmt::format("face corners  {}\n", mesh.face_indices.size());
   out += fmt::format("groups        {}\n", groups);
+  if (mesh.has_uvs()) {
+    out += fmt::format("uvs           {} texture coordinates on every face\n", mesh.num_uvs());
+  } else if (mesh.faces_without_uvs > 0) {
+    out += fmt::format("uvs           none kept: {} of {} faces have no texture coordinates\n",
+                       mesh.faces_without_uvs, mesh.num_faces());
+  } else {
+    out += "uvs           none\n";
+  }
   out +=
       fmt::format("creases       {} ({} infinitely sharp)\n", t.creases.size(), s.infinite_creases);
   out += fmt::format("corners       {}\n", t.corners.size());
@@ -103,6 +111,8 @@ void PrintJson(const InfoOptions& options, const Mesh& mesh, const Summary& s) {
   j["faces_by_size"] = sizes;
   j["face_corners"] = mesh.face_indices.size();
   j["groups"] = mesh.group_names;
+  j["uvs"] = {{"texture_coordinates", mesh.num_uvs()},
+              {"faces_without_uvs", mesh.faces_without_uvs}};
   const SubdivTags& t = mesh.tags;
   j["tags"] = {{"creases", t.creases.size()},
                {"infinitely_sharp_creases", s.infinite_creases},

@@ -57,6 +57,17 @@ struct Mesh {
   std::vector<std::int32_t> face_groups;
   std::vector<std::string> group_names;
 
+  // Optional face-varying texture coordinates (OBJ `vt` and the `/vt` of face corners). Either
+  // both are empty (no UVs), or face_uv_indices has one entry per entry of face_indices, laid
+  // out the same way (corner c of face f at face_uv_indices[face_offsets[f] + c]), each an
+  // index in [0, uvs.size() / 2) into uvs, which holds (u, v) pairs, all finite. The OBJ
+  // convention: v = 0 at the bottom of the image.
+  std::vector<float> uvs;
+  std::vector<std::int32_t> face_uv_indices;
+  // When some faces name texture coordinates and others do not, the reader keeps the mesh
+  // without UVs (both arrays empty) and counts here the faces that had none; 0 otherwise.
+  std::size_t faces_without_uvs = 0;
+
   SubdivTags tags;
 
   std::size_t num_vertices() const { return positions.size(); }
@@ -68,6 +79,8 @@ struct Mesh {
     return {face_indices.data() + face_offsets[f], face_indices.data() + face_offsets[f + 1]};
   }
   bool all_quads() const { return face_indices.size() == 4 * num_faces(); }
+  bool has_uvs() const { return !face_uv_indices.empty(); }
+  std::size_t num_uvs() const { return uvs.size() / 2; }
 };
 
 // ---- Reading -------------------------------------------------------------------------------
@@ -91,7 +104,9 @@ MeshFormat DetectMeshFormat(const std::string& path);
 // What every reader guarantees on success: at least one face; every face has at least 3
 // vertices; every index is in [0, num_vertices()); every position is finite; face_offsets
 // starts at 0 and ends at face_indices.size(); positions.capacity() > positions.size() (Embree
-// reads 16 bytes at the last vertex); `source` is the path (or `name`). The result is the same
+// reads 16 bytes at the last vertex); UVs absent or consistent as Mesh::uvs states (both
+// arrays empty, or one in-range UV index per corner and finite UVs); `source` is the path
+// (or `name`). The result is the same
 // for any ReadOptions. On failure the Status message is one line that starts with the file
 // name, then the 1-based line (OBJ, ASCII PLY) or the element and its index (PLY), then what
 // is wrong: "sculpt.obj:1234: face index 99 out of range (98 vertices)". Never throws for bad
@@ -100,24 +115,33 @@ StatusOr<Mesh> ReadMesh(const std::string& path, const ReadOptions& options = {}
 
 // Wavefront OBJ, parsed in parallel over chunks of the memory-mapped file.
 //  - `v x y z [w | r g b ...]`: extra numbers are ignored; coordinates must be finite floats.
+//  - `vt u [v [w]]`: texture coordinates (v defaults to 0; w and further numbers are ignored);
+//    they must be finite.
 //  - `f` with `i`, `i/t`, `i//n`, `i/t/n` corners and n-gons; negative indices count back from
-//    the vertices defined before the line; positive ones may refer to any vertex of the file.
-//    Texture and normal indices are checked for syntax only (they may dangle).
+//    the vertices (for t: the texture coordinates) defined before the line; positive ones may
+//    refer to any vertex (texture coordinate) of the file. Vertex and texture indices are
+//    checked against those counts ("face texture index 7 out of range (6 texture
+//    coordinates)"); normal indices are checked for syntax only (they may dangle).
+//  - UVs (Mesh::uvs, face_uv_indices) are kept when every face names a texture coordinate at
+//    every corner. When some faces (or corners) do and others do not, the mesh is still read
+//    but without UVs, and Mesh::faces_without_uvs counts the faces that had none (this reader
+//    has no warning channel: callers that need UVs say why they are missing from that count).
 //  - `o name` / `g name...`: a group per distinct name (blanks collapsed; no name = "default"),
 //    in order of first appearance, listing only groups that own faces; faces before the first
 //    group line form the group "default". With no o/g line, face_groups stays empty.
 //  - OpenSubdiv `t` tags (crease, corner, hole, interpolateboundary; others counted in
 //    tags.ignored_tags) with 0-based ids checked against the whole file.
 //  - `#` comments, blank lines, CRLF; a `\` at the end of any line (comments too) joins the
-//    next line. Every other keyword (vt, vn, usemtl, mtllib, s, l, p, ...) is ignored; a line
+//    next line. Every other keyword (vn, vp, usemtl, mtllib, s, l, p, ...) is ignored; a line
 //    that does not start with a keyword is an error.
 // Peak memory is about the final arrays: the file's pages are released as chunks are done.
 StatusOr<Mesh> ReadObj(const std::string& path, const ReadOptions& options = {});
 
 // PLY: ascii, binary_little_endian, binary_big_endian. The `vertex` element's x, y, z (any
 // numeric type) and the `face` element's `vertex_indices` (or `vertex_index`) list (any
-// integer count and index types) are read; other properties and elements are skipped. Binary
-// vertex and face data are converted in parallel.
+// integer count and index types) are read; other properties and elements are skipped (so are
+// texture coordinates: a PLY mesh has no UVs). Binary vertex and face data are converted in
+// parallel.
 StatusOr<Mesh> ReadPly(const std::string& path, const ReadOptions& options = {});
 
 // The same parsers over bytes in memory (`name` is used in messages). For tests and fuzzing.

@@ -14,18 +14,42 @@ namespace dispex {
 
 // ---- Ground-truth sculpts ------------------------------------------------------------------
 
-// Known displacement patterns h(P), functions of the limit point P in object space, scaled by
-// the base's bounding box (diagonal D) and the sculpt's edge length e (the base's median edge
-// length / 2^levels) so that every pattern is resolved by the sculpt it is put on.
+// Known displacement patterns h. All but kImage are functions of the limit point P in object
+// space, scaled by the base's bounding box (diagonal D) and the sculpt's edge length e (the
+// base's median edge length / 2^levels) so that every pattern is resolved by the sculpt it is
+// put on.
 enum class Pattern : std::uint8_t {
   kSmooth,  // three long sines (wavelengths 0.6, 0.35, 0.25 D)
   kDetail,  // smooth + bumps of wavelength 8e confined to two balls of radius 0.22 D
   kRidges,  // smooth + a triangle wave of period 0.12 D: sharp creases (C0) along planes
   kNoise,   // 24 sines of random directions and wavelengths in [6e, 24e] (seeded)
   kNone,    // h = 0: the refined limit surface itself (e.g. a denser base cage)
+  // A height image (PNG) through the cage's UVs: h = A (2 L - 1), L in [0, 1] the image's
+  // luminance at the point's UV. The point's UV is the cage's face-varying UVs interpolated
+  // linearly at its (Ptex face, u, v): bilinear over a quad's four corner UVs; on sub-face k
+  // of an n-gon bilinear over (corner k, midpoint of edge k, the face's centroid, midpoint of
+  // edge k-1), at Ptex (0,0), (1,0), (1,1), (0,1) -- OpenSubdiv's linear face-varying
+  // interpolation, exact in closed form. The image: 8- or 16-bit grey, grey + alpha, RGB or
+  // RGBA (palettes expanded, alpha ignored); L = 0.2126 R + 0.7152 G + 0.0722 B (Rec. 709
+  // weights) on the stored values over 255 or 65535, no gamma decoding (grey: L = value /
+  // max). Read with bilinear filtering between pixel centres, repeating outside [0, 1)
+  // (pixel (i, j) centred at ((i + 0.5) / width, (j + 0.5) / height)), v = 0 at the image's
+  // BOTTOM row (the OBJ / Maya convention). At a UV seam h is continuous only where the image
+  // agrees on both sides; a sculpt vertex on a seam takes h from the Ptex face its truth
+  // record names.
+  kImage,
 };
-std::string_view PatternName(Pattern pattern);  // "smooth", "detail", "ridges", "noise", "none"
+// "smooth", "detail", "ridges", "noise", "none", "image".
+std::string_view PatternName(Pattern pattern);
+// One of the names above except "image" (which needs a file: ParsePatternArgument).
 StatusOr<Pattern> ParsePattern(std::string_view name);
+
+// The --pattern argument of make-sculpt: a pattern name, or "image:FILE.png".
+struct PatternArgument {
+  Pattern pattern = Pattern::kDetail;
+  std::string image_path;  // kImage only
+};
+StatusOr<PatternArgument> ParsePatternArgument(std::string_view text);
 
 struct PatternFrame {
   float center[3] = {0, 0, 0};  // the base's bounding-box centre
@@ -35,7 +59,8 @@ struct PatternFrame {
   std::uint32_t seed = 1;
 };
 
-// h at one point.
+// h at one point, for the patterns that are functions of the position (NaN for kImage, which
+// MakeSculpt evaluates through the cage's UVs).
 double EvaluatePattern(Pattern pattern, const PatternFrame& frame, const float p[3]);
 
 struct MakeSculptOptions {
@@ -44,6 +69,7 @@ struct MakeSculptOptions {
   std::string truth_path;   // empty: output_path + ".truth"
   int levels = 4;           // uniform Catmull-Clark refinements, 1..8
   Pattern pattern = Pattern::kDetail;
+  std::string image_path;   // Pattern::kImage: the height image (PNG)
   double amplitude = 0;     // object units; 0: 1% of the base's bounding-box diagonal
   std::uint32_t seed = 1;
   int threads = 0;
@@ -66,7 +92,10 @@ struct MakeSculptReport {
 
 // Refines the cage `levels` times (OpenSubdiv, tags honoured), puts each vertex on the limit
 // surface and moves it along the limit normal by h. Writes the sculpt (OBJ, quads) and the
-// truth file: for every sculpt vertex its (Ptex face, u, v) on the base and h there.
+// truth file: for every sculpt vertex its (Ptex face, u, v) on the base and h there. With
+// Pattern::kImage, fails before refining (one line naming the file) when the cage has no UVs
+// on every face or the image cannot be read (missing, not a PNG, truncated, corrupt, larger
+// than 2^28 pixels).
 StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options);
 
 // The truth file: "DISPEXGT" magic, u32 version (1), u32 zero, u64 count, then count records

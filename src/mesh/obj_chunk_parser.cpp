@@ -16,7 +16,12 @@ namespace {
 class ChunkParser {
  public:
   ChunkParser(const ChunkInput& in, ChunkOutput& out)
-      : in_(in), out_(out), p_(in.begin), end_(in.end), line_(in.first_line) {}
+      : in_(in),
+        out_(out),
+        p_(in.begin),
+        end_(in.end),
+        line_(in.first_line),
+        keep_uvs_(out.uv_indices.capacity() > 0) {}
 
   void Run() {
     while (p_ < end_) {
@@ -26,6 +31,9 @@ class ChunkParser {
       switch (kind) {
         case LineKind::kVertex:
           ok = ParseVertex();
+          break;
+        case LineKind::kTexCoord:
+          ok = ParseTexCoord();
           break;
         case LineKind::kFace:
           ok = ParseFace();
@@ -74,48 +82,97 @@ class ChunkParser {
     return Fail(fmt::format("unexpected '{}' {}", text::TokenForMessage(p_, end_), what));
   }
 
-  bool ParseVertex() {
-    float xyz[3];
-    for (int k = 0; k < 3; ++k) {
+  // The numbers of a `v` or `vt` line: `needed` floats, then up to `stored` - `needed`
+  // optional ones (`out` keeps its value where one is missing), then any further numbers,
+  // which are checked and ignored. The one place that parses floats, so that the compiler
+  // keeps fast_float inlined in it (a second call site made it an out-of-line call for every
+  // coordinate, 5% slower on vertex-heavy files); kept out of line for the same reason.
+  // `what` names the line in messages: "vertex" -> "vertex has 2 coordinates (3 needed)",
+  // "bad vertex coordinate 'x'", "vertex coordinate 'nan' is not a finite number".
+  [[gnu::noinline]] bool ParseNumbers(float* out, int needed, int stored, const char* what) {
+    for (int k = 0; k < stored; ++k) {
       text::SkipBlanks(p_, end_, line_);
       if (AtStatementEnd()) {
-        return Fail(fmt::format("vertex has {} coordinate{} (3 needed)", k, k == 1 ? "" : "s"));
+        if (k >= needed) return true;
+        return Fail(fmt::format("{} has {} coordinate{} ({} needed)", what, k,
+                                k == 1 ? "" : "s", needed));
       }
       const char* token = p_;
-      const text::NumberResult r = text::ParseReal(p_, end_, xyz[k]);
+      const text::NumberResult r = text::ParseReal(p_, end_, out[k]);
       if (r == text::NumberResult::kOk && text::EndsToken(p_, end_)) continue;
       p_ = token;
       if (r == text::NumberResult::kNotFinite) {
-        return Fail(fmt::format("vertex coordinate '{}' is not a finite number",
+        return Fail(fmt::format("{} coordinate '{}' is not a finite number", what,
                                 text::TokenForMessage(p_, end_)));
       }
       if (text::IsDanglingContinuation(p_, end_)) {
         return Fail("line continued with '\\' at the end of the file");
       }
-      return Fail(fmt::format("bad vertex coordinate '{}'", text::TokenForMessage(p_, end_)));
+      return Fail(fmt::format("bad {} coordinate '{}'", what, text::TokenForMessage(p_, end_)));
     }
     // Optional w or per-vertex colour values: must be numbers, otherwise ignored.
     for (;;) {
       text::SkipBlanks(p_, end_, line_);
-      if (AtStatementEnd()) break;
+      if (AtStatementEnd()) return true;
       const char* token = p_;
       double extra = 0;
       if (text::ParseReal(p_, end_, extra) != text::NumberResult::kOk ||
           !text::EndsToken(p_, end_)) {
         p_ = token;
-        return FailUnexpected("after the vertex coordinates");
+        return FailUnexpected(fmt::format("after the {} coordinates", what).c_str());
       }
     }
+  }
+
+  bool ParseVertex() {
+    float xyz[3];
+    if (!ParseNumbers(xyz, 3, 3, "vertex")) return false;
     in_.positions[in_.vertex_base + out_.vertices] = Float3{xyz[0], xyz[1], xyz[2]};
     ++out_.vertices;
     return true;
   }
 
-  // One corner "v", "v/t", "v//n" or "v/t/n". Texture and normal indices are checked for
-  // syntax only: they may point at vt/vn lines the file does not have.
+  // `vt u [v [w]]`: v defaults to 0; w and any further numbers must be numbers and are ignored.
+  bool ParseTexCoord() {
+    float uv[2] = {0, 0};
+    if (!ParseNumbers(uv, 1, 2, "texture")) return false;
+    float* out = in_.uvs + 2 * (in_.texcoord_base + out_.texcoords);
+    out[0] = uv[0];
+    out[1] = uv[1];
+    ++out_.texcoords;
+    return true;
+  }
+
+  // The 0-based texture coordinate of a corner's 1-based or relative index, checked as
+  // vertex indices are.
+  bool ResolveTexture(std::int64_t index, const char* token, std::int64_t& texcoord) {
+    if (index > 0) {
+      texcoord = index - 1;
+      if (texcoord < in_.num_texcoords) return true;
+      p_ = token;
+      return Fail(fmt::format("face texture index {} out of range ({} texture coordinates)",
+                              index, in_.num_texcoords));
+    }
+    if (index < 0) {
+      const std::int64_t before = in_.texcoord_base + out_.texcoords;
+      texcoord = before + index;
+      if (texcoord >= 0) return true;
+      p_ = token;
+      return Fail(fmt::format(
+          "relative face texture index {} out of range ({} texture coordinates before it)",
+          index, before));
+    }
+    p_ = token;
+    return Fail("face texture index 0 (OBJ indices start at 1)");
+  }
+
+  // One corner "v", "v/t", "v//n" or "v/t/n". Vertex and texture indices are resolved and
+  // checked; normal indices are checked for syntax only (they may point at vn lines the file
+  // does not have). Texture ids are kept while every face of the chunk has one per corner.
   bool ParseFace() {
     const std::int64_t vertices_before = in_.vertex_base + out_.vertices;
     std::uint32_t count = 0;
+    std::uint32_t textured = 0;  // corners that named a texture coordinate
     for (;;) {
       text::SkipBlanks(p_, end_, line_);
       if (AtStatementEnd()) break;
@@ -137,11 +194,16 @@ class ChunkParser {
         continue;
       }
       text::NumberResult r = text::ParseInt(p_, end_, index);
+      bool has_texture = false;
+      std::int64_t texture = 0;
       if (r == text::NumberResult::kOk && p_ < end_ && *p_ == '/') {
-        std::int64_t unused = 0;
         ++p_;
-        if (p_ < end_ && *p_ != '/') r = text::ParseInt(p_, end_, unused);  // texture index
+        if (p_ < end_ && *p_ != '/') {
+          r = text::ParseInt(p_, end_, texture);
+          has_texture = true;
+        }
         if (r == text::NumberResult::kOk && p_ < end_ && *p_ == '/') {
+          std::int64_t unused = 0;
           ++p_;
           r = text::ParseInt(p_, end_, unused);  // normal index
         }
@@ -172,6 +234,17 @@ class ChunkParser {
         p_ = token;
         return Fail("face index 0 (OBJ indices start at 1)");
       }
+      if (has_texture) {
+        const char* after = p_;
+        std::int64_t texcoord = 0;
+        if (!ResolveTexture(texture, token, texcoord)) return false;
+        p_ = after;
+        if (keep_uvs_) {
+          DISPEX_CHECK(!out_.uv_indices.full());
+          out_.uv_indices.push_back(static_cast<std::int32_t>(texcoord));
+        }
+        ++textured;
+      }
       DISPEX_CHECK(!out_.indices.full());
       out_.indices.push_back(static_cast<std::int32_t>(vertex));
       ++count;
@@ -179,6 +252,12 @@ class ChunkParser {
     if (count < 3) {
       return Fail(fmt::format("face has {} {} (at least 3 needed)", count,
                               count == 1 ? "vertex" : "vertices"));
+    }
+    if (textured == count) {
+      ++out_.faces_with_uvs;
+    } else if (keep_uvs_) {
+      out_.uv_indices.pop_back(textured);
+      keep_uvs_ = false;  // the file has no UVs: stop keeping them
     }
     in_.face_sizes[in_.face_base + out_.faces] = count;
     ++out_.faces;
@@ -220,6 +299,7 @@ class ChunkParser {
   const char* p_;
   const char* end_;
   std::int64_t line_;
+  bool keep_uvs_;  // every face so far had UVs (and the file has vt lines)
 };
 
 }  // namespace
@@ -228,6 +308,8 @@ bool ParseChunk(const ChunkInput& in, ChunkOutput& out) {
   // Every face corner takes at least two bytes ("1 "), so this bounds the chunk's indices.
   const std::size_t bytes = static_cast<std::size_t>(in.end - in.begin);
   if (!out.indices.Reserve(bytes / 2 + 2)) return false;
+  // Without a vt line every texture index is an error: no buffer needed.
+  if (in.num_texcoords > 0 && !out.uv_indices.Reserve(bytes / 2 + 2)) return false;
   ChunkParser(in, out).Run();
   return true;
 }

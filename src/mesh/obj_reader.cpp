@@ -2,15 +2,15 @@
 //
 // 1. Cut the file into chunks of about ReadOptions::chunk_bytes that start at logical line
 //    starts (a cut never splits a `\` continuation).
-// 2. Counting pass, in parallel: per chunk, physical lines, `v` lines and `f` lines.
-//    Prefix sums give each chunk its first line number, vertex base and face base, and the
-//    totals size the final arrays.
-// 3. Parsing pass, in parallel: each chunk writes its positions and face sizes straight into
-//    the final arrays and its face indices into a per-chunk buffer; relative indices, index
-//    ranges and tag ids are checked there with the exact line number.
+// 2. Counting pass, in parallel: per chunk, physical lines, `v`, `vt` and `f` lines.
+//    Prefix sums give each chunk its first line number, vertex, texture coordinate and face
+//    bases, and the totals size the final arrays.
+// 3. Parsing pass, in parallel: each chunk writes its positions, UVs and face sizes straight
+//    into the final arrays and its face (and texture) indices into per-chunk buffers;
+//    relative indices, index ranges and tag ids are checked there with the exact line number.
 // 4. Merge, in file order: the first error of the earliest chunk is the file's first error;
 //    face sizes become offsets; index buffers are appended and freed one by one; groups and
-//    tags are concatenated.
+//    tags are concatenated. UVs are kept only when every face had them (Mesh::uvs).
 // Memory: the final arrays plus the index buffers of the chunks not yet appended; for a
 // mapped file the pages of each chunk are dropped after each pass, so the file itself does
 // not stay resident. The result is identical for any thread count and chunk size.
@@ -48,6 +48,7 @@ struct Chunk {
 struct ChunkCounts {
   std::int64_t lines = 0;  // '\n' bytes in the chunk
   std::int64_t vertices = 0;
+  std::int64_t texcoords = 0;
   std::int64_t faces = 0;
 };
 
@@ -76,6 +77,7 @@ ChunkCounts CountChunk(const char* file_begin, const Chunk& chunk) {
     text::SkipBlanks(p, chunk.end, crossed);
     const obj::LineKind kind = obj::ReadKeyword(p, chunk.end);
     counts.vertices += kind == obj::LineKind::kVertex;
+    counts.texcoords += kind == obj::LineKind::kTexCoord;
     counts.faces += kind == obj::LineKind::kFace;
   };
   classify(chunk.begin);
@@ -154,16 +156,18 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     });
   });
 
-  std::int64_t lines = 0, vertices = 0, faces = 0;
+  std::int64_t lines = 0, vertices = 0, texcoords = 0, faces = 0;
   for (std::size_t i = 0; i < n; ++i) {
     inputs[i].file_begin = file_begin;
     inputs[i].begin = chunks[i].begin;
     inputs[i].end = chunks[i].end;
     inputs[i].first_line = lines + 1;
     inputs[i].vertex_base = vertices;
+    inputs[i].texcoord_base = texcoords;
     inputs[i].face_base = faces;
     lines += counts[i].lines;
     vertices += counts[i].vertices;
+    texcoords += counts[i].texcoords;
     faces += counts[i].faces;
   }
   // Vertex ids are int32 (OpenSubdiv, Embree) and so are face ids.
@@ -174,14 +178,21 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   if (faces > std::numeric_limits<std::int32_t>::max()) {
     return Status::Error(fmt::format("{}: {} faces: more than the 2^31-1 supported", name, faces));
   }
+  if (texcoords > std::numeric_limits<std::int32_t>::max()) {
+    return Status::Error(
+        fmt::format("{}: {} texture coordinates: more than the 2^31-1 supported", name, texcoords));
+  }
   // Embree reads 16 bytes at the last vertex: keep one spare element of capacity.
   mesh.positions.reserve(static_cast<std::size_t>(vertices) + 1);
   mesh.positions.resize(static_cast<std::size_t>(vertices));
   mesh.face_offsets.resize(static_cast<std::size_t>(faces) + 1);
+  mesh.uvs.resize(2 * static_cast<std::size_t>(texcoords));
   for (auto& in : inputs) {
     in.num_vertices = vertices;
+    in.num_texcoords = texcoords;
     in.num_faces = faces;
     in.positions = mesh.positions.data();
+    in.uvs = mesh.uvs.data();
     in.face_sizes = mesh.face_offsets.data() + 1;
   }
 
@@ -194,12 +205,15 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   if (out_of_memory.load()) return Status::Error(name + ": out of memory while reading");
 
   std::uint64_t corners = 0;
+  std::int64_t faces_without_uvs = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const obj::ChunkOutput& out = outputs[i];
     if (out.error) return LineError(name, out.error->line, out.error->message);
     DISPEX_CHECK_EQ(out.vertices, counts[i].vertices);
+    DISPEX_CHECK_EQ(out.texcoords, counts[i].texcoords);
     DISPEX_CHECK_EQ(out.faces, counts[i].faces);
     corners += out.indices.size();
+    faces_without_uvs += out.faces - out.faces_with_uvs;
   }
   if (faces == 0) {
     return Status::Error(
@@ -220,6 +234,21 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   for (auto& out : outputs) {
     mesh.face_indices.insert(mesh.face_indices.end(), out.indices.begin(), out.indices.end());
     out.indices.Release();
+  }
+  // UVs: all faces or none (see Mesh::faces_without_uvs).
+  if (faces_without_uvs == 0 && texcoords > 0) {
+    mesh.face_uv_indices.reserve(static_cast<std::size_t>(corners));
+    for (auto& out : outputs) {
+      mesh.face_uv_indices.insert(mesh.face_uv_indices.end(), out.uv_indices.begin(),
+                                  out.uv_indices.end());
+      out.uv_indices.Release();
+    }
+    DISPEX_CHECK_EQ(mesh.face_uv_indices.size(), mesh.face_indices.size());
+  } else {
+    for (auto& out : outputs) out.uv_indices.Release();
+    std::vector<float>().swap(mesh.uvs);
+    if (faces_without_uvs < faces)
+      mesh.faces_without_uvs = static_cast<std::size_t>(faces_without_uvs);
   }
 
   MergeGroups(outputs, mesh);

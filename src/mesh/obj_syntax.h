@@ -15,10 +15,11 @@ namespace dispex::obj {
 enum class LineKind : std::uint8_t {
   kEmpty,       // blank line or comment
   kVertex,      // v
+  kTexCoord,    // vt
   kFace,        // f
   kGroup,       // o or g: starts a named group of faces
   kTag,         // t: OpenSubdiv subdivision tag
-  kIgnored,     // any other keyword: vt, vn, vp, usemtl, mtllib, s, l, p, cstype, ...
+  kIgnored,     // any other keyword: vn, vp, usemtl, mtllib, s, l, p, cstype, ...
   kNotKeyword,  // the line does not start with a keyword (binary garbage, a stray number)
 };
 
@@ -68,6 +69,8 @@ inline LineKind ReadKeyword(const char*& p, const char* end) {
       default:
         break;
     }
+  } else if (length == 2 && p[0] == 'v' && p[1] == 't') {
+    kind = LineKind::kTexCoord;
   }
   p = q;
   return kind;

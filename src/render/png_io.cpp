@@ -1,24 +1,24 @@
-// PNG in and out through libpng's stream API (png_set_write_fn / png_set_read_fn over memory),
-// following the libpng manual (libpng-manual.txt, "IV. Writing" and "III. Reading"). libpng
-// reports errors by longjmp: the functions that call setjmp below hold no object with a
-// destructor, and every buffer they fill belongs to their caller.
+// PNG out through libpng's stream API (png_set_write_fn over memory), following the libpng
+// manual (libpng-manual.txt, "IV. Writing"); PNG in through dispex::core's reader
+// (core/png_read.h), converted to 8-bit RGB. libpng reports errors by longjmp: the function
+// that calls setjmp below holds no object with a destructor, and every buffer it fills
+// belongs to its caller.
 #include <fmt/format.h>
 #include <png.h>
 
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include "core/atomic_output.h"
-#include "core/mapped_file.h"
+#include "core/png_read.h"
 #include "dispex/render.h"
 
 namespace dispex {
 
 namespace {
-
-constexpr std::size_t kMaxReadPixels = std::size_t{1} << 28;
 
 struct PngError {
   char message[256] = {0};
@@ -70,66 +70,6 @@ bool EncodeRows(int width, int height, png_bytep* rows, std::vector<std::uint8_t
   return true;
 }
 
-struct ReadSource {
-  const std::uint8_t* data = nullptr;
-  std::size_t size = 0;
-  std::size_t position = 0;
-};
-
-void ReadBytes(png_structp png, png_bytep out, png_size_t size) {
-  auto* source = static_cast<ReadSource*>(png_get_io_ptr(png));
-  if (size > source->size - source->position) png_error(png, "file is truncated");
-  std::memcpy(out, source->data + source->position, size);
-  source->position += size;
-}
-
-// Decodes into `image` (resized here) through `rows` (row pointers, resized here).
-bool DecodeRows(ReadSource* source, Image* image, std::vector<png_bytep>* rows, PngError* error) {
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, error, OnError, OnWarning);
-  if (png == nullptr) {
-    std::snprintf(error->message, sizeof error->message, "cannot create a libpng reader");
-    return false;
-  }
-  png_infop info = png_create_info_struct(png);
-  if (info == nullptr) {
-    png_destroy_read_struct(&png, nullptr, nullptr);
-    std::snprintf(error->message, sizeof error->message, "cannot create a libpng reader");
-    return false;
-  }
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_read_struct(&png, &info, nullptr);
-    return false;
-  }
-  png_set_read_fn(png, source, ReadBytes);
-  png_set_user_limits(png, 1u << 20, 1u << 20);
-  png_read_info(png, info);
-  const png_uint_32 width = png_get_image_width(png, info);
-  const png_uint_32 height = png_get_image_height(png, info);
-  if (std::size_t{width} * height > kMaxReadPixels) {
-    png_error(png, "image is larger than 2^28 pixels");
-  }
-  png_set_expand(png);
-  png_set_strip_16(png);
-  png_set_strip_alpha(png);
-  png_set_gray_to_rgb(png);
-  png_set_interlace_handling(png);
-  png_read_update_info(png, info);
-  if (png_get_rowbytes(png, info) != 3 * std::size_t{width}) {
-    png_error(png, "unexpected row size after conversion to RGB");
-  }
-  image->width = static_cast<int>(width);
-  image->height = static_cast<int>(height);
-  image->rgb.resize(3 * std::size_t{width} * height);
-  rows->resize(height);
-  for (png_uint_32 y = 0; y < height; ++y) {
-    (*rows)[y] = image->rgb.data() + 3 * std::size_t{width} * y;
-  }
-  png_read_image(png, rows->data());
-  png_read_end(png, nullptr);
-  png_destroy_read_struct(&png, &info, nullptr);
-  return true;
-}
-
 }  // namespace
 
 StatusOr<std::vector<std::uint8_t>> EncodePng(const Image& image) {
@@ -168,22 +108,22 @@ Status WritePng(const std::string& path, const Image& image) {
 }
 
 StatusOr<Image> DecodePng(const std::uint8_t* data, std::size_t size, const std::string& name) {
-  if (size < 8 || png_sig_cmp(data, 0, 8) != 0) {
-    return Status::Error(name + ": not a PNG file (bad signature)");
-  }
-  ReadSource source{data, size, 0};
+  DISPEX_ASSIGN_OR_RETURN(PngPixels pixels,
+                          DecodePngPixels(data, size, name, PngConversion::kRgb8));
   Image image;
-  std::vector<png_bytep> rows;
-  PngError error;
-  if (!DecodeRows(&source, &image, &rows, &error)) {
-    return Status::Error(name + ": cannot read PNG: " + error.message);
-  }
+  image.width = pixels.width;
+  image.height = pixels.height;
+  image.rgb = std::move(pixels.data);
   return image;
 }
 
 StatusOr<Image> ReadPng(const std::string& path) {
-  DISPEX_ASSIGN_OR_RETURN(MappedFile file, MappedFile::Open(path));
-  return DecodePng(reinterpret_cast<const std::uint8_t*>(file.data()), file.size(), path);
+  DISPEX_ASSIGN_OR_RETURN(PngPixels pixels, ReadPngPixels(path, PngConversion::kRgb8));
+  Image image;
+  image.width = pixels.width;
+  image.height = pixels.height;
+  image.rgb = std::move(pixels.data);
+  return image;
 }
 
 }  // namespace dispex

@@ -1,5 +1,6 @@
 // Ground-truth sculpts: the cage refined uniformly with OpenSubdiv, every vertex on the limit
-// surface and moved along the limit normal by a known pattern h.
+// surface and moved along the limit normal by a known pattern h (pattern_field.h), which is
+// evaluated at each vertex's (Ptex face, u, v) and limit position.
 #include <fmt/format.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -17,6 +18,7 @@
 #include "dispex/subdiv.h"
 #include "dispex/verify.h"
 #include "verify/obj_writer.h"
+#include "verify/pattern_field.h"
 
 namespace dispex {
 
@@ -30,7 +32,7 @@ struct SculptQuality {
 // See MakeSculptReport::linear_error and folded_faces. `refined.mesh` already holds the
 // displaced positions.
 StatusOr<SculptQuality> MeasureSculpt(const LimitSurface& surface, const RefinedMesh& refined,
-                                   Pattern pattern, const PatternFrame& frame) {
+                                      const PatternField& pattern) {
   const Mesh& mesh = refined.mesh;
   const std::size_t faces = mesh.num_faces();
   std::vector<float> errors(faces, 0.0f);
@@ -51,7 +53,7 @@ StatusOr<SculptQuality> MeasureSculpt(const LimitSurface& surface, const Refined
         failed = true;
         return;
       }
-      double h = EvaluatePattern(pattern, frame, p);
+      double h = pattern(refined.face_ptex[f], uv[0], uv[1], p);
       double truth[3] = {p[0] + h * n[0], p[1] + h * n[1], p[2] + h * n[2]};
       auto at = [&](int k) { return mesh.positions[static_cast<std::size_t>(face[k])]; };
       double worst = 0;
@@ -91,6 +93,9 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   if (options.output_path == options.cage_path) {
     return Status::Error("the output must differ from the cage");
   }
+  if (options.pattern == Pattern::kImage && options.image_path.empty()) {
+    return Status::Error("the image pattern needs a height image (image:FILE.png)");
+  }
   std::optional<tbb::global_control> limit;
   if (options.threads > 0) {
     limit.emplace(tbb::global_control::max_allowed_parallelism,
@@ -98,10 +103,6 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   }
   DISPEX_ASSIGN_OR_RETURN(Mesh cage, ReadMesh(options.cage_path));
   DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(cage));
-  RefineOptions refine_options;
-  refine_options.face_charts = true;
-  DISPEX_ASSIGN_OR_RETURN(RefinedMesh refined,
-                          RefineUniform(surface, options.levels, refine_options));
 
   BoundingBox box = ComputeBounds(cage);
   PatternFrame frame;
@@ -112,6 +113,15 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   frame.edge = MedianEdgeLength(cage) / double(1 << options.levels);
   frame.amplitude = options.amplitude > 0 ? options.amplitude : 0.01 * frame.diagonal;
   frame.seed = options.seed;
+  // Before the refinement, so that a bad image or a cage without UVs fails at once.
+  DISPEX_ASSIGN_OR_RETURN(
+      PatternField pattern,
+      PatternField::Create(options.pattern, options.image_path, frame, cage, surface));
+
+  RefineOptions refine_options;
+  refine_options.face_charts = true;
+  DISPEX_ASSIGN_OR_RETURN(RefinedMesh refined,
+                          RefineUniform(surface, options.levels, refine_options));
 
   Mesh& sculpt = refined.mesh;
   const std::size_t n = sculpt.num_vertices();
@@ -124,19 +134,21 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
                       for (std::size_t v = range.begin(); v < range.end(); ++v) {
                         Float3& p = sculpt.positions[v];
                         const float xyz[3] = {p.x, p.y, p.z};
-                        double h = EvaluatePattern(options.pattern, frame, xyz);
+                        double h = pattern(truth.faces[v], truth.uvs[2 * v],
+                                           truth.uvs[2 * v + 1], xyz);
                         truth.h[v] = static_cast<float>(h);
                         p.x = static_cast<float>(p.x + h * refined.normals[3 * v]);
                         p.y = static_cast<float>(p.y + h * refined.normals[3 * v + 1]);
                         p.z = static_cast<float>(p.z + h * refined.normals[3 * v + 2]);
                       }
                     });
-  DISPEX_ASSIGN_OR_RETURN(SculptQuality quality,
-                          MeasureSculpt(surface, refined, options.pattern, frame));
+  DISPEX_ASSIGN_OR_RETURN(SculptQuality quality, MeasureSculpt(surface, refined, pattern));
+  const std::string pattern_name =
+      options.pattern == Pattern::kImage ? "image:" + options.image_path
+                                         : std::string(PatternName(options.pattern));
   std::string header = fmt::format(
       "# dispex make-sculpt: {} refined {} times, pattern {}, amplitude {}, seed {}\n",
-      options.cage_path, options.levels, PatternName(options.pattern), frame.amplitude,
-      options.seed);
+      options.cage_path, options.levels, pattern_name, frame.amplitude, options.seed);
   DISPEX_RETURN_IF_ERROR(WriteObj(options.output_path, sculpt, header));
   std::string truth_path =
       options.truth_path.empty() ? options.output_path + ".truth" : options.truth_path;

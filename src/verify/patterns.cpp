@@ -1,10 +1,12 @@
-// Displacement patterns with known values, for ground-truth sculpts. Each is a closed-form
-// function of the position, so the exact displacement at any point is known.
+// Displacement patterns with known values, for ground-truth sculpts. Each but the image is a
+// closed-form function of the position, so the exact displacement at any point is known; the
+// image pattern (pattern_field.cpp) is a closed-form function of the point's place on the base.
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "dispex/verify.h"
@@ -68,6 +70,7 @@ std::string_view PatternName(Pattern pattern) {
     case Pattern::kRidges: return "ridges";
     case Pattern::kNoise: return "noise";
     case Pattern::kNone: return "none";
+    case Pattern::kImage: return "image";
   }
   return "smooth";
 }
@@ -77,8 +80,27 @@ StatusOr<Pattern> ParsePattern(std::string_view name) {
                     Pattern::kNone}) {
     if (name == PatternName(p)) return p;
   }
-  return Status::Error(
-      fmt::format("unknown pattern '{}' (expected smooth, detail, ridges, noise or none)", name));
+  if (name == "image") {
+    return Status::Error("pattern 'image' needs a height image: image:FILE.png");
+  }
+  return Status::Error(fmt::format(
+      "unknown pattern '{}' (expected smooth, detail, ridges, noise, none or image:FILE.png)",
+      name));
+}
+
+StatusOr<PatternArgument> ParsePatternArgument(std::string_view text) {
+  constexpr std::string_view kImagePrefix = "image:";
+  PatternArgument argument;
+  if (text.substr(0, kImagePrefix.size()) == kImagePrefix) {
+    argument.pattern = Pattern::kImage;
+    argument.image_path = std::string(text.substr(kImagePrefix.size()));
+    if (argument.image_path.empty()) {
+      return Status::Error("pattern 'image:' names no file (expected image:FILE.png)");
+    }
+    return argument;
+  }
+  DISPEX_ASSIGN_OR_RETURN(argument.pattern, ParsePattern(text));
+  return argument;
 }
 
 double EvaluatePattern(Pattern pattern, const PatternFrame& f, const float point[3]) {
@@ -115,6 +137,7 @@ double EvaluatePattern(Pattern pattern, const PatternFrame& f, const float point
       return A * h;
     }
     case Pattern::kNone: return 0;
+    case Pattern::kImage: return std::numeric_limits<double>::quiet_NaN();
   }
   return 0;
 }

@@ -64,6 +64,10 @@ TEST(InfoCli, TextSummary) {
             std::string::npos)
       << run.out;
   EXPECT_NE(run.out.find("warnings      0\n"), std::string::npos) << run.out;
+  // 267 `vt` lines in the file, named by every face.
+  EXPECT_NE(run.out.find("uvs           267 texture coordinates on every face\n"),
+            std::string::npos)
+      << run.out;
 }
 
 TEST(InfoCli, TagsAndWarningsInText) {

@@ -53,6 +53,17 @@ inline ::testing::AssertionResult SameMesh(const Mesh& a, const Mesh& b) {
   if (a.face_indices != b.face_indices) return ::testing::AssertionFailure() << "face indices";
   if (a.face_groups != b.face_groups) return ::testing::AssertionFailure() << "face groups";
   if (a.group_names != b.group_names) return ::testing::AssertionFailure() << "group names";
+  if (a.uvs.size() != b.uvs.size() ||
+      (!a.uvs.empty() && std::memcmp(a.uvs.data(), b.uvs.data(), a.uvs.size() * 4) != 0)) {
+    return ::testing::AssertionFailure() << "uvs";
+  }
+  if (a.face_uv_indices != b.face_uv_indices) {
+    return ::testing::AssertionFailure() << "face uv indices";
+  }
+  if (a.faces_without_uvs != b.faces_without_uvs) {
+    return ::testing::AssertionFailure()
+           << "faces without uvs " << a.faces_without_uvs << " vs " << b.faces_without_uvs;
+  }
   const SubdivTags& s = a.tags;
   const SubdivTags& t = b.tags;
   if (s.creases.size() != t.creases.size() || s.corners.size() != t.corners.size() ||

@@ -126,6 +126,129 @@ std::string GenerateObj(int seed) {
   return s;
 }
 
+// About 3 MB of OBJ where every face names a texture coordinate at every corner, in every
+// form (v/t, v/t/n, relative, continued), with a vt line right after each v line, so that
+// texture id = vertex id. The vt lines come in every form too (w, continued, CRLF).
+std::string GenerateTexturedObj(int seed) {
+  std::mt19937 rng(static_cast<unsigned>(seed));
+  std::string s;
+  s.reserve(4 << 20);
+  auto eol = [&] { s += (rng() % 7 == 0) ? "\r\n" : "\n"; };
+  const int n = 150;
+  std::int64_t vertices = 0;
+  for (int block = 0; block < 4; ++block) {
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        s += fmt::format("v {} {} {}", i * 0.01 + block, j * 0.013, (rng() % 1000) * 1e-4);
+        eol();
+        const double u = (i + 0.5) / n, v = (j + 0.25) / n;
+        switch (rng() % 8) {
+          case 0:
+            s += fmt::format("vt {} \\", u);
+            eol();
+            s += fmt::format("   {}", v);
+            break;
+          case 1:
+            s += fmt::format("vt\t{:.9e}\t{:.3f} 0", u, v);
+            break;
+          default:
+            s += fmt::format("vt {} {}", u, v);
+            break;
+        }
+        eol();
+        ++vertices;
+      }
+    }
+    if (rng() % 2 == 0) {
+      s += "vn 0 0 1";
+      eol();
+    }
+    const std::int64_t base = vertices - n * n;
+    for (int j = 0; j + 1 < n; ++j) {
+      for (int i = 0; i + 1 < n; ++i) {
+        const std::int64_t a = base + j * n + i, b = a + 1, c = a + n + 1, d = a + n;
+        switch (rng() % 6) {
+          case 0:
+            s += fmt::format("f {0}/{0}/1 {1}/{1}/1 {2}/{2}/1 {3}/{3}/1", a + 1, b + 1, c + 1,
+                             d + 1);
+            break;
+          case 1:
+            s += fmt::format("f {0}/{0} {1}/{1} {2}/{2} {3}/{3}", a - vertices, b - vertices,
+                             c - vertices, d - vertices);
+            break;
+          case 2:
+            s += fmt::format("f {0}/{0} {1}/{1} \\", a + 1, b + 1);
+            eol();
+            s += fmt::format("  {0}/{0} {1}/{1}", c + 1, d + 1);
+            break;
+          case 3:
+            s += fmt::format("f {0}/{0} {1}/{1} {2}/{2} # tri", a + 1, b + 1, c + 1);
+            break;
+          default:
+            s += fmt::format("f {0}/{0} {1}/{1} {2}/{2} {3}/{3}", a + 1, b + 1, c + 1, d + 1);
+            break;
+        }
+        eol();
+      }
+    }
+  }
+  return s;
+}
+
+TEST(ObjParallel, SameUvsForAnyThreadsAndChunks) {
+  const std::string text = GenerateTexturedObj(4);
+  StatusOr<Mesh> reference = ParseObj(text, "uv.obj", ReadOptions{1, kOneChunk});
+  ASSERT_TRUE(reference.ok()) << reference.status().message();
+  ASSERT_TRUE(reference->has_uvs());
+  EXPECT_EQ(reference->num_uvs(), reference->num_vertices());
+  EXPECT_EQ(reference->face_uv_indices, reference->face_indices);  // by construction
+  for (int threads : {1, 2}) {
+    for (std::size_t chunk :
+         {std::size_t{0}, std::size_t{999}, std::size_t{4096}, std::size_t{100003}}) {
+      StatusOr<Mesh> mesh = ParseObj(text, "uv.obj", ReadOptions{threads, chunk});
+      ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+      EXPECT_TRUE(testing::SameMesh(*mesh, *reference)) << threads << " threads, chunk " << chunk;
+    }
+  }
+
+  // One face without texture coordinates late in the file: no UVs, one face counted, for
+  // every chunking (the chunks before it kept theirs).
+  std::string mixed = text;
+  std::size_t pos = mixed.find("\nf ", mixed.size() * 3 / 4);
+  ASSERT_NE(pos, std::string::npos);
+  const std::size_t end = mixed.find('\n', pos + 1);
+  mixed.replace(pos + 1, end - pos - 1, "f 1 2 3");
+  StatusOr<Mesh> mixed_reference = ParseObj(mixed, "uv.obj", ReadOptions{1, kOneChunk});
+  ASSERT_TRUE(mixed_reference.ok()) << mixed_reference.status().message();
+  EXPECT_FALSE(mixed_reference->has_uvs());
+  EXPECT_EQ(mixed_reference->faces_without_uvs, 1u);
+  for (std::size_t chunk : {std::size_t{0}, std::size_t{2048}, std::size_t{65536}}) {
+    StatusOr<Mesh> mesh = ParseObj(mixed, "uv.obj", ReadOptions{2, chunk});
+    ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+    EXPECT_TRUE(testing::SameMesh(*mesh, *mixed_reference)) << "chunk " << chunk;
+  }
+
+  // A texture index past the last vt deep in the file: the same line for every chunking.
+  std::string broken = text;
+  pos = broken.find("\nf ", broken.size() * 2 / 3);
+  ASSERT_NE(pos, std::string::npos);
+  std::size_t line = 2;
+  for (std::size_t i = 0; i < pos; ++i) line += broken[i] == '\n';
+  const std::size_t slash = broken.find('/', pos);
+  // "a/99999999a": past the last vt; a relative "-x/99999999-y" is bad syntax instead. Either
+  // way that line fails.
+  broken.insert(slash + 1, "99999999");
+  const std::string prefix = "uv.obj:" + std::to_string(line) + ": ";
+  for (std::size_t chunk : {kOneChunk, std::size_t{0}, std::size_t{3000}, std::size_t{50000}}) {
+    StatusOr<Mesh> mesh = ParseObj(broken, "uv.obj", ReadOptions{2, chunk});
+    ASSERT_FALSE(mesh.ok());
+    EXPECT_EQ(mesh.status().message().rfind(prefix, 0), 0u) << mesh.status().message();
+    StatusOr<Mesh> one = ParseObj(broken, "uv.obj", ReadOptions{1, kOneChunk});
+    ASSERT_FALSE(one.ok());
+    EXPECT_EQ(mesh.status().message(), one.status().message());
+  }
+}
+
 TEST(ObjParallel, SameMeshForAnyThreadsAndChunks) {
   const std::string text = GenerateObj(1);
   ASSERT_GT(text.size(), std::size_t{3} << 20);
@@ -137,6 +260,10 @@ TEST(ObjParallel, SameMeshForAnyThreadsAndChunks) {
   EXPECT_GT(reference->tags.creases.size(), 100u);
   EXPECT_EQ(reference->tags.holes.size(), 6u);
   EXPECT_EQ(reference->tags.boundary, BoundaryInterpolation::kEdgeOnly);  // last value: 2
+  // Some faces name texture coordinates, most do not: no UVs, every other face counted.
+  EXPECT_FALSE(reference->has_uvs());
+  EXPECT_GT(reference->faces_without_uvs, reference->num_faces() / 2);
+  EXPECT_LT(reference->faces_without_uvs, reference->num_faces());
 
   for (int threads : {1, 2, 0}) {
     for (std::size_t chunk : {std::size_t{0}, std::size_t{1000}, std::size_t{4096},

@@ -40,6 +40,85 @@ TEST(ObjReader, AllIndexForms) {
   EXPECT_EQ(Face(mesh, 4), (std::vector<std::int32_t>{0, 1, 2, 3}));
   EXPECT_EQ(Face(mesh, 5), (std::vector<std::int32_t>{0, 1, 2}));
   EXPECT_EQ(mesh.face_offsets, (std::vector<std::uint32_t>{0, 3, 6, 9, 12, 16, 19}));
+  // Faces 1 and 3 name a texture coordinate at every corner, the others do not (face 5 only
+  // at two corners): the mesh keeps no UVs and says how many faces lacked them.
+  EXPECT_FALSE(mesh.has_uvs());
+  EXPECT_TRUE(mesh.uvs.empty());
+  EXPECT_EQ(mesh.faces_without_uvs, 4u);
+}
+
+TEST(ObjReader, TextureCoordinatesInEveryFaceForm) {
+  const Mesh mesh = ObjOrDie(std::string(kFourVertices) +
+                             "vt 0.25 0.5\n"
+                             "vt 1 0 0.5\n"         // w ignored
+                             "vt 0.75\n"            // v defaults to 0
+                             "vt -1.5 2.5e1 0 7\n"  // further numbers ignored
+                             "vn 0 0 1\n"
+                             "f 1/1 2/2 3/3\n"
+                             "f 1/4/1 3/3/1 4/2/1\n"
+                             "f -4/-4 -3/-3/-1 -2/-2 -1/-1\n"
+                             "vt 0.5 0.5\n"
+                             "f 1/-1 2/5 3/-5\n");  // relative to the 5 vt lines before it
+  ASSERT_EQ(mesh.num_faces(), 4u);
+  ASSERT_TRUE(mesh.has_uvs());
+  EXPECT_EQ(mesh.faces_without_uvs, 0u);
+  EXPECT_EQ(mesh.uvs, (std::vector<float>{0.25f, 0.5f, 1, 0, 0.75f, 0, -1.5f, 25, 0.5f, 0.5f}));
+  EXPECT_EQ(mesh.num_uvs(), 5u);
+  EXPECT_EQ(mesh.face_uv_indices,
+            (std::vector<std::int32_t>{0, 1, 2, 3, 2, 1, 0, 1, 2, 3, 4, 4, 0}));
+  ASSERT_EQ(mesh.face_uv_indices.size(), mesh.face_indices.size());
+}
+
+// Texture indices, like vertex indices, may point forward to vt lines later in the file.
+TEST(ObjReader, TextureIndicesMayPointForward) {
+  const Mesh mesh =
+      ObjOrDie(std::string(kFourVertices) + "f 1/3 2/2 3/1\nvt 0 0\nvt 1 0\nvt 1 1\n");
+  ASSERT_TRUE(mesh.has_uvs());
+  EXPECT_EQ(mesh.face_uv_indices, (std::vector<std::int32_t>{2, 1, 0}));
+}
+
+TEST(ObjReader, UvsDroppedWhenSomeFacesHaveNone) {
+  // A face without vt among faces with: the mesh is kept, the UVs are not.
+  const Mesh some = ObjOrDie(std::string(kFourVertices) +
+                             "vt 0 0\nvt 1 0\nvt 1 1\nf 1/1 2/2 3/3\nf 1 3 4\nf 1/1 3/3 4/2\n");
+  EXPECT_EQ(some.num_faces(), 3u);
+  EXPECT_FALSE(some.has_uvs());
+  EXPECT_TRUE(some.uvs.empty());
+  EXPECT_EQ(some.faces_without_uvs, 1u);
+  // A face that names texture coordinates at some corners only counts as without.
+  const Mesh corner =
+      ObjOrDie(std::string(kFourVertices) + "vt 0 0\nvt 1 0\nvt 1 1\nf 1/1 2/2 3/3\nf 1/1 3 4/2\n");
+  EXPECT_FALSE(corner.has_uvs());
+  EXPECT_EQ(corner.faces_without_uvs, 1u);
+  // vt lines that no face uses: no UVs, and nothing was dropped.
+  const Mesh unused = ObjOrDie(std::string(kFourVertices) + "vt 0 0\nvt 1 0\nf 1 2 3\n");
+  EXPECT_FALSE(unused.has_uvs());
+  EXPECT_TRUE(unused.uvs.empty());
+  EXPECT_EQ(unused.faces_without_uvs, 0u);
+}
+
+TEST(ObjReader, TextureIndexErrorsNameTheLine) {
+  const std::string vertices = std::string(kFourVertices) + "vt 0 0\nvt 1 1\n";  // 6 lines
+  EXPECT_EQ(ObjError(vertices + "f 1/1 2/3 3/1\n"),
+            "test.obj:7: face texture index 3 out of range (2 texture coordinates)");
+  EXPECT_EQ(ObjError(vertices + "f 1/1 2/0 3/1\n"),
+            "test.obj:7: face texture index 0 (OBJ indices start at 1)");
+  EXPECT_EQ(ObjError(vertices + "f 1/1 2/-3/1 3/1\n"),
+            "test.obj:7: relative face texture index -3 out of range (2 texture coordinates "
+            "before it)");
+  // The vertex index of a corner is checked before its texture index.
+  EXPECT_EQ(ObjError(vertices + "f 1/1 9/9 3/1\n"),
+            "test.obj:7: face index 9 out of range (4 vertices)");
+  EXPECT_EQ(ObjError(vertices + "f 1/1 2/ 3/1\n"), "test.obj:7: bad face vertex '2/'");
+  EXPECT_EQ(ObjError(vertices + "vt\nf 1/1 2/1 3/1\n"),
+            "test.obj:7: texture has 0 coordinates (1 needed)");
+  EXPECT_EQ(ObjError(vertices + "vt 1 inf\nf 1/1 2/1 3/1\n"),
+            "test.obj:7: texture coordinate 'inf' is not a finite number");
+  EXPECT_EQ(ObjError(vertices + "vt 1 0.5.5\nf 1/1 2/1 3/1\n"),
+            "test.obj:7: bad texture coordinate '0.5.5'");
+  // Normal indices are only checked for syntax.
+  const Mesh dangling_normal = ObjOrDie(vertices + "f 1/1/7 2/2/8 3/1/9\n");
+  EXPECT_TRUE(dangling_normal.has_uvs());
 }
 
 // A relative index counts back from the vertices defined so far, not from the file's end.

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include "dispex/extract.h"
 #include "dispex/mesh.h"
@@ -35,6 +36,7 @@ struct TruthCase {
   // itself and has creases of curvature radius below 1e-3 of its diagonal, so even a small
   // displacement folds a few sculpt faces and a few rays find no surface (filled as holes).
   bool self_intersecting = false;
+  const char* image = nullptr;  // Pattern::kImage: the height image, under tests/data
 };
 
 std::string CaseName(const ::testing::TestParamInfo<TruthCase>& info) {
@@ -56,6 +58,7 @@ TEST_P(GroundTruth, ExtractionIsWithinToleranceAndTheSculptsLinearError) {
   make.output_path = dir / "sculpt.obj";
   make.levels = c.levels;
   make.pattern = c.pattern;
+  if (c.image != nullptr) make.image_path = DataPath(c.image);
   make.amplitude = c.amplitude * ComputeBounds(*base).diagonal();
   auto made = MakeSculpt(make);
   ASSERT_TRUE(made.ok()) << made.status().message();
@@ -113,8 +116,45 @@ INSTANTIATE_TEST_SUITE_P(
                   Pattern::kRidges, 4},
         TruthCase{"tent", "meshes/opensubdiv/catmark_tent.obj", Pattern::kSmooth, 4},
         TruthCase{"tent", "meshes/opensubdiv/catmark_tent.obj", Pattern::kDetail, 4},
-        TruthCase{"tent", "meshes/opensubdiv/catmark_tent.obj", Pattern::kRidges, 4}),
+        TruthCase{"tent", "meshes/opensubdiv/catmark_tent.obj", Pattern::kRidges, 4},
+        // Quads, pentagons and triangles with continuous UVs and a seamless 16-bit image.
+        TruthCase{"wavy_plane", "image_pattern/wavy_plane.obj", Pattern::kImage, 4, 0.005,
+                  false, "image_pattern/heights.png"}),
     CaseName);
+
+// The command line: --pattern image:FILE.png, and its errors.
+TEST(ImagePatternCli, MakesASculptAndFailsOnBadImages) {
+  TempDir dir;
+  const std::string cage = DataPath("image_pattern/wavy_plane.obj");
+  const std::string image = DataPath("image_pattern/heights.png");
+  auto made = RunDispex("make-sculpt " + cage + " --levels 2 --pattern image:" + image +
+                            " --amplitude 0.05 -o " + (dir / "s.obj"),
+                        dir);
+  EXPECT_EQ(made.exit_code, 0) << made.err;
+  EXPECT_NE(made.err.find("pattern image:" + image), std::string::npos) << made.err;
+  EXPECT_NE(testing::Slurp(dir / "s.obj").find("pattern image:" + image), std::string::npos);
+  auto truth = ReadGroundTruth(dir / "s.obj.truth");
+  ASSERT_TRUE(truth.ok()) << truth.status().message();
+  for (float h : truth->h) {
+    ASSERT_LE(std::abs(h), 0.05f);
+  }
+
+  auto missing = RunDispex("make-sculpt " + cage + " --pattern image:" + (dir / "none.png") +
+                               " -o " + (dir / "t.obj"),
+                           dir);
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_EQ(missing.err, "dispex: " + (dir / "none.png") + ": no such file\n");
+  auto no_uvs = RunDispex("make-sculpt " + DataPath("meshes/opensubdiv/catmark_pole8.obj") +
+                              " --pattern image:" + image + " -o " + (dir / "t.obj"),
+                          dir);
+  EXPECT_NE(no_uvs.exit_code, 0);
+  EXPECT_NE(no_uvs.err.find("catmark_pole8.obj: the cage has no texture coordinates"),
+            std::string::npos)
+      << no_uvs.err;
+  auto bare = RunDispex("make-sculpt " + cage + " --pattern image: -o " + (dir / "t.obj"), dir);
+  EXPECT_EQ(bare.exit_code, 2) << bare.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "t.obj"));
+}
 
 // Maps that are wrong on purpose fail verify's thresholds.
 class WrongMaps : public ::testing::Test {

@@ -1,0 +1,41 @@
+// h over the base's limit surface for one MakeSculpt run, in one place for every pattern: the
+// closed-form patterns of the position (EvaluatePattern) and the image pattern of the point's
+// place on the base (Ptex face, u, v) through the cage's UVs (uv_charts.h, height_image.h).
+// make_sculpt.cpp evaluates it at the sculpt's vertices and at its faces' centres.
+#pragma once
+
+#include <optional>
+
+#include "dispex/mesh.h"
+#include "dispex/subdiv.h"
+#include "dispex/verify.h"
+#include "verify/height_image.h"
+#include "verify/uv_charts.h"
+
+namespace dispex {
+
+class PatternField {
+ public:
+  // For Pattern::kImage, reads the image and the cage's UVs (errors name the file); the
+  // cage must be the surface's.
+  static StatusOr<PatternField> Create(Pattern pattern, const std::string& image_path,
+                                       const PatternFrame& frame, const Mesh& cage,
+                                       const LimitSurface& surface);
+
+  // h at the limit point `position` of Ptex face `face` at (u, v). Safe from any number of
+  // threads; no allocation.
+  double operator()(PtexFaceId face, float u, float v, const float position[3]) const {
+    if (pattern_ != Pattern::kImage) return EvaluatePattern(pattern_, frame_, position);
+    double uv[2];
+    charts_->Evaluate(face, u, v, uv);
+    return frame_.amplitude * (2 * image_->Sample(uv[0], uv[1]) - 1);
+  }
+
+ private:
+  Pattern pattern_ = Pattern::kNone;
+  PatternFrame frame_;
+  std::optional<PtexUvCharts> charts_;
+  std::optional<HeightImage> image_;
+};
+
+}  // namespace dispex
