@@ -10,19 +10,12 @@
 
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
+#include "contract_meshes.h"
 
 namespace dispex {
 namespace {
 
-Mesh Triangle(const std::string& name) {
-  Mesh mesh;
-  mesh.source = name;
-  mesh.positions.reserve(4);
-  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-  mesh.face_offsets = {0, 3};
-  mesh.face_indices = {0, 1, 2};
-  return mesh;
-}
+using fuzz_test::Triangle;
 
 TEST(ReaderContract, AcceptsAWellFormedMesh) {
   EXPECT_EQ(fuzz::CheckMesh(Triangle("t.obj"), "t.obj"), "");

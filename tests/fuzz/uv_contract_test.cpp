@@ -9,23 +9,13 @@
 #include <utility>
 
 #include "dispex/mesh.h"
+#include "contract_meshes.h"
 #include "fuzz/reader_contract.h"
-#include "mesh_test_util.h"
 
 namespace dispex {
 namespace {
 
-Mesh TexturedTriangle(const std::string& name) {
-  Mesh mesh;
-  mesh.source = name;
-  mesh.positions.reserve(4);
-  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-  mesh.face_offsets = {0, 3};
-  mesh.face_indices = {0, 1, 2};
-  mesh.uvs = {0, 0, 1, 0, 0, 1};
-  mesh.face_uv_indices = {0, 1, 2};
-  return mesh;
-}
+using fuzz_test::TexturedTriangle;
 
 std::string Check(const Mesh& mesh) { return fuzz::CheckMesh(mesh, mesh.source); }
 
@@ -101,7 +91,7 @@ TEST(UvContract, ReaderKeepsItOnFilesWithUvs) {
   for (const char* file :
        {"meshes/keenan_spot/spot_control_mesh.obj", "meshes/opensubdiv/catmark_nonquads.obj",
         "image_pattern/wavy_plane.obj"}) {
-    const std::string path = testing::DataPath(file);
+    const std::string path = std::string(DISPEX_TEST_DATA_DIR) + "/" + file;
     StatusOr<Mesh> mesh = ReadObj(path);
     ASSERT_TRUE(mesh.ok()) << mesh.status().message();
     EXPECT_TRUE(mesh->has_uvs()) << file;
