@@ -20,7 +20,8 @@ namespace dispex {
 // put on.
 enum class Pattern : std::uint8_t {
   kSmooth,  // three long sines (wavelengths 0.6, 0.35, 0.25 D)
-  kDetail,  // smooth + bumps of wavelength 8e confined to two balls of radius 0.22 D
+  kDetail,  // smooth + bumps of wavelength 8e confined to two balls of radius 0.22 D + a few
+            // sharp ridges (tents 0.02 D wide on planes 0.25 D apart)
   kRidges,  // smooth + a triangle wave of period 0.12 D: sharp creases (C0) along planes
   kNoise,   // 24 sines of random directions and wavelengths in [6e, 24e] (seeded)
   kNone,    // h = 0: the refined limit surface itself (e.g. a denser base cage)

@@ -121,7 +121,13 @@ double EvaluatePattern(Pattern pattern, const PatternFrame& f, const float point
       }
       double k = kTwoPi / (8 * f.edge);
       double bumps = std::sin(k * p[0]) * std::sin(k * p[1]) * std::sin(k * p[2]);
-      return A * (Smooth(p, D) + 0.5 * std::min(weight, 1.0) * bumps);
+      // A few sharp ridges: tents of half-width 0.01 D on parallel planes 0.25 D apart, with
+      // kinks (C0) at the crest and at both feet.
+      static const double normal[3] = {0.36, 0.48, 0.8};
+      double s = Dot(normal, p) / (0.25 * D);
+      double from_plane = std::abs(s - std::round(s)) * 0.25 * D;
+      double ridge = std::max(0.0, 1 - from_plane / (0.01 * D));
+      return A * (Smooth(p, D) + 0.5 * std::min(weight, 1.0) * bumps + 0.3 * ridge);
     }
     case Pattern::kRidges: {
       static const double d[3] = {0.36, 0.48, 0.8};
