@@ -40,8 +40,21 @@ int PtexFile::Impl::NumStoredLevels(int face) const {
   return n;
 }
 
-// Decodes one untiled block (constant, zipped or diff-zipped) of ures x vres texels into
-// `dst` (rows `stride` bytes apart). `split` is scratch.
+// "" when a block (or tile) of ures x vres texels with header `fdh` can hold them: a zipped
+// block's compressed size bounds what it can inflate to. Checked for every block and tile
+// before anything is allocated for the texels.
+static std::string CheckInflatable(std::uint32_t fdh, int ures, int vres,
+                                   const PtexHeaderInfo& header) {
+  if (EncodingOf(fdh) == kEncConstant) return {};
+  const std::uint32_t size = BlockSizeOf(fdh);
+  const std::uint64_t bytes = std::uint64_t(ures) * vres * header.pixel_size();
+  if (bytes <= MaxInflatedSize(size)) return {};
+  return std::to_string(size) + " compressed bytes cannot hold " + std::to_string(bytes) +
+         " bytes of texels";
+}
+
+// Decodes one untiled block (constant, zipped or diff-zipped) of ures x vres texels, which
+// CheckInflatable accepted, into `dst` (rows `stride` bytes apart). `split` is scratch.
 static std::string DecodeSimple(const std::uint8_t* block, std::uint32_t fdh, int ures, int vres,
                                 const PtexHeaderInfo& header, std::uint8_t* dst, std::size_t stride,
                                 std::vector<std::uint8_t>& split) {
@@ -55,10 +68,6 @@ static std::string DecodeSimple(const std::uint8_t* block, std::uint32_t fdh, in
     return {};
   }
   const std::uint64_t bytes = std::uint64_t(ures) * vres * pixel;
-  if (bytes > MaxInflatedSize(size)) {
-    return std::to_string(size) + " compressed bytes cannot hold " + std::to_string(bytes) +
-           " bytes of texels";
-  }
   split.resize(bytes);
   std::string why = Inflate({block, size}, split);
   if (!why.empty()) return why;
@@ -73,6 +82,19 @@ Status PtexFile::Impl::DecodeBlock(const Block& block, const std::string& where,
   const int pixel = header.pixel_size();
   const int ures = 1 << block.ulog2, vres = 1 << block.vlog2;
   const std::size_t stride = std::size_t(ures) * pixel;
+  if (block.tiles < 0) {
+    if (std::string why = CheckInflatable(block.fdh, ures, vres, header); !why.empty()) {
+      return Status::Error(name + ": " + where + ": " + why);
+    }
+  } else {
+    const TileTable& table = tile_tables[std::size_t(block.tiles)];
+    for (std::size_t t = 0; t < table.headers.size(); ++t) {
+      std::string why = CheckInflatable(table.headers[t], 1 << table.ulog2, 1 << table.vlog2, header);
+      if (!why.empty()) {
+        return Status::Error(name + ": " + where + " tile " + std::to_string(t) + ": " + why);
+      }
+    }
+  }
   out.resize(stride * vres);
   std::vector<std::uint8_t> split;
   if (block.tiles < 0) {
@@ -225,8 +247,10 @@ float PtexFile::Sample(PtexFaceId face, float u, float v, int channel) const {
   std::atomic<std::vector<float>*>& slot = impl_->sample_cache[std::size_t(face.value)];
   std::vector<float>* texels = slot.load(std::memory_order_acquire);
   if (texels == nullptr) {
+    // A face that cannot be decoded is cached as an empty vector, so that a caller sampling it
+    // many times does not decode it again each time.
     auto decoded = std::make_unique<std::vector<float>>();
-    if (!ReadFace(face, 0, *decoded).ok()) return std::numeric_limits<float>::quiet_NaN();
+    if (!ReadFace(face, 0, *decoded).ok()) decoded->clear();
     std::vector<float>* expected = nullptr;
     if (slot.compare_exchange_strong(expected, decoded.get(), std::memory_order_acq_rel)) {
       texels = decoded.release();
@@ -235,6 +259,7 @@ float PtexFile::Sample(PtexFaceId face, float u, float v, int channel) const {
     }
   }
   const std::vector<float>& t = *texels;
+  if (t.empty()) return std::numeric_limits<float>::quiet_NaN();
   const int ures = info.ures(), vres = info.vres();
   u = std::clamp(std::isnan(u) ? 0.0f : u, 0.0f, 1.0f);
   v = std::clamp(std::isnan(v) ? 0.0f : v, 0.0f, 1.0f);

@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -179,6 +181,30 @@ TEST(FuzzRegression, FixedInputsGiveTheirError) {
     EXPECT_NE(status.message().find(fixed.fragment), std::string::npos)
         << fixed.file << ": " << status.message();
   }
+}
+
+// ptex_fuzzer-db76f2e888f691f3: faces whose zipped block is far too small for their
+// resolution. Each read used to allocate and zero the whole face (4 MiB) before finding that
+// out, and Sample decoded the face again at every call.
+TEST(FuzzRegression, UndecodableFacesCostNoAllocationAndOneDecode) {
+  const std::string name = "ptex_fuzzer-db76f2e888f691f3";
+  const std::string bytes = ReadBytes(kRegressions / name);
+  StatusOr<PtexFile> file = ParsePtex(bytes, name);
+  ASSERT_TRUE(file.ok()) << file.status().message();
+  int undecodable = 0;
+  for (int f = 0; f < file->num_faces(); ++f) {
+    const PtexFaceId id(f);
+    if (file->face_info(id).constant) continue;
+    std::vector<std::uint8_t> raw;
+    const Status read = file->ReadFaceRaw(id, 0, raw);
+    if (read.ok()) continue;
+    ++undecodable;
+    EXPECT_NE(read.message().find("compressed bytes cannot hold"), std::string::npos)
+        << read.message();
+    EXPECT_EQ(raw.capacity(), 0u) << "face " << f << ": allocated before the size check";
+    for (int k = 0; k < 3; ++k) EXPECT_TRUE(std::isnan(file->Sample(id, 0.5f, 0.5f, 0)));
+  }
+  EXPECT_GT(undecodable, 0);
 }
 
 TEST(FuzzRegression, EverySavedInputIsExplained) {
