@@ -152,10 +152,6 @@ StatusOr<CoarseSampling> SampleCoarsely(const LimitSurface& surface) {
   return out;
 }
 
-}  // namespace
-
-namespace {
-
 StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int threads) {
   Stopwatch total_clock;
   ExtractReport report;
