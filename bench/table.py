@@ -37,14 +37,15 @@ def load(path):
 
 
 def median_run(out, name, repeat):
-    """The report with the median total time of the repeated extractions, and all totals."""
+    """The report with the median total time of the repeated extractions, and all reports."""
     runs = [load(os.path.join(out, f"{name}-report-{i}.json")) for i in range(1, repeat + 1)]
     runs.sort(key=lambda r: r["phases_seconds"]["total"])
-    return runs[(len(runs) - 1) // 2], [r["phases_seconds"]["total"] for r in runs]
+    return runs[(len(runs) - 1) // 2], runs
 
 
 def row(out, name, repeat):
-    r, totals = median_run(out, name, repeat)
+    r, runs = median_run(out, name, repeat)
+    totals = [x["phases_seconds"]["total"] for x in runs]
     truth = load(os.path.join(out, name + "-verify-truth.json"))["truth"]
     sculpt_path = os.path.join(out, name + "-verify-sculpt.json")
     sculpt = load(sculpt_path) if os.path.exists(sculpt_path) else None
@@ -57,6 +58,7 @@ def row(out, name, repeat):
         "sample_trace": p["sample_trace"], "write": p["write"],
         "auto_settings": p["auto_settings"], "total": p["total"],
         "totals_of_all_runs": totals,
+        "sample_trace_of_all_runs": sorted(x["phases_seconds"]["sample_trace"] for x in runs),
         "cpu_limit": r["cpu_seconds"]["limit"], "cpu_trace": r["cpu_seconds"]["trace"],
         "cpu_spectral": r["cpu_seconds"]["spectral"],
         "cpu_compress": r["cpu_seconds"]["compress"],
@@ -124,10 +126,16 @@ def targets(rows, components):
                           x["total"] <= limit))
     body = next((x for x in rows if x["asset"] == "body"), None)
     if body and components and "rays_packet8" in components:
+        # The median sample+trace time over the repeated runs (the phase varies by +-10% from
+        # run to run on this virtual machine), against the same rays cast alone.
         raw = components["rays_packet8"]["seconds"] * body["rays"] / components["rays_packet8"]["rays"]
-        ratio = body["sample_trace"] / raw
+        times = body["sample_trace_of_all_runs"]
+        median = statistics.median(times)
+        ratio = median / raw
+        spread = (f' (runs {", ".join(f"{t:.2f}" for t in times)} s: '
+                  f'{times[0] / raw:.2f}-{times[-1] / raw:.2f}x)' if len(times) > 1 else "")
         found.append((f"body sample+trace <= {TRACE_OVER_RAW_TARGET}x raw Embree time for its rays",
-                      f'{body["sample_trace"]:.2f} s / {raw:.2f} s = {ratio:.2f}x',
+                      f'median {median:.2f} s / {raw:.2f} s = {ratio:.2f}x{spread}',
                       ratio <= TRACE_OVER_RAW_TARGET))
     if body:
         found.append(("body peak RSS <= 4 GB", f'{body["peak_rss_bytes"]/1e9:.2f} GB',
@@ -138,7 +146,7 @@ def targets(rows, components):
                       x["written_fraction"] <= WRITTEN_FRACTION_TARGET))
         if x["map_to_sculpt_max"] is not None:
             found.append((f'{x["asset"]} verify: map->sculpt max <= tolerance',
-                          f'{x["map_to_sculpt_max"]:.3g} vs {x["tolerance"]:.3g}',
+                          f'{x["map_to_sculpt_max"]:.4g} vs {x["tolerance"]:.4g}',
                           x["map_to_sculpt_max"] <= x["tolerance"]))
     return found
 
