@@ -36,7 +36,7 @@ std::string DefaultCacheDir() {
     return std::string(xdg) + "/dispex";
   if (const char* home = std::getenv("HOME"); home && *home)
     return std::string(home) + "/.cache/dispex";
-  return "/tmp/dispex-cache";
+  return (std::filesystem::temp_directory_path() / "dispex-cache").string();
 }
 
 // A wavy height field, written the way sculpting tools write OBJ (6 decimals).

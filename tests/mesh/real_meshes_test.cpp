@@ -1,6 +1,6 @@
 // Every mesh in tests/data/meshes: counts, faces by size, tags, groups, bounding box, median
 // edge length and validation counts, against values computed independently of dispex:
-// V/F/face sizes/tags/topology from the data README (/work/shared/data/meshes/README.md),
+// V/F/face sizes/tags/topology from the data set's README (see tests/data/README.md),
 // bounding boxes and median edge lengths from a Python script over the file text (float()
 // on each coordinate; all face sides, median of the middle two for an even count),
 // validation counts from a Python edge count over the file text.
