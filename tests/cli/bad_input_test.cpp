@@ -13,6 +13,7 @@ namespace dispex {
 namespace {
 
 using testing::DataPath;
+using testing::SculptOptions;
 using testing::RunDispex;
 using testing::TempDir;
 namespace fs = std::filesystem;
@@ -21,11 +22,7 @@ class BadInput : public ::testing::Test {
  protected:
   void SetUp() override {
     cage_ = DataPath("meshes/keenan_blub/blub_control_mesh.obj");
-    MakeSculptOptions make;
-    make.cage_path = cage_;
-    make.output_path = dir_ / "sculpt.obj";
-    make.levels = 2;
-    make.amplitude = 0.004;
+    MakeSculptOptions make = SculptOptions(cage_, dir_ / "sculpt.obj", 2, Pattern::kDetail, 0.004);
     ASSERT_TRUE(MakeSculpt(make).ok());
     sculpt_ = make.output_path;
     fs::remove(make.output_path + ".truth");

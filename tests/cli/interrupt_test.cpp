@@ -20,17 +20,14 @@ namespace dispex {
 namespace {
 
 using testing::DataPath;
+using testing::SculptOptions;
 using testing::TempDir;
 namespace fs = std::filesystem;
 
 TEST(Interrupt, SignalsStopExtractionCleanly) {
   TempDir dir;
   const std::string cage = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
-  MakeSculptOptions make;
-  make.cage_path = cage;
-  make.output_path = dir / "sculpt.obj";
-  make.levels = 4;
-  make.amplitude = 0.005;
+  MakeSculptOptions make = SculptOptions(cage, dir / "sculpt.obj", 4, Pattern::kDetail, 0.005);
   ASSERT_TRUE(MakeSculpt(make).ok());
   const std::string target = dir / "map.ptx";
   const std::string old_content = "an older map that must survive";

@@ -13,12 +13,26 @@
 #include <sstream>
 #include <string>
 
+#include "dispex/verify.h"
+
 namespace dispex::testing {
 
 namespace fs = std::filesystem;
 
 inline std::string DataPath(const std::string& relative) {
   return std::string(DISPEX_TEST_DATA_DIR) + "/" + relative;
+}
+
+// A ground-truth sculpt of `cage`: refined `levels` times, displaced by `pattern`.
+inline MakeSculptOptions SculptOptions(const std::string& cage, const std::string& output,
+                                       int levels, Pattern pattern, double amplitude) {
+  MakeSculptOptions options;
+  options.cage_path = cage;
+  options.output_path = output;
+  options.levels = levels;
+  options.pattern = pattern;
+  options.amplitude = amplitude;
+  return options;
 }
 
 // A fresh folder per test, removed afterwards.

@@ -16,6 +16,7 @@ namespace dispex {
 namespace {
 
 using testing::DataPath;
+using testing::SculptOptions;
 using testing::RunDispex;
 using testing::TempDir;
 
@@ -33,12 +34,8 @@ TEST_P(ExtractRealCages, MapMatchesTheKnownDisplacementAndTheReportAddsUp) {
   ASSERT_TRUE(base.ok()) << base.status().message();
   const double diagonal = ComputeBounds(*base).diagonal();
 
-  MakeSculptOptions make;
-  make.cage_path = cage;
-  make.output_path = dir / "sculpt.obj";
-  make.levels = 3;
-  make.pattern = Pattern::kSmooth;
-  make.amplitude = 0.002 * diagonal;
+  MakeSculptOptions make =
+      SculptOptions(cage, dir / "sculpt.obj", 3, Pattern::kSmooth, 0.002 * diagonal);
   auto made = MakeSculpt(make);
   ASSERT_TRUE(made.ok()) << made.status().message();
   ASSERT_EQ(made->folded_faces, 0u);
@@ -118,12 +115,7 @@ class ExtractTest : public ::testing::Test {
  protected:
   void SetUp() override {
     cage_ = DataPath("meshes/keenan_blub/blub_control_mesh.obj");
-    MakeSculptOptions make;
-    make.cage_path = cage_;
-    make.output_path = dir_ / "sculpt.obj";
-    make.levels = 3;
-    make.pattern = Pattern::kDetail;
-    make.amplitude = 0.005;
+    MakeSculptOptions make = SculptOptions(cage_, dir_ / "sculpt.obj", 3, Pattern::kDetail, 0.005);
     auto made = MakeSculpt(make);
     ASSERT_TRUE(made.ok()) << made.status().message();
     sculpt_ = make.output_path;

@@ -21,6 +21,7 @@ namespace {
 using render_test::DataPath;
 using render_test::RunDispex;
 using render_test::TempDir;
+using testing::SculptOptions;
 namespace fs = std::filesystem;
 
 // The demo asset, made once for the whole suite.
@@ -37,12 +38,7 @@ class SpotRender : public ::testing::Test {
   }
   static void Make(int levels, Pattern pattern, double amplitude, const std::string& sculpt,
                    const std::string& map) {
-    MakeSculptOptions make;
-    make.cage_path = base_path_;
-    make.output_path = Path(sculpt);
-    make.levels = levels;
-    make.pattern = pattern;
-    make.amplitude = amplitude;
+    MakeSculptOptions make = SculptOptions(base_path_, Path(sculpt), levels, pattern, amplitude);
     auto made = MakeSculpt(make);
     ASSERT_TRUE(made.ok()) << made.status().message();
     ExtractOptions extract;

@@ -161,18 +161,9 @@ struct Point3 {
   }
 };
 
-}  // namespace
-
-struct PatchOracle::State {
-  std::unique_ptr<Far::TopologyRefiner> refiner;
-  std::unique_ptr<Far::PatchTable> table;
-  std::unique_ptr<Far::PatchMap> map;
-  std::unique_ptr<Far::PtexIndices> ptex;
-  std::vector<Point3> points;  // base, refined, then local points
-  std::vector<bool> extraordinary;
-};
-
-PatchOracle::PatchOracle(const Mesh& cage, int isolation) : state_(std::make_unique<State>()) {
+// The cage as an OpenSubdiv refiner (Catmull-Clark, its tags and boundary rule), built here
+// with the library's own descriptor so that the oracles do not share dispex's topology code.
+std::unique_ptr<Far::TopologyRefiner> CreateRefiner(const Mesh& cage) {
   Sdc::Options sdc;
   switch (cage.tags.boundary) {
     case BoundaryInterpolation::kNone:
@@ -215,8 +206,24 @@ PatchOracle::PatchOracle(const Mesh& cage, int isolation) : state_(std::make_uni
   desc.holeIndices = holes.data();
 
   using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
+  return std::unique_ptr<Far::TopologyRefiner>(
+      Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, sdc)));
+}
+
+}  // namespace
+
+struct PatchOracle::State {
+  std::unique_ptr<Far::TopologyRefiner> refiner;
+  std::unique_ptr<Far::PatchTable> table;
+  std::unique_ptr<Far::PatchMap> map;
+  std::unique_ptr<Far::PtexIndices> ptex;
+  std::vector<Point3> points;  // base, refined, then local points
+  std::vector<bool> extraordinary;
+};
+
+PatchOracle::PatchOracle(const Mesh& cage, int isolation) : state_(std::make_unique<State>()) {
   State& st = *state_;
-  st.refiner.reset(Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, sdc)));
+  st.refiner = CreateRefiner(cage);
   if (!st.refiner) return;
   st.ptex = std::make_unique<Far::PtexIndices>(*st.refiner);
   const Far::TopologyLevel& base = st.refiner->GetLevel(0);
@@ -266,41 +273,7 @@ PatchOracle::~PatchOracle() = default;
 
 FarLimit FarUniformLimit(const Mesh& cage, int levels) {
   FarLimit out;
-  std::vector<int> sizes, crease_pairs, corner_verts, holes;
-  std::vector<float> crease_weights, corner_weights;
-  for (std::size_t f = 0; f < cage.num_faces(); ++f) sizes.push_back(cage.face_size(f));
-  for (const auto& c : cage.tags.creases) {
-    crease_pairs.push_back(c.v0.value);
-    crease_pairs.push_back(c.v1.value);
-    crease_weights.push_back(c.sharpness);
-  }
-  for (const auto& c : cage.tags.corners) {
-    corner_verts.push_back(c.vertex.value);
-    corner_weights.push_back(c.sharpness);
-  }
-  for (BaseFaceId h : cage.tags.holes) holes.push_back(h.value);
-  Far::TopologyDescriptor desc;
-  desc.numVertices = static_cast<int>(cage.num_vertices());
-  desc.numFaces = static_cast<int>(cage.num_faces());
-  desc.numVertsPerFace = sizes.data();
-  desc.vertIndicesPerFace = cage.face_indices.data();
-  desc.numCreases = static_cast<int>(crease_weights.size());
-  desc.creaseVertexIndexPairs = crease_pairs.data();
-  desc.creaseWeights = crease_weights.data();
-  desc.numCorners = static_cast<int>(corner_weights.size());
-  desc.cornerVertexIndices = corner_verts.data();
-  desc.cornerWeights = corner_weights.data();
-  desc.numHoles = static_cast<int>(holes.size());
-  desc.holeIndices = holes.data();
-  Sdc::Options sdc;
-  sdc.SetVtxBoundaryInterpolation(cage.tags.boundary == BoundaryInterpolation::kNone
-                                      ? Sdc::Options::VTX_BOUNDARY_NONE
-                                  : cage.tags.boundary == BoundaryInterpolation::kEdgeOnly
-                                      ? Sdc::Options::VTX_BOUNDARY_EDGE_ONLY
-                                      : Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
-  using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-  std::unique_ptr<Far::TopologyRefiner> refiner(
-      Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, sdc)));
+  std::unique_ptr<Far::TopologyRefiner> refiner = CreateRefiner(cage);
   if (!refiner) return out;
   Far::TopologyRefiner::UniformOptions options(levels);
   options.fullTopologyInLastLevel = true;

@@ -23,6 +23,7 @@ namespace dispex {
 namespace {
 
 using testing::DataPath;
+using testing::SculptOptions;
 using testing::RunDispex;
 using testing::TempDir;
 
@@ -161,12 +162,7 @@ class WrongMaps : public ::testing::Test {
  protected:
   void SetUp() override {
     cage_ = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
-    MakeSculptOptions make;
-    make.cage_path = cage_;
-    make.output_path = dir_ / "sculpt.obj";
-    make.levels = 3;
-    make.pattern = Pattern::kDetail;
-    make.amplitude = 0.004;
+    MakeSculptOptions make = SculptOptions(cage_, dir_ / "sculpt.obj", 3, Pattern::kDetail, 0.004);
     auto made = MakeSculpt(make);
     ASSERT_TRUE(made.ok()) << made.status().message();
     linear_error_ = made->linear_error;
