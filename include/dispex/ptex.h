@@ -297,8 +297,10 @@ StatusOr<PtexFile> ParsePtex(std::string_view bytes, const std::string& name,
 
 // ---- Half floats ----------------------------------------------------------------------------
 
-// IEEE-754 binary16 conversions: round to nearest, ties to even; overflow to +-infinity;
-// subnormals produced and read; NaN stays NaN (quiet, sign and top payload bits kept).
+// IEEE-754 binary16 conversions as the reference Ptex library makes them: round to nearest
+// with ties away from zero (normal and subnormal halves), -0 and +0 both to +0, overflow to
+// +-infinity, NaN stays NaN (quiet, sign and top payload bits kept); a double is rounded to
+// float first. Reading is exact.
 std::uint16_t FloatToHalf(float value);
 std::uint16_t DoubleToHalf(double value);
 float HalfToFloat(std::uint16_t bits);
