@@ -43,16 +43,20 @@ void SetupMakeSculpt(CLI::App& app, int& exit_code) {
   cmd->add_option("cage", o.cage_path, "base cage (.obj, .ply)")->required();
   cmd->add_option("-o,--output", o.output_path, "sculpt to write (.obj)")->required();
   cmd->add_option("--levels", o.levels, "Catmull-Clark refinement levels (1..8)")
+      ->check(CLI::Range(1, 8))
       ->capture_default_str();
   cmd->add_option("--pattern", args->pattern,
                   "smooth, detail, ridges, noise, none, or image:FILE.png (h = A (2 L - 1), L "
                   "the PNG's luminance at the cage's UVs; v = 0 at the image's bottom row)")
       ->capture_default_str();
   cmd->add_option("--amplitude", o.amplitude,
-                  "pattern amplitude in object units (default: 1% of the bounding-box diagonal)");
+                  "pattern amplitude in object units (default: 1% of the bounding-box diagonal)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--seed", o.seed, "seed of the noise pattern")->capture_default_str();
   cmd->add_option("--truth", o.truth_path, "ground-truth file (default: OUTPUT.truth)");
-  cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")->capture_default_str();
+  cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_flag("-q,--quiet", args->quiet, "no summary");
   cmd->callback([args, &exit_code] { exit_code = RunMakeSculpt(*args); });
 }
