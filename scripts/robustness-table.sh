@@ -19,18 +19,31 @@ printf 'v 0 0 0\nv 1 0 0\nv 0 inf 0\nv 1 1 0\nf 1 2 4 3\n' > inf.obj
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 2 4\nf 1 2 3 4\n' > degenerate.obj
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n' > points.obj
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nf 1 2 3 4\nf 2 1 5 6\nf 1 2 6 5\nf 2 1 3 4\n' > nonmanifold.obj
+# The sculpt's faces whose first vertex lies left of the middle: it covers half the base.
+awk '/^v /{x[++n]=$2; lo=(n==1||$2<lo)?$2:lo; hi=(n==1||$2>hi)?$2:hi; print; next}
+     /^f /{f[++m]=$0; split($2,a,"/"); k[m]=a[1]; next}
+     END{for(i=1;i<=m;i++) if (x[k[i]] < (lo+hi)/2) print f[i]}' sculpt.obj > half.obj
 printf 'v 100 100 100\nv 101 100 100\nv 101 101 100\nv 100 101 100\nf 1 2 3 4\n' > far.obj
 printf 'ply\nformat binary_little_endian 1.0\nelement vertex 4294967295\nproperty float x\nend_header\n' > huge.ply
 printf 'Ptex garbage' > garbage.ptx
 mkdir -p adir
+# One row. A failed run must leave nothing behind: no output and no temporary file (a
+# successful run's output is removed before the next row).
+leftovers=0
 run() {
   local what="$1"; shift
-  local err
+  local err code
   err=$("$dispex" "$@" 2>&1 >/dev/null | head -n 3)
-  local code=${PIPESTATUS[0]}
-  printf '| %s | `dispex %s` | %s | `%s` |\n' "$what" "$*" "$code" "$err"
+  code=${PIPESTATUS[0]}
+  local command="$*"
+  printf '| %s | `dispex %s` | %s | `%s` |\n' "$what" "${command//$root\//}" "$code" \
+    "${err//$root\//}"
+  if [[ $code -ne 0 ]] && ls | grep -qE '\.tmp\.|^out\.ptx$'; then
+    echo "robustness-table: '$what' left files behind: $(ls | grep -E '\.tmp\.|^out\.ptx$')" >&2
+    leftovers=1
+  fi
+  rm -f out.ptx
 }
-x() { echo "extract $1 $2 -o out.ptx ${3:-}"; }
 echo "| input class | command | exit | message |"
 echo "|---|---|---|---|"
 run "missing file" extract "$cage" missing.obj -o out.ptx
@@ -46,8 +59,11 @@ run "non-manifold base" extract nonmanifold.obj sculpt.obj -o out.ptx
 run "PLY claiming 4 billion vertices" info huge.ply
 run "garbage Ptex" info garbage.ptx
 run "sculpt not overlapping the base" extract "$cage" far.obj -o out.ptx
+run "sculpt covering half the base" extract "$cage" half.obj -o out.ptx
 run "zero search distance" extract "$cage" sculpt.obj -o out.ptx --search-distance 0
 run "negative tolerance" extract "$cage" sculpt.obj -o out.ptx --tolerance -1
+run "zero tolerance" extract "$cage" sculpt.obj -o out.ptx --tolerance 0
+run "zero amplitude" make-sculpt "$cage" -o s.obj --amplitude 0
 run "unknown option" extract "$cage" sculpt.obj -o out.ptx --frobnicate
 run "too little memory" extract "$cage" sculpt.obj -o out.ptx --max-memory 1K
 run "output in a missing directory" extract "$cage" sculpt.obj -o nodir/out.ptx
@@ -57,4 +73,4 @@ if [[ $(id -u) -ne 0 ]]; then
   chmod 555 adir
   run "read-only output directory" extract "$cage" sculpt.obj -o adir/out.ptx
 fi
-ls "$w" | grep -E '\.tmp\.|out\.ptx' && echo "LEFT OVER FILES" >&2
+exit $leftovers

@@ -57,6 +57,11 @@ struct ExtractOptions {
   PtexDataType data_type = PtexDataType::kFloat;  // kFloat or kHalf
   int compression_level = -1;                     // -1: the writer's default
   HolePolicy holes = HolePolicy::kFill;
+  // The largest fraction of samples (over all faces) that may still miss the sculpt after the
+  // second search; above it the extraction fails and writes nothing, since the map would be
+  // mostly invented by hole filling (the sculpt covers the base only in part, or the meshes
+  // are not aligned). 1 turns the check off.
+  double max_miss_fraction = 0.05;
   BuildQuality bvh_quality = BuildQuality::kLow;  // measured: same ray speed, a third of the build
 
   int threads = 0;        // 0: all cores; the output does not depend on it
@@ -95,7 +100,8 @@ struct ExtractReport {
   // Phases, wall seconds.
   double t_read_base = 0, t_read_sculpt = 0, t_topology = 0, t_bvh = 0, t_search = 0,
          t_sample_trace = 0, t_write = 0, t_total = 0;
-  // Within sample+trace (summed over threads, CPU seconds): limit evaluation, rays, spectral.
+  // Within sample+trace, CPU time of the worker threads (each thread's own clock, summed):
+  // limit evaluation, rays, spectral analysis, compression and writing.
   double cpu_limit = 0, cpu_trace = 0, cpu_spectral = 0, cpu_compress = 0;
 
   // Sampling and rays.
@@ -111,6 +117,7 @@ struct ExtractReport {
   double retry_search_distance = 0;
   std::int64_t misses_recovered = 0;   // samples that hit on that second search
   std::int64_t misses = 0;             // samples whose rays found nothing
+  double miss_fraction = 0;            // misses / samples
   std::int64_t holes_filled = 0;       // of those, filled within their face
   std::int64_t faces_with_misses = 0;
   std::int64_t faces_filled_from_neighbours = 0;

@@ -327,7 +327,7 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
     w.values.resize(count);
     w.valid.resize(count);
 
-    Stopwatch step;
+    ThreadCpuStopwatch step;
     DISPEX_RETURN_IF_ERROR(w.evaluator.EvaluateGrid(face, n, n, w.positions, w.normals));
     w.cpu_limit += step.seconds();
     step.Reset();
@@ -496,6 +496,20 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
     first = false;
   }
   report.displacement_rms = report.samples ? std::sqrt(sum_squares / double(report.samples)) : 0;
+  report.miss_fraction = report.samples ? double(report.misses) / double(report.samples) : 0;
+  if (report.miss_fraction > options.max_miss_fraction) {
+    return Status::Error(fmt::format(
+        "{:.1f}% of the samples ({} of {}) found no surface of {} within the search distance "
+        "{:.6g}{}, more than the limit of {:.4g}%: the sculpt covers only part of {} or is not "
+        "aligned with it; align the meshes, give a longer search distance, or raise the limit "
+        "of missed samples",
+        100 * report.miss_fraction, report.misses, report.samples, options.sculpt_path,
+        report.search_distance,
+        retry_distance > report.search_distance
+            ? fmt::format(" (and {:.6g} on the second search)", retry_distance)
+            : "",
+        100 * options.max_miss_fraction, options.base_path));
+  }
   for (const Worker& w : workers) {
     report.rays_cast += w.counters.rays_cast;
     report.cpu_limit += w.cpu_limit;

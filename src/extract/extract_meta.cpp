@@ -37,6 +37,7 @@ nlohmann::json ExtractOptionsJson(const ExtractOptions& o) {
   j["data_type"] = PtexName(o.data_type);
   j["compression_level"] = o.compression_level;
   j["holes"] = std::string(HolePolicyName(o.holes));
+  j["max_miss_fraction"] = o.max_miss_fraction;
   j["bvh_quality"] = std::string(ToString(o.bvh_quality));
   return j;
 }
@@ -65,6 +66,7 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
   j["retry_search_distance"] = r.retry_search_distance;
   j["misses_recovered"] = r.misses_recovered;
   j["misses"] = r.misses;
+  j["miss_fraction"] = r.miss_fraction;
   j["holes_filled"] = r.holes_filled;
   j["faces_with_misses"] = r.faces_with_misses;
   j["faces_filled_from_neighbours"] = r.faces_filled_from_neighbours;

@@ -64,6 +64,10 @@ Status ValidateExtractOptions(const ExtractOptions& o) {
   if (o.data_type != PtexDataType::kFloat && o.data_type != PtexDataType::kHalf) {
     return Status::Error("--data-type: must be float or half");
   }
+  if (!(o.max_miss_fraction >= 0 && o.max_miss_fraction <= 1)) {
+    return Status::Error(
+        fmt::format("max_miss_fraction {}: must be in [0, 1]", o.max_miss_fraction));
+  }
   if (o.threads < 0) return Status::Error(fmt::format("--threads {}: must be >= 0", o.threads));
   SpectralOptions spectral;
   spectral.rule = o.resolution_rule;

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "../extract/e2e_support.h"
+#include "dispex/mesh.h"
 #include "dispex/verify.h"
 
 namespace dispex {
@@ -112,6 +113,72 @@ TEST_F(BadInput, BadOptionValues) {
   ExpectFailure(Extract(cage_, sculpt_, "--max-memory lots"), "--max-memory", 2);
   ExpectFailure(Extract(cage_, sculpt_, "--frobnicate"), "--frobnicate", 2);
   ExpectFailure("frobnicate", "frobnicate", 2);
+}
+
+// Zero or negative values of options that must be positive are errors, never a silent
+// "automatic" or "off".
+TEST_F(BadInput, ZeroOrNegativeValuesOfPositiveOptions) {
+  for (const char* option : {"--tolerance", "--tolerance-fraction", "--search-distance-rel",
+                             "--max-oversample", "--min-oversample"}) {
+    for (const char* value : {"0", "-1"}) {
+      ExpectFailure(Extract(cage_, sculpt_, std::string(option) + " " + value), option, 2);
+    }
+  }
+  ExpectFailure(Extract(cage_, sculpt_, "--threads -1"), "--threads", 2);
+  ExpectFailure(Extract(cage_, sculpt_, "--max-miss-fraction 1.5"), "--max-miss-fraction", 2);
+  ExpectFailure(Extract(cage_, sculpt_, "--max-miss-fraction -0.1"), "--max-miss-fraction", 2);
+  const std::string map = dir_ / "map.ptx";
+  for (const char* option : {"--max-error", "--max-error-rel", "--max-rms"}) {
+    ExpectFailure("verify " + cage_ + " " + sculpt_ + " " + map + " " + option + " 0", option, 2);
+  }
+  const std::string make = "make-sculpt " + cage_ + " -o " + (dir_ / "s.obj") + " ";
+  ExpectFailure(make + "--amplitude 0", "--amplitude", 2);
+  ExpectFailure(make + "--amplitude -0.1", "--amplitude", 2);
+  ExpectFailure(make + "--levels 0", "--levels", 2);
+  const std::string render = "render " + cage_ + " -o " + (dir_ / "r.png") + " ";
+  for (const char* option : {"--density 0", "--min-density 0", "--max-density 0",
+                             "--supersample 0", "--ao -1", "--ao-distance 0"}) {
+    ExpectFailure(render + option, std::string(option).substr(0, std::string(option).find(' ')),
+                  2);
+  }
+  const std::string preview = "preview " + map + " -o " + (dir_ / "p.png") + " ";
+  ExpectFailure(preview + "--tile 0", "--tile", 2);
+  ExpectFailure(preview + "--max-tile 0", "--max-tile", 2);
+}
+
+// A sculpt that covers only half of the base: most rays from the other half find nothing,
+// and a map that would be half invented by hole filling is refused.
+TEST_F(BadInput, SculptCoveringHalfTheBaseIsRefused) {
+  auto mesh = ReadMesh(sculpt_);
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  const BoundingBox box = ComputeBounds(*mesh);
+  const float middle = 0.5f * (box.min.x + box.max.x);
+  std::ofstream out(dir_ / "half.obj");
+  for (const Float3& p : mesh->positions) out << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
+  for (std::size_t f = 0; f < mesh->num_faces(); ++f) {
+    const auto first = mesh->face_indices[mesh->face_offsets[f]];
+    if (mesh->positions[static_cast<std::size_t>(first)].x > middle) continue;
+    out << 'f';
+    for (auto k = mesh->face_offsets[f]; k < mesh->face_offsets[f + 1]; ++k) {
+      out << ' ' << mesh->face_indices[k] + 1;
+    }
+    out << '\n';
+  }
+  out.close();
+  ExpectFailure(Extract(cage_, dir_ / "half.obj"), "more than the limit of 5%");
+  // The limit is an option: raised, the same extraction succeeds and reports the fraction.
+  auto r = RunDispex(Extract(cage_, dir_ / "half.obj",
+                             "--max-miss-fraction 1 -q --report " + (dir_ / "r.json")),
+                     dir_);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out.ptx"));
+  std::ifstream report(dir_ / "r.json");
+  const std::string text((std::istreambuf_iterator<char>(report)), {});
+  const auto at = text.find("\"miss_fraction\": ");
+  ASSERT_NE(at, std::string::npos);
+  const double fraction = std::stod(text.substr(at + 17));
+  EXPECT_GT(fraction, 0.2);
+  EXPECT_LT(fraction, 0.8);
 }
 
 TEST_F(BadInput, OutputPaths) {
