@@ -157,10 +157,10 @@ void SetupExtract(CLI::App& app, int& exit_code) {
                   "power of two 1..512")
       ->capture_default_str();
   cmd->add_option("--max-oversample", o.max_oversample, "cap for automatic oversampling")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--min-oversample", o.min_oversample, "floor for automatic oversampling")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--search-distance", args->search_distance,
                   "how far along ±normal to look: 'auto', a length, or N% of the base "
@@ -168,24 +168,24 @@ void SetupExtract(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--search-distance-rel", args->search_distance_rel,
                   "search distance as a fraction of the base bounding-box diagonal")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--ray-policy", args->ray_policy,
                   "hit kept when both directions hit: nearest, outside-first, inside-first")
       ->capture_default_str();
   cmd->add_option("--tolerance", o.tolerance,
                   "largest allowed error per face, object units (default: "
                   "--tolerance-fraction x the sculpt's median edge length)")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--tolerance-fraction", o.tolerance_fraction,
                   "automatic tolerance as a fraction of the sculpt's median edge length")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--resolution-rule", args->resolution_rule,
                   "per-face resolution: bound (error bound), nonzero (published rule), fixed")
       ->capture_default_str();
   cmd->add_option("--nonzero-threshold", o.nonzero_threshold,
                   "|DCT coefficient| counted as non-zero by --resolution-rule nonzero")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_option("--fixed-resolution", args->fixed_resolution,
                   "WxH for --resolution-rule fixed")
@@ -206,7 +206,7 @@ void SetupExtract(CLI::App& app, int& exit_code) {
   cmd->add_option("--bvh-quality", args->bvh_quality, "BVH build quality: low, medium, high")
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_option("--max-memory", args->max_memory,
                   "refuse work estimated to need more memory than this (e.g. 8G; default: the "

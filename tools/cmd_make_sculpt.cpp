@@ -51,11 +51,11 @@ void SetupMakeSculpt(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--amplitude", o.amplitude,
                   "pattern amplitude in object units (default: 1% of the bounding-box diagonal)")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--seed", o.seed, "seed of the noise pattern")->capture_default_str();
   cmd->add_option("--truth", o.truth_path, "ground-truth file (default: OUTPUT.truth)");
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", args->quiet, "no summary");
   cmd->callback([args, &exit_code] { exit_code = RunMakeSculpt(*args); });

@@ -77,18 +77,18 @@ void SetupPreview(CLI::App& app, int& exit_code) {
   cmd->add_option("--tile", o.min_tile,
                   "smallest tile side in pixels (faces scaled up by an "
                   "integer factor)")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--max-tile", o.max_tile,
                   "largest tile side in pixels (bigger faces are shown reduced)")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--width", o.width, "atlas width in pixels (0: about square)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_option("--channel", o.channel, "channel to draw")->capture_default_str();
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", args->quiet, "no summary");
   cmd->callback([args, &exit_code] { exit_code = RunPreview(*args); });

@@ -108,29 +108,29 @@ void SetupRender(CLI::App& app, int& exit_code) {
   cmd->add_option("--size", args->size, "image size WxH (all panels together)")
       ->capture_default_str();
   cmd->add_option("--density", o.density, "quads per side of each face without a map")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--min-density", o.min_density,
                   "with a map: fewest quads per face side (faces use their map resolution)")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--max-density", o.max_density, "with a map: most quads per face side")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--supersample", o.supersample, "s x s rays per pixel (1..4)")
       ->check(CLI::Range(1, 4))
       ->capture_default_str();
   cmd->add_option("--ao", o.ao_samples, "ambient occlusion rays per hit (0: off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_option("--ao-distance", o.ao_distance,
                   "ambient occlusion ray length, fraction of the bounding-box diagonal")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--channel", o.channel, "map channel used as the displacement")
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", args->quiet, "no summary");
   cmd->callback([args, &exit_code] { exit_code = RunRender(*args); });

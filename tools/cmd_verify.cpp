@@ -57,22 +57,22 @@ void SetupVerify(CLI::App& app, int& exit_code) {
   cmd->add_option("--truth", o.truth_path, "make-sculpt truth file: compare with the exact h");
   cmd->add_option("--samples", o.samples_per_face,
                   "samples per side of each face (0: twice the map resolution, 8..64)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_option("--max-sculpt-points", o.max_sculpt_points,
                   "sculpt vertices measured (evenly strided; 0: all)")
       ->capture_default_str();
   cmd->add_option("--max-error", o.max_error,
                   "fail (exit 3) when a max error exceeds this, object units")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--max-error-rel", o.max_error_rel,
                   "fail when a max error exceeds this fraction of the bounding-box diagonal")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--max-rms", o.max_rms,
                   "fail (exit 3) when an RMS error exceeds this, object units")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_option("--report", args->report_path, "write a JSON report to this file");
   cmd->add_flag("-q,--quiet", args->quiet, "no summary on stdout");

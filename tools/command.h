@@ -27,6 +27,11 @@ int ReportFailure(const Status& status, int exit_code = 1);
 // True when stderr is a terminal and CI is not set: only then is progress drawn.
 bool StderrIsInteractive();
 
+// Option checks with messages that say what to do: "--tolerance: 0 must be greater than 0
+// (leave the option out for the automatic value)".
+CLI::Validator Positive();
+CLI::Validator NonNegative();
+
 }  // namespace dispex::cli
 
 #define DISPEX_CLI_CONCAT_INNER(a, b) a##b

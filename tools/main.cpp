@@ -34,6 +34,32 @@ bool StderrIsInteractive() {
   return ::isatty(STDERR_FILENO) == 1;
 }
 
+namespace {
+CLI::Validator NumberCheck(const char* name, bool (*accept)(double), const char* requirement) {
+  return CLI::Validator(
+      [accept, requirement](std::string& text) -> std::string {
+        double value = 0;
+        try {
+          std::size_t used = 0;
+          value = std::stod(text, &used);
+          if (used != text.size()) return text + " is not a number";
+        } catch (...) {
+          return text + " is not a number";
+        }
+        return accept(value) ? std::string() : text + " " + requirement;
+      },
+      name);
+}
+}  // namespace
+
+CLI::Validator Positive() {
+  return NumberCheck("> 0", [](double v) { return v > 0; },
+                     "must be greater than 0 (leave the option out for the automatic value)");
+}
+CLI::Validator NonNegative() {
+  return NumberCheck(">= 0", [](double v) { return v >= 0; }, "must be 0 or more");
+}
+
 }  // namespace dispex::cli
 
 int main(int argc, char** argv) {
