@@ -1,6 +1,8 @@
 // Facts about the running process and machine that reports and resource checks need.
 #pragma once
 
+#include <time.h>
+
 #include <chrono>
 #include <cstdint>
 #include <string>
@@ -24,6 +26,24 @@ class Stopwatch {
 
  private:
   std::chrono::steady_clock::time_point start_;
+};
+
+// CPU time of the calling thread (CLOCK_THREAD_CPUTIME_ID): unlike wall intervals, it does
+// not count the time a thread waits or is descheduled, so per-thread sums are CPU seconds
+// whatever the thread count. Must be read on the thread that started it.
+class ThreadCpuStopwatch {
+ public:
+  ThreadCpuStopwatch() : start_(Now()) {}
+  double seconds() const { return Now() - start_; }
+  void Reset() { start_ = Now(); }
+
+ private:
+  static double Now() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+  }
+  double start_;
 };
 
 }  // namespace dispex
