@@ -5,19 +5,23 @@ JOBS        ?= $(shell nproc)
 WERROR      ?= OFF
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build demo test test-sanitize bench fuzz format clean
+.PHONY: all deps configure build demo test test-sanitize test-tsan bench fuzz format clean
 
 all: build
 
 deps:
 	@scripts/install-deps.sh
 
-build: deps
+configure: deps
 	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DDISPEX_BUILD_BENCH=ON \
 	  -DDISPEX_WERROR=$(WERROR) $(CMAKE_FLAGS) >/dev/null
+
+build: configure
 	@cmake --build $(BUILD) -j$(JOBS)
 
-demo: build
+# The demo needs only the command-line tool: tests and benchmarks are built by `make test`.
+demo: configure
+	@cmake --build $(BUILD) -j$(JOBS) --target dispex
 	@scripts/demo.sh $(BUILD)
 
 test: build
@@ -37,11 +41,20 @@ test-sanitize: deps
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  ctest --output-on-failure -j$(JOBS) -L unit --timeout 900
 
+# The extraction pipeline (TBB tasks at 4 threads) under ThreadSanitizer.
+test-tsan: deps
+	@cmake -S . -B $(BUILD)-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDISPEX_TSAN=ON \
+	  -DDISPEX_BUILD_TESTS=OFF -DDISPEX_BUILD_BENCH=OFF -DDISPEX_WERROR=$(WERROR) \
+	  $(CMAKE_FLAGS) >/dev/null
+	@cmake --build $(BUILD)-tsan -j$(JOBS) --target dispex
+	@scripts/build-tsan-tbb.sh $(BUILD)-tsan/tbb
+	@scripts/tsan-extract.sh $(BUILD)-tsan
+
 format:
 	@clang-format -i $$(git ls-files '*.cpp' '*.h')
 
 clean:
-	rm -rf $(BUILD) $(BUILD)-sanitize
+	rm -rf $(BUILD) $(BUILD)-sanitize $(BUILD)-tsan
 
 # libFuzzer targets for the OBJ, PLY and Ptex readers (clang; see fuzz/README.md). `fuzz`
 # runs each target for FUZZ_SECONDS, `fuzz-ci` for 60 s; a crash fails the run and its input

@@ -17,6 +17,13 @@ if(DISPEX_SANITIZE)
     -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   target_link_options(dispex_options INTERFACE -fsanitize=address,undefined)
 endif()
+if(DISPEX_TSAN)
+  if(DISPEX_SANITIZE)
+    message(FATAL_ERROR "DISPEX_TSAN and DISPEX_SANITIZE cannot be combined")
+  endif()
+  target_compile_options(dispex_options INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
+  target_link_options(dispex_options INTERFACE -fsanitize=thread)
+endif()
 
 # dispex_add_library(NAME SOURCES... ) : one static library per src/ folder, alias dispex::NAME.
 function(dispex_add_library name)
