@@ -26,8 +26,8 @@ struct TagLimits {
 //   hole    k/0/0:            k face ids
 //   interpolateboundary 1/0/0 N: 0 none, 1 edge and corner, 2 edge only
 //   creasemethod 0/0/1 S:        normal (uniform) or chaikin
-//   smoothtriangles 0/0/1 S:     catmark or smooth (far_utils.h); also Hbr's 1/0/0 N
-//                                (hbr_utils.h): 0 catmark, 2 smooth, 1 an error (not in Far)
+//   smoothtriangles 0/0/1 S:     catmark or smooth; also OpenSubdiv 2 (Hbr)'s 1/0/0 N:
+//                                0 catmark, 2 smooth, 1 an error (Hbr's other rule, not in Far)
 // The last setting tag of a kind wins. Sharpness is clamped at 0 from below as OpenSubdiv
 // does. Vertex and face ids are 0-based and must be in range. Other tag names
 // (facevaryinginterpolateboundary, ...) are checked for well-formed counts and their names
