@@ -25,7 +25,10 @@ bool SameFloat(float a, float b) {
 bool SameTags(const SubdivTags& a, const SubdivTags& b) {
   if (a.creases.size() != b.creases.size() || a.corners.size() != b.corners.size() ||
       a.holes != b.holes || a.boundary != b.boundary ||
-      a.boundary_from_file != b.boundary_from_file || a.ignored_tags != b.ignored_tags) {
+      a.boundary_from_file != b.boundary_from_file || a.crease_method != b.crease_method ||
+      a.crease_method_from_file != b.crease_method_from_file || a.triangles != b.triangles ||
+      a.triangles_from_file != b.triangles_from_file ||
+      a.ignored_tag_names != b.ignored_tag_names) {
     return false;
   }
   for (std::size_t i = 0; i < a.creases.size(); ++i) {
@@ -100,8 +103,8 @@ std::string CheckUvs(const Mesh& mesh) {
     const auto nuv = static_cast<std::int64_t>(mesh.uvs.size() / 2);
     for (std::size_t i = 0; i < mesh.face_uv_indices.size(); ++i) {
       if (mesh.face_uv_indices[i] < 0 || mesh.face_uv_indices[i] >= nuv) {
-        return "face uv index " + std::to_string(mesh.face_uv_indices[i]) + " at corner " +
-               Num(i) + " out of range (" + Num(mesh.uvs.size() / 2) + " uvs)";
+        return "face uv index " + std::to_string(mesh.face_uv_indices[i]) + " at corner " + Num(i) +
+               " out of range (" + Num(mesh.uvs.size() / 2) + " uvs)";
       }
     }
     if (mesh.faces_without_uvs != 0) return "faces_without_uvs set while UVs are kept";

@@ -21,6 +21,7 @@ int RunMakeSculpt(MakeSculptArgs& args) {
   auto report = MakeSculpt(args.options);
   if (!report.ok()) return ReportFailure(report.status());
   if (!args.quiet) {
+    for (const std::string& w : report->warnings) fmt::print(stderr, "dispex: warning: {}\n", w);
     std::string truth = args.options.truth_path.empty() ? args.options.output_path + ".truth"
                                                         : args.options.truth_path;
     fmt::print(stderr,

@@ -59,6 +59,11 @@ int RunRender(RenderArgs& args) {
   read.threads = args.options.threads;
   auto base = ReadMesh(args.files[0], read);
   if (!base.ok()) return ReportFailure(base.status());
+  if (!args.quiet) {
+    for (const std::string& w : IgnoredTagWarnings(*base)) {
+      fmt::print(stderr, "dispex: warning: {}\n", w);
+    }
+  }
   std::optional<PtexFile> map;
   if (args.files.size() == 2) {
     auto opened = PtexFile::Open(args.files[1]);

@@ -37,7 +37,10 @@ int RunVerify(VerifyArgs& args) {
     Status written = WriteFileAtomically(args.report_path, json.data(), json.size());
     if (!written.ok()) return ReportFailure(written.WithPrefix("--report"));
   }
-  if (!args.quiet) std::fputs(VerifyReportSummary(*report).c_str(), stdout);
+  if (!args.quiet) {
+    for (const std::string& w : report->warnings) fmt::print(stderr, "dispex: warning: {}\n", w);
+    std::fputs(VerifyReportSummary(*report).c_str(), stdout);
+  }
   if (!report->passed) {
     return ReportFailure(Status::Error(o.map_path + ": " + report->failure), 3);
   }

@@ -1,11 +1,13 @@
 // `dispex info MESH`: counts, faces by size, groups, subdivision tags, bounds, edge length
 // statistics and validation warnings of an OBJ or PLY mesh, as text or JSON.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "command.h"
@@ -36,6 +38,24 @@ const char* BoundaryName(BoundaryInterpolation b) {
       return "edge_and_corner";
   }
   return "?";
+}
+
+const char* CreaseMethodName(CreaseMethod m) {
+  return m == CreaseMethod::kChaikin ? "chaikin" : "uniform";
+}
+
+const char* TrianglesName(TriangleSubdivision t) {
+  return t == TriangleSubdivision::kSmooth ? "smooth" : "catmark";
+}
+
+// The distinct ignored tag names, first appearance first.
+std::vector<std::string> DistinctNames(const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  std::unordered_set<std::string> seen;
+  for (const std::string& n : names) {
+    if (seen.insert(n).second) out.push_back(n);
+  }
+  return out;
 }
 
 std::string SizeName(int size, std::size_t count) {
@@ -86,7 +106,21 @@ void PrintText(const InfoOptions& options, const Mesh& mesh, const Summary& s) {
   out += fmt::format("holes         {}\n", t.holes.size());
   out += fmt::format("boundary      {} ({})\n", BoundaryName(t.boundary),
                      t.boundary_from_file ? "from the file" : "default");
-  out += fmt::format("ignored tags  {}\n", t.ignored_tags);
+  out += fmt::format("crease method {} ({})\n", CreaseMethodName(t.crease_method),
+                     t.crease_method_from_file ? "from the file" : "default");
+  out += fmt::format("triangles     {} ({})\n", TrianglesName(t.triangles),
+                     t.triangles_from_file ? "from the file" : "default");
+  if (t.ignored_tag_names.empty()) {
+    out += "ignored tags  0\n";
+  } else {
+    std::vector<std::string> names = DistinctNames(t.ignored_tag_names);
+    if (names.size() > 10) {
+      names.resize(10);
+      names.push_back("...");
+    }
+    out +=
+        fmt::format("ignored tags  {} ({})\n", t.ignored_tag_names.size(), fmt::join(names, ", "));
+  }
   out += fmt::format("bounds        min {} max {}\n", Point(s.bounds.min), Point(s.bounds.max));
   out += fmt::format("diagonal      {:.6g}\n", s.bounds.diagonal());
   out += fmt::format("median edge   {:.6g}\n", s.median_edge);
@@ -120,7 +154,12 @@ void PrintJson(const InfoOptions& options, const Mesh& mesh, const Summary& s) {
                {"holes", t.holes.size()},
                {"boundary", BoundaryName(t.boundary)},
                {"boundary_from_file", t.boundary_from_file},
-               {"ignored", t.ignored_tags}};
+               {"crease_method", CreaseMethodName(t.crease_method)},
+               {"crease_method_from_file", t.crease_method_from_file},
+               {"triangles", TrianglesName(t.triangles)},
+               {"triangles_from_file", t.triangles_from_file},
+               {"ignored", t.ignored_tag_names.size()},
+               {"ignored_names", DistinctNames(t.ignored_tag_names)}};
   // A float as the double nearest to its shortest decimal form: -0.337421, not
   // -0.3374210000038147.
   const auto real = [](float f) { return std::stod(fmt::format("{}", f)); };

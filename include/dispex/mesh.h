@@ -26,6 +26,14 @@ struct Float3 {
 // 1 = edge and corner, 2 = edge only). Without a tag, edge and corner, as renderers do.
 enum class BoundaryInterpolation : std::uint8_t { kNone, kEdgeOnly, kEdgeAndCorner };
 
+// OpenSubdiv's crease rule for semi-sharp creases ("t creasemethod 0/0/1 normal|chaikin"):
+// uniform decrements sharpness by 1 per level; Chaikin averages it along crease chains.
+enum class CreaseMethod : std::uint8_t { kUniform, kChaikin };
+
+// Catmull-Clark weights at triangles ("t smoothtriangles 0/0/1 catmark|smooth"): catmark, or
+// OpenSubdiv's "smooth triangle" edge weights that round triangles off.
+enum class TriangleSubdivision : std::uint8_t { kCatmark, kSmooth };
+
 // Subdivision tags of a Catmull-Clark cage, as OpenSubdiv's OBJ `t` lines carry them.
 struct SubdivTags {
   struct Crease {
@@ -41,7 +49,14 @@ struct SubdivTags {
   std::vector<BaseFaceId> holes;
   BoundaryInterpolation boundary = BoundaryInterpolation::kEdgeAndCorner;
   bool boundary_from_file = false;  // true when a tag set it
-  int ignored_tags = 0;             // tags read but not used (face-varying settings, ...)
+  CreaseMethod crease_method = CreaseMethod::kUniform;
+  bool crease_method_from_file = false;
+  TriangleSubdivision triangles = TriangleSubdivision::kCatmark;
+  bool triangles_from_file = false;
+  // Names of the tag lines read but not used (face-varying settings, unknown names), one
+  // entry per line in file order; bytes that are not printable ASCII become '?', names
+  // longer than 64 bytes end in "...".
+  std::vector<std::string> ignored_tag_names;
 
   bool empty() const { return creases.empty() && corners.empty() && holes.empty(); }
 };
@@ -129,8 +144,9 @@ StatusOr<Mesh> ReadMesh(const std::string& path, const ReadOptions& options = {}
 //  - `o name` / `g name...`: a group per distinct name (blanks collapsed; no name = "default"),
 //    in order of first appearance, listing only groups that own faces; faces before the first
 //    group line form the group "default". With no o/g line, face_groups stays empty.
-//  - OpenSubdiv `t` tags (crease, corner, hole, interpolateboundary; others counted in
-//    tags.ignored_tags) with 0-based ids checked against the whole file.
+//  - OpenSubdiv `t` tags (crease, corner, hole, interpolateboundary, creasemethod,
+//    smoothtriangles; other names kept in tags.ignored_tag_names) with 0-based ids checked
+//    against the whole file.
 //  - `#` comments, blank lines, CRLF; a `\` at the end of any line (comments too) joins the
 //    next line. Every other keyword (vn, vp, usemtl, mtllib, s, l, p, ...) is ignored; a line
 //    that does not start with a keyword is an error.
@@ -178,6 +194,11 @@ MeshValidation ValidateMesh(const Mesh& mesh);
 // OK when validation.clean(); otherwise an error "<source>: mesh is not clean: <warnings
 // joined by '; '>" (the --strict flag).
 Status RequireClean(const Mesh& mesh, const MeshValidation& validation);
+
+// One line per distinct ignored tag name (tags.ignored_tag_names, first appearance first),
+// naming the file, the tag, how many lines carry it and that it is ignored; after 10 names,
+// one line counting the rest. Empty when none.
+std::vector<std::string> IgnoredTagWarnings(const Mesh& mesh);
 
 struct BoundingBox {
   Float3 min{0, 0, 0}, max{0, 0, 0};

@@ -88,6 +88,7 @@ struct MakeSculptReport {
   // Sculpt quads turned inside out: the displaced surface folds there (|h| x curvature >= 1),
   // so rays along the limit normal can miss it or meet another sheet.
   std::size_t folded_faces = 0;
+  std::vector<std::string> warnings;  // one line each (tags of the cage that were ignored)
   double seconds = 0;
 };
 
@@ -157,7 +158,8 @@ struct VerifyReport {
   std::int64_t map_misses = -1, map_holes_filled = -1, map_faces_filled_from_neighbours = -1;
   double map_tolerance = 0;
   bool passed = true;
-  std::string failure;  // why it did not pass
+  std::string failure;                // why it did not pass
+  std::vector<std::string> warnings;  // one line each (tags of the base that were ignored)
   double seconds = 0;
 };
 

@@ -215,6 +215,7 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
   report.inf_sharp_edges = surface_stats.inf_sharp_edges;
   report.sculpt_vertices = sculpt.num_vertices();
   report.sculpt_faces = sculpt.num_faces();
+  for (std::string& w : IgnoredTagWarnings(base)) report.warnings.push_back(std::move(w));
   if (surface_stats.inf_sharp_edges > 0) {
     report.warnings.push_back(fmt::format(
         "{}: {} infinitely sharp edges: the limit normal has two values there, so the map "

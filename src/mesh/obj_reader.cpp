@@ -262,7 +262,16 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
       tags.boundary = out.tags.boundary;
       tags.boundary_from_file = true;
     }
-    tags.ignored_tags += out.tags.ignored_tags;
+    if (out.tags.crease_method_from_file) {
+      tags.crease_method = out.tags.crease_method;
+      tags.crease_method_from_file = true;
+    }
+    if (out.tags.triangles_from_file) {
+      tags.triangles = out.tags.triangles;
+      tags.triangles_from_file = true;
+    }
+    tags.ignored_tag_names.insert(tags.ignored_tag_names.end(), out.tags.ignored_tag_names.begin(),
+                                  out.tags.ignored_tag_names.end());
   }
   return mesh;
 }

@@ -3,7 +3,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <string_view>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "mesh/text_scan.h"
@@ -111,11 +114,13 @@ bool ParseTag(const char*& p, const char* end, std::int64_t& line, const TagLimi
     }
     floats.push_back(value);
   }
+  std::vector<std::string_view> strings;
   for (std::int64_t i = 0; i < counts[2]; ++i) {
     if (!NextToken(p, end, line, token)) {
       error = fmt::format("tag '{}' ends after {} of its {} strings", shown, i, counts[2]);
       return false;
     }
+    strings.push_back(token);
   }
   text::SkipBlanks(p, end, line);
   if (!AtLineEnd(p, end)) {
@@ -204,10 +209,89 @@ bool ParseTag(const char*& p, const char* end, std::int64_t& line, const TagLimi
         return false;
     }
     tags.boundary_from_file = true;
+  } else if (name == "creasemethod") {
+    if (strings.size() != 1 || !ints.empty() || !floats.empty()) {
+      error = fmt::format("creasemethod tag needs 1 string, normal or chaikin (got {}/{}/{})",
+                          counts[0], counts[1], counts[2]);
+      return false;
+    }
+    if (strings[0] == "normal") {
+      tags.crease_method = CreaseMethod::kUniform;
+    } else if (strings[0] == "chaikin") {
+      tags.crease_method = CreaseMethod::kChaikin;
+    } else {
+      error = fmt::format("creasemethod {} is not normal or chaikin", Quoted(strings[0]));
+      return false;
+    }
+    tags.crease_method_from_file = true;
+  } else if (name == "smoothtriangles") {
+    if (strings.size() == 1 && ints.empty() && floats.empty()) {
+      if (strings[0] == "catmark") {
+        tags.triangles = TriangleSubdivision::kCatmark;
+      } else if (strings[0] == "smooth") {
+        tags.triangles = TriangleSubdivision::kSmooth;
+      } else {
+        error = fmt::format("smoothtriangles {} is not catmark or smooth", Quoted(strings[0]));
+        return false;
+      }
+    } else if (ints.size() == 1 && floats.empty() && strings.empty()) {
+      // Hbr's integer form (OpenSubdiv 2): 2 is its edge rule, which Far's smooth triangles
+      // implement; 1 is its older face rule, which OpenSubdiv 3 does not have.
+      if (ints[0] == 0) {
+        tags.triangles = TriangleSubdivision::kCatmark;
+      } else if (ints[0] == 2) {
+        tags.triangles = TriangleSubdivision::kSmooth;
+      } else if (ints[0] == 1) {
+        error =
+            "smoothtriangles 1 (Hbr's older face rule) is not in OpenSubdiv 3; use 2 or "
+            "0/0/1 smooth (the edge rule)";
+        return false;
+      } else {
+        error = fmt::format("smoothtriangles {} is not 0 (catmark) or 2 (smooth)", ints[0]);
+        return false;
+      }
+    } else {
+      error = fmt::format("smoothtriangles tag needs 1 string, catmark or smooth (got {}/{}/{})",
+                          counts[0], counts[1], counts[2]);
+      return false;
+    }
+    tags.triangles_from_file = true;
   } else {
-    ++tags.ignored_tags;
+    // Printable and at most 64 bytes, so that warnings stay one line.
+    tags.ignored_tag_names.push_back(
+        text::TokenForMessage(name_token.data(), name_token.data() + name_token.size(), 64));
   }
   return true;
 }
 
 }  // namespace dispex::obj
+
+namespace dispex {
+
+std::vector<std::string> IgnoredTagWarnings(const Mesh& mesh) {
+  constexpr std::size_t kMaxNames = 10;  // a fuzzed file may hold millions of names
+  std::vector<std::pair<std::string_view, std::size_t>> distinct;  // name, lines
+  std::unordered_map<std::string_view, std::size_t> index;
+  for (const std::string& name : mesh.tags.ignored_tag_names) {
+    auto [it, added] = index.try_emplace(name, distinct.size());
+    if (added) distinct.emplace_back(name, 0);
+    ++distinct[it->second].second;
+  }
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < std::min(distinct.size(), kMaxNames); ++i) {
+    const auto& [name, lines] = distinct[i];
+    // Face-varying settings shape texture coordinates only, never the limit surface.
+    const bool face_varying =
+        name == "facevaryinginterpolateboundary" || name == "facevaryingpropagatecorners";
+    out.push_back(fmt::format(
+        "{}: tag '{}' ({} line{}) ignored{}", mesh.source, name, lines, lines == 1 ? "" : "s",
+        face_varying ? " (face-varying data is not used)" : ": dispex does not know it"));
+  }
+  if (distinct.size() > kMaxNames) {
+    out.push_back(
+        fmt::format("{}: {} more tag names ignored", mesh.source, distinct.size() - kMaxNames));
+  }
+  return out;
+}
+
+}  // namespace dispex

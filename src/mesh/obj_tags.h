@@ -25,9 +25,13 @@ struct TagLimits {
 //   corner  k/1/0 or k/k/0:   k vertices; one sharpness for all or one per vertex
 //   hole    k/0/0:            k face ids
 //   interpolateboundary 1/0/0 N: 0 none, 1 edge and corner, 2 edge only
-// Sharpness is clamped at 0 from below as OpenSubdiv does. Vertex and face ids are 0-based
-// and must be in range. Other tag names (facevaryinginterpolateboundary, smoothtriangles,
-// creasemethod, ...) are checked for well-formed counts and counted in tags.ignored_tags.
+//   creasemethod 0/0/1 S:        normal (uniform) or chaikin
+//   smoothtriangles 0/0/1 S:     catmark or smooth; also OpenSubdiv 2 (Hbr)'s 1/0/0 N:
+//                                0 catmark, 2 smooth, 1 an error (Hbr's other rule, not in Far)
+// The last setting tag of a kind wins. Sharpness is clamped at 0 from below as OpenSubdiv
+// does. Vertex and face ids are 0-based and must be in range. Other tag names
+// (facevaryinginterpolateboundary, ...) are checked for well-formed counts and their names
+// kept in tags.ignored_tag_names.
 bool ParseTag(const char*& p, const char* end, std::int64_t& line, const TagLimits& limits,
               SubdivTags& tags, std::string& error);
 

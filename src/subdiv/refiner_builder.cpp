@@ -118,8 +118,12 @@ Sdc::Options SchemeOptions(const SubdivTags& tags) {
       break;
   }
   options.SetFVarLinearInterpolation(Sdc::Options::FVAR_LINEAR_ALL);
-  options.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
-  options.SetTriangleSubdivision(Sdc::Options::TRI_SUB_CATMARK);
+  options.SetCreasingMethod(tags.crease_method == CreaseMethod::kChaikin
+                                ? Sdc::Options::CREASE_CHAIKIN
+                                : Sdc::Options::CREASE_UNIFORM);
+  options.SetTriangleSubdivision(tags.triangles == TriangleSubdivision::kSmooth
+                                     ? Sdc::Options::TRI_SUB_SMOOTH
+                                     : Sdc::Options::TRI_SUB_CATMARK);
   return options;
 }
 

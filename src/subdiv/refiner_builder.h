@@ -22,7 +22,10 @@ Status ValidateCage(const Mesh& cage);
 float MaxSemiSharpness(const SubdivTags& tags);
 
 // A Catmull-Clark refiner of the cage's base level with its tags (face-varying settings
-// ignored). Runs ValidateCage first; OpenSubdiv's own rejections become a Status too.
+// ignored). The one place where tags become Sdc::Options (boundary interpolation, crease
+// method, triangle subdivision): every surface, patch table and uniform refinement of dispex
+// starts from this refiner. Runs ValidateCage first; OpenSubdiv's own rejections become a
+// Status too.
 StatusOr<std::unique_ptr<OpenSubdiv::Far::TopologyRefiner>> BuildTopologyRefiner(const Mesh& cage);
 
 }  // namespace dispex::subdiv

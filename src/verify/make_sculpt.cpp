@@ -167,6 +167,7 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   }
   report.linear_error = quality.linear_error;
   report.folded_faces = quality.folded_faces;
+  report.warnings = IgnoredTagWarnings(cage);
   report.seconds = clock.seconds();
   return report;
 }

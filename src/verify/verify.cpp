@@ -201,6 +201,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   VerifyReport r;
   r.ptex_faces = static_cast<std::size_t>(surface.num_ptex_faces());
   r.diagonal = ComputeBounds(base).diagonal();
+  r.warnings = IgnoredTagWarnings(base);
   if (map.num_faces() != surface.num_ptex_faces()) {
     return Status::Error(fmt::format("{}: {} faces, but {} has {} Ptex faces: not a map of this "
                                      "base mesh", options.map_path, map.num_faces(),
@@ -344,6 +345,7 @@ std::string VerifyReportJson(const VerifyReport& r) {
               {"tolerance", r.map_tolerance}};
   j["passed"] = r.passed;
   if (!r.passed) j["failure"] = r.failure;
+  j["warnings"] = r.warnings;
   j["seconds"] = r.seconds;
   return j.dump(2) + "\n";
 }

@@ -4,7 +4,9 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 
 #include "dispex/extract.h"
 #include "dispex/mesh.h"
@@ -302,6 +304,60 @@ TEST_F(ExtractTest, CommandLineWritesMapAndJsonReport) {
                        dir_);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("--tolerance"), std::string::npos) << bad.err;
+}
+
+// A cage with tags dispex does not use: every command that reads it says so on stderr, naming
+// the file and the tag, and the extract report lists it. The Chaikin box also takes its
+// crease rule through make-sculpt, extract and verify: the map is within 4e-3 of the diagonal
+// of the exact heights (measured 1.6e-3), where the rules differ by 8.7e-3.
+TEST(IgnoredTags, EveryCommandAnnouncesThem) {
+  TempDir dir;
+  const std::string cage = dir / "tagged.obj";
+  {
+    std::ofstream out(cage, std::ios::binary);
+    out << testing::Slurp(DataPath("meshes/dispex/chaikin_box.obj"))
+        << "t facevaryinginterpolateboundary 1/0/0 1\nt somethingnew 0/0/0\n";
+  }
+  const std::string fvar = fmt::format(
+      "{}: tag 'facevaryinginterpolateboundary' (1 line) ignored (face-varying data is not used)",
+      cage);
+  const std::string unknown =
+      fmt::format("{}: tag 'somethingnew' (1 line) ignored: dispex does not know it", cage);
+  const std::string sculpt = dir / "sculpt.obj", map = dir / "map.ptx", json = dir / "r.json";
+
+  auto made = RunDispex("make-sculpt " + cage + " -o " + sculpt + " --levels 4", dir);
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  EXPECT_NE(made.err.find("dispex: warning: " + fvar + "\n"), std::string::npos) << made.err;
+  EXPECT_NE(made.err.find("dispex: warning: " + unknown + "\n"), std::string::npos) << made.err;
+
+  auto extracted =
+      RunDispex("extract " + cage + " " + sculpt + " -o " + map + " --report " + json, dir);
+  ASSERT_EQ(extracted.exit_code, 0) << extracted.err;
+  EXPECT_NE(extracted.err.find("  warning: " + fvar + "\n"), std::string::npos) << extracted.err;
+  EXPECT_NE(extracted.err.find("  warning: " + unknown + "\n"), std::string::npos) << extracted.err;
+  const auto report = nlohmann::json::parse(testing::Slurp(json));
+  const auto& warnings = report["warnings"];
+  EXPECT_NE(std::find(warnings.begin(), warnings.end(), fvar), warnings.end()) << warnings;
+  EXPECT_NE(std::find(warnings.begin(), warnings.end(), unknown), warnings.end()) << warnings;
+
+  auto verified = RunDispex(
+      "verify " + cage + " " + map + " --truth " + sculpt + ".truth --max-error-rel 4e-3", dir);
+  EXPECT_EQ(verified.exit_code, 0) << verified.out << verified.err;
+  EXPECT_NE(verified.err.find("dispex: warning: " + fvar + "\n"), std::string::npos)
+      << verified.err;
+
+  auto rendered = RunDispex("render " + cage + " -o " + (dir / "r.png") + " --size 64x64", dir);
+  EXPECT_EQ(rendered.exit_code, 0) << rendered.err;
+  EXPECT_NE(rendered.err.find("dispex: warning: " + unknown + "\n"), std::string::npos)
+      << rendered.err;
+
+  // Quiet commands print nothing, warnings included; the clean cage has none.
+  auto quiet = RunDispex("render " + cage + " -o " + (dir / "q.png") + " --size 64x64 -q", dir);
+  EXPECT_EQ(quiet.err, "");
+  auto clean = RunDispex("render " + DataPath("meshes/dispex/chaikin_box.obj") + " -o " +
+                             (dir / "c.png") + " --size 64x64",
+                         dir);
+  EXPECT_EQ(clean.err.find("warning"), std::string::npos) << clean.err;
 }
 
 }  // namespace

@@ -8,9 +8,9 @@
 #include <limits>
 #include <string>
 
+#include "contract_meshes.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
-#include "contract_meshes.h"
 
 namespace dispex {
 namespace {
@@ -94,8 +94,14 @@ TEST(ReaderContract, ComparesResultsExactly) {
   moved.positions[2].z = -0.0f;  // equal as numbers, not as bits
   EXPECT_NE(fuzz::CompareMeshResults(a, moved), "");
   Mesh tagged = Triangle("t.obj");
-  tagged.tags.ignored_tags = 1;
+  tagged.tags.ignored_tag_names = {"x"};
   EXPECT_NE(fuzz::CompareMeshResults(a, tagged), "");
+  Mesh chaikin = Triangle("t.obj");
+  chaikin.tags.crease_method = CreaseMethod::kChaikin;
+  EXPECT_NE(fuzz::CompareMeshResults(a, chaikin), "");
+  Mesh smooth = Triangle("t.obj");
+  smooth.tags.triangles = TriangleSubdivision::kSmooth;
+  EXPECT_NE(fuzz::CompareMeshResults(a, smooth), "");
   const StatusOr<Mesh> failed = Status::Error("t.obj:1: bad");
   EXPECT_NE(fuzz::CompareMeshResults(a, failed), "");
   EXPECT_EQ(fuzz::CompareMeshResults(failed, Status::Error("t.obj:1: bad")), "");

@@ -82,7 +82,15 @@ TEST(InfoCli, TagsAndWarningsInText) {
   const CliRun creases = Dispex("info " + Data("meshes/opensubdiv/catmark_cubes_infsharp.obj"));
   EXPECT_NE(creases.out.find("creases       18 (17 infinitely sharp)\n"), std::string::npos)
       << creases.out;
-  EXPECT_NE(creases.out.find("ignored tags  1\n"), std::string::npos) << creases.out;
+  EXPECT_NE(creases.out.find("ignored tags  1 (facevaryinginterpolateboundary)\n"),
+            std::string::npos)
+      << creases.out;
+  EXPECT_NE(creases.out.find("crease method uniform (default)\n"), std::string::npos)
+      << creases.out;
+  const CliRun tris = Dispex("info " + Data("meshes/opensubdiv/catmark_smoothtris0.obj"));
+  EXPECT_NE(tris.out.find("triangles     catmark (from the file)\n"), std::string::npos)
+      << tris.out;
+  EXPECT_NE(tris.out.find("ignored tags  0\n"), std::string::npos) << tris.out;
 }
 
 TEST(InfoCli, JsonParses) {
@@ -97,6 +105,10 @@ TEST(InfoCli, JsonParses) {
   EXPECT_EQ(j["groups"].size(), 0u);
   EXPECT_EQ(j["tags"]["boundary"], "edge_and_corner");
   EXPECT_EQ(j["tags"]["boundary_from_file"], false);
+  EXPECT_EQ(j["tags"]["crease_method"], "uniform");
+  EXPECT_EQ(j["tags"]["triangles"], "catmark");
+  EXPECT_EQ(j["tags"]["ignored"], 0);
+  EXPECT_EQ(j["tags"]["ignored_names"].size(), 0u);
   EXPECT_NEAR(j["bounds"]["min"][0].get<double>(), -0.0946899, 1e-7);
   EXPECT_NEAR(j["bounds"]["max"][1].get<double>(), 0.187321, 1e-7);
   EXPECT_NEAR(j["median_edge_length"].get<double>(), 0.0014670207735407127, 1e-9);

@@ -68,7 +68,10 @@ inline ::testing::AssertionResult SameMesh(const Mesh& a, const Mesh& b) {
   const SubdivTags& t = b.tags;
   if (s.creases.size() != t.creases.size() || s.corners.size() != t.corners.size() ||
       s.holes.size() != t.holes.size() || s.boundary != t.boundary ||
-      s.boundary_from_file != t.boundary_from_file || s.ignored_tags != t.ignored_tags) {
+      s.boundary_from_file != t.boundary_from_file || s.crease_method != t.crease_method ||
+      s.crease_method_from_file != t.crease_method_from_file || s.triangles != t.triangles ||
+      s.triangles_from_file != t.triangles_from_file ||
+      s.ignored_tag_names != t.ignored_tag_names) {
     return ::testing::AssertionFailure() << "tag counts or settings";
   }
   for (std::size_t i = 0; i < s.creases.size(); ++i) {

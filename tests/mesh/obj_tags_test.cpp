@@ -1,7 +1,8 @@
-// OpenSubdiv `t` tags (semantics of regression/common/far_utils.h).
+// OpenSubdiv `t` tags (semantics of regression/common/far_utils.h; see src/mesh/obj_tags.h).
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "dispex/mesh.h"
 #include "mesh_test_util.h"
@@ -90,15 +91,96 @@ TEST(ObjTags, InterpolateBoundaryValues) {
   EXPECT_EQ(last.tags.boundary, BoundaryInterpolation::kEdgeOnly);
 }
 
-TEST(ObjTags, OtherTagsAreCounted) {
+TEST(ObjTags, CreaseMethodAndTriangles) {
+  const Mesh none = ObjOrDie(kCube);
+  EXPECT_EQ(none.tags.crease_method, CreaseMethod::kUniform);
+  EXPECT_FALSE(none.tags.crease_method_from_file);
+  EXPECT_EQ(none.tags.triangles, TriangleSubdivision::kCatmark);
+  EXPECT_FALSE(none.tags.triangles_from_file);
+
+  const Mesh set = ObjOrDie(std::string(kCube) +
+                            "t creasemethod 0/0/1 chaikin\n"
+                            "t smoothtriangles 0/0/1 smooth\n");
+  EXPECT_EQ(set.tags.crease_method, CreaseMethod::kChaikin);
+  EXPECT_TRUE(set.tags.crease_method_from_file);
+  EXPECT_EQ(set.tags.triangles, TriangleSubdivision::kSmooth);
+  EXPECT_TRUE(set.tags.triangles_from_file);
+  EXPECT_TRUE(set.tags.ignored_tag_names.empty());
+  EXPECT_TRUE(set.tags.empty());
+
+  // The last tag of a kind wins, as in far_utils.h's GetSdcOptions.
+  const Mesh back = ObjOrDie(std::string(kCube) +
+                             "t creasemethod 0/0/1 chaikin\n"
+                             "t creasemethod 0/0/1 normal\n"
+                             "t smoothtriangles 0/0/1 smooth\n"
+                             "t smoothtriangles 0/0/1 catmark\n");
+  EXPECT_EQ(back.tags.crease_method, CreaseMethod::kUniform);
+  EXPECT_TRUE(back.tags.crease_method_from_file);
+  EXPECT_EQ(back.tags.triangles, TriangleSubdivision::kCatmark);
+  EXPECT_TRUE(back.tags.triangles_from_file);
+
+  // Hbr's integer form: 2 is the smooth (edge) rule, 0 Catmull-Clark.
+  EXPECT_EQ(ObjOrDie(std::string(kCube) + "t smoothtriangles 1/0/0 2\n").tags.triangles,
+            TriangleSubdivision::kSmooth);
+  const Mesh zero = ObjOrDie(std::string(kCube) + "t smoothtriangles 0/0/1 smooth\n" +
+                             "t smoothtriangles 1/0/0 0\n");
+  EXPECT_EQ(zero.tags.triangles, TriangleSubdivision::kCatmark);
+}
+
+TEST(ObjTags, SettingsAcrossChunksKeepTheLast) {
+  ReadOptions options;
+  options.threads = 2;
+  options.chunk_bytes = 16;
+  const Mesh mesh = ObjOrDie(std::string(kCube) + "t creasemethod 0/0/1 chaikin\n" +
+                                 "t smoothtriangles 0/0/1 smooth\n" + kCube +
+                                 "t facevaryingpropagatecorners 1/0/0 0\n" + kCube,
+                             options);
+  EXPECT_EQ(mesh.tags.crease_method, CreaseMethod::kChaikin);
+  EXPECT_EQ(mesh.tags.triangles, TriangleSubdivision::kSmooth);
+  EXPECT_EQ(mesh.tags.ignored_tag_names, std::vector<std::string>{"facevaryingpropagatecorners"});
+  const Mesh last = ObjOrDie(std::string(kCube) + "t creasemethod 0/0/1 chaikin\n" + kCube +
+                                 "t creasemethod 0/0/1 normal\n" + kCube,
+                             options);
+  EXPECT_EQ(last.tags.crease_method, CreaseMethod::kUniform);
+  EXPECT_TRUE(last.tags.crease_method_from_file);
+}
+
+TEST(ObjTags, OtherTagsAreKeptByName) {
   const Mesh mesh = ObjOrDie(std::string(kCube) +
                              "t facevaryinginterpolateboundary 1/0/0 1\n"
-                             "t smoothtriangles 0/0/1 catmark\n"
-                             "t creasemethod 0/0/1 chaikin\n"
                              "t facevaryingpropagatecorners 1/0/0 0\n"
-                             "t somethingnew 1/1/1 3 0.5 text\n");
-  EXPECT_EQ(mesh.tags.ignored_tags, 5);
+                             "t somethingnew 1/1/1 3 0.5 text\n"
+                             "t facevaryinginterpolateboundary 1/0/0 2\n");
+  EXPECT_EQ(
+      mesh.tags.ignored_tag_names,
+      (std::vector<std::string>{"facevaryinginterpolateboundary", "facevaryingpropagatecorners",
+                                "somethingnew", "facevaryinginterpolateboundary"}));
   EXPECT_TRUE(mesh.tags.empty());
+  EXPECT_EQ(mesh.tags.crease_method, CreaseMethod::kUniform);
+  EXPECT_EQ(mesh.tags.triangles, TriangleSubdivision::kCatmark);
+
+  const std::vector<std::string> warnings = IgnoredTagWarnings(mesh);
+  ASSERT_EQ(warnings.size(), 3u);
+  EXPECT_EQ(warnings[0],
+            "test.obj: tag 'facevaryinginterpolateboundary' (2 lines) ignored (face-varying data "
+            "is not used)");
+  EXPECT_EQ(warnings[1],
+            "test.obj: tag 'facevaryingpropagatecorners' (1 line) ignored (face-varying data is "
+            "not used)");
+  EXPECT_EQ(warnings[2], "test.obj: tag 'somethingnew' (1 line) ignored: dispex does not know it");
+  EXPECT_TRUE(IgnoredTagWarnings(ObjOrDie(kCube)).empty());
+
+  // Names are kept printable; past 10 names one line counts the rest.
+  std::string many = kCube;
+  for (int i = 0; i < 12; ++i) many += "t unknown" + std::to_string(i) + " 0/0/0\n";
+  many += "t bad\x01name 0/0/0\n";
+  const Mesh lots = ObjOrDie(many);
+  ASSERT_EQ(lots.tags.ignored_tag_names.size(), 13u);
+  EXPECT_EQ(lots.tags.ignored_tag_names[12], "bad?name");
+  const std::vector<std::string> capped = IgnoredTagWarnings(lots);
+  ASSERT_EQ(capped.size(), 11u);
+  EXPECT_EQ(capped[9], "test.obj: tag 'unknown9' (1 line) ignored: dispex does not know it");
+  EXPECT_EQ(capped[10], "test.obj: 3 more tag names ignored");
 }
 
 TEST(ObjTags, ContinuedTagLine) {
@@ -134,6 +216,23 @@ TEST(ObjTags, Errors) {
             "test.obj:15: tag 'crease' ends after 2 of its 4000000000 integers");
   EXPECT_EQ(ObjError(cube + "t smoothtriangles 0/0/1\n"),
             "test.obj:15: tag 'smoothtriangles' ends after 0 of its 1 strings");
+  EXPECT_EQ(ObjError(cube + "t creasemethod 0/0/1 uniform\n"),
+            "test.obj:15: creasemethod 'uniform' is not normal or chaikin");
+  EXPECT_EQ(ObjError(cube + "t creasemethod 1/0/0 1\n"),
+            "test.obj:15: creasemethod tag needs 1 string, normal or chaikin (got 1/0/0)");
+  EXPECT_EQ(ObjError(cube + "t creasemethod 0/0/2 chaikin normal\n"),
+            "test.obj:15: creasemethod tag needs 1 string, normal or chaikin (got 0/0/2)");
+  EXPECT_EQ(ObjError(cube + "t smoothtriangles 0/0/1 loop\n"),
+            "test.obj:15: smoothtriangles 'loop' is not catmark or smooth");
+  EXPECT_EQ(ObjError(cube + "t smoothtriangles 1/0/0 1\n"),
+            "test.obj:15: smoothtriangles 1 (Hbr's older face rule) is not in OpenSubdiv 3; use "
+            "2 or 0/0/1 smooth (the edge rule)");
+  EXPECT_EQ(ObjError(cube + "t smoothtriangles 1/0/0 3\n"),
+            "test.obj:15: smoothtriangles 3 is not 0 (catmark) or 2 (smooth)");
+  EXPECT_EQ(ObjError(cube + "t smoothtriangles 1/0/1 2 smooth\n"),
+            "test.obj:15: smoothtriangles tag needs 1 string, catmark or smooth (got 1/0/1)");
+  EXPECT_EQ(ObjError(cube + "t smoothtriangles 0/0/0\n"),
+            "test.obj:15: smoothtriangles tag needs 1 string, catmark or smooth (got 0/0/0)");
   EXPECT_EQ(ObjError(cube + "t crease 2/1/0 0 1 \\\n inf\n"),
             "test.obj:16: tag 'crease': value 'inf' is not a finite number");
 }

@@ -35,12 +35,23 @@ struct Expected {
   // counts the zero-length sides (v, v) of its degenerate faces as edges; dispex does not.
   std::size_t topology[5];
   // creases, corners, hole faces, interpolateboundary value in the file (-1: none), ignored
+  // tag lines
   int tags[5];
   const char* group;  // the only group name, or "" when the file has no o/g line
 };
 
 const std::vector<Expected>& Table() {
   static const std::vector<Expected> table = {
+      {"dispex/chaikin_box.obj",
+       56,
+       54,
+       {{4, 54}},
+       {-1.5, -1.5, -1.5},
+       {1.5, 1.5, 1.5},
+       1.0,
+       {0, 0, 0, 0, 0},
+       {4, 0, 0, -1, 0},
+       ""},
       {"jerry_the_ogre/controlmesh.obj",
        1329,
        1308,
@@ -329,7 +340,7 @@ const std::vector<Expected>& Table() {
        {1.0, 1.0, 1.0},
        1.0000002220212008,
        {0, 0, 0, 0, 0},
-       {0, 0, 0, -1, 1},
+       {0, 0, 0, -1, 0},  // smoothtriangles is understood (catmark)
        ""},
       {"opensubdiv/catmark_tent.obj",
        16,
@@ -468,7 +479,7 @@ TEST_P(RealMesh, MatchesIndependentCounts) {
                                             BoundaryInterpolation::kEdgeOnly};
   EXPECT_EQ(mesh.tags.boundary,
             e.tags[3] < 0 ? BoundaryInterpolation::kEdgeAndCorner : boundary[e.tags[3]]);
-  EXPECT_EQ(mesh.tags.ignored_tags, e.tags[4]);
+  EXPECT_EQ(static_cast<int>(mesh.tags.ignored_tag_names.size()), e.tags[4]);
 
   if (std::string(e.group).empty()) {
     EXPECT_TRUE(mesh.group_names.empty());
@@ -541,6 +552,19 @@ TEST(RealMeshes, TagValues) {
   EXPECT_EQ(semisharp->tags.corners[1].vertex.value, 16);
   EXPECT_EQ(semisharp->tags.corners[1].sharpness, 3.0f);
   EXPECT_EQ(semisharp->tags.creases[2].sharpness, 0.1f);  // t crease 2/1/0 24 25 0.1
+  EXPECT_EQ(semisharp->tags.ignored_tag_names,
+            std::vector<std::string>{"facevaryinginterpolateboundary"});
+
+  StatusOr<Mesh> tris = ReadObj(DataPath("meshes/opensubdiv/catmark_smoothtris0.obj"));
+  ASSERT_TRUE(tris.ok()) << tris.status().message();
+  EXPECT_EQ(tris->tags.triangles, TriangleSubdivision::kCatmark);  // 0/0/1 catmark
+  EXPECT_TRUE(tris->tags.triangles_from_file);
+
+  StatusOr<Mesh> chaikin = ReadObj(DataPath("meshes/dispex/chaikin_box.obj"));
+  ASSERT_TRUE(chaikin.ok()) << chaikin.status().message();
+  EXPECT_EQ(chaikin->tags.crease_method, CreaseMethod::kChaikin);
+  ASSERT_EQ(chaikin->tags.creases.size(), 4u);
+  EXPECT_EQ(chaikin->tags.creases[3].sharpness, 3.0f);  // t crease 2/1/0 23 21 3
 }
 
 // The ogre cage writes `f v/vt/vn` with no `vn` lines: the dangling normal indices are ignored.

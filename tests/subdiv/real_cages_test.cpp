@@ -10,7 +10,10 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dispex/mesh.h"
@@ -79,7 +82,7 @@ INSTANTIATE_TEST_SUITE_P(
         Cage{"opensubdiv/catmark_pole64.obj", false},
         Cage{"opensubdiv/catmark_val2_interior.obj", false},
         Cage{"opensubdiv/catmark_pyramid.obj", true},
-        Cage{"opensubdiv/catmark_smoothtris0.obj", true},
+        Cage{"opensubdiv/catmark_smoothtris0.obj", true}, Cage{"dispex/chaikin_box.obj", true},
         Cage{"opensubdiv/catmark_gregory_test8.obj", true},
         Cage{"opensubdiv/catmark_torus.obj", false},
         Cage{"opensubdiv/catmark_torus_creases0.obj", false},
@@ -110,11 +113,9 @@ struct RefineCase {
   int levels;
 };
 
-class RealCageRefineTest : public ::testing::TestWithParam<RefineCase> {};
-
-TEST_P(RealCageRefineTest, MatchesPrimvarRefiner) {
-  const Mesh mesh = ReadOrDie(GetParam().path);
-  const int levels = GetParam().levels;
+// Counts and face-vertex lists of RefineUniform equal Far's, positions and normals its
+// Limit's away from base vertices.
+void ExpectRefinementMatchesFar(const Mesh& mesh, int levels, const std::string& name) {
   StatusOr<LimitSurface> s = LimitSurface::Build(mesh);
   ASSERT_TRUE(s.ok()) << s.status().message();
   StatusOr<RefinedMesh> r = RefineUniform(*s, levels);
@@ -144,7 +145,13 @@ TEST_P(RealCageRefineTest, MatchesPrimvarRefiner) {
   // the Gregory end caps' error at level 10 (measured <= 5.4e-6 rad on the ogre).
   EXPECT_LT(max_angle, 5e-5);
   std::printf("  %-40s level %d: %d vertices compared, position %.2e, normal %.2e rad\n",
-              GetParam().path, levels, compared, max_err, max_angle);
+              name.c_str(), levels, compared, max_err, max_angle);
+}
+
+class RealCageRefineTest : public ::testing::TestWithParam<RefineCase> {};
+
+TEST_P(RealCageRefineTest, MatchesPrimvarRefiner) {
+  ExpectRefinementMatchesFar(ReadOrDie(GetParam().path), GetParam().levels, GetParam().path);
 }
 
 INSTANTIATE_TEST_SUITE_P(Cages, RealCageRefineTest,
@@ -152,6 +159,7 @@ INSTANTIATE_TEST_SUITE_P(Cages, RealCageRefineTest,
                                            RefineCase{"opensubdiv/catmark_nonquads.obj", 3},
                                            RefineCase{"opensubdiv/catmark_cubes_infsharp.obj", 3},
                                            RefineCase{"opensubdiv/catmark_pole64.obj", 2},
+                                           RefineCase{"dispex/chaikin_box.obj", 4},
                                            RefineCase{"keenan_spot/spot_control_mesh.obj", 3},
                                            RefineCase{"jerry_the_ogre/controlmesh.obj", 2}),
                          [](const ::testing::TestParamInfo<RefineCase>& param) {
@@ -202,6 +210,116 @@ TEST(RealCageTest, TagsReachOpenSubdiv) {
   StatusOr<LimitSurface> blub = LimitSurface::Build(ReadOrDie("keenan_blub/blub_control_mesh.obj"));
   ASSERT_TRUE(blub.ok());
   EXPECT_EQ(blub->num_ptex_faces(), 144);
+}
+
+// ---- Tags that change the surface: t creasemethod, t smoothtriangles ----------------------
+
+// catmark_smoothtris0 (all triangles) with its `t smoothtriangles 0/0/1 catmark` made
+// `smooth`: OpenSubdiv's smooth-triangle rule.
+Mesh SmoothTriangles() {
+  const std::string path = DataPath("opensubdiv/catmark_smoothtris0.obj");
+  std::ifstream in(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string tag = "t smoothtriangles 0/0/1 catmark";
+  const std::size_t at = text.find(tag);
+  EXPECT_NE(at, std::string::npos);
+  if (at != std::string::npos) text.replace(at, tag.size(), "t smoothtriangles 0/0/1 smooth");
+  StatusOr<Mesh> mesh = ParseObj(text, path);
+  EXPECT_TRUE(mesh.ok()) << mesh.status().message();
+  return mesh.ok() ? std::move(mesh).value() : Mesh{};
+}
+
+TEST(TagOptionsTest, SmoothTrianglesMatchPatchTable) {
+  const Mesh mesh = SmoothTriangles();
+  ASSERT_EQ(mesh.tags.triangles, TriangleSubdivision::kSmooth);
+  const OracleComparison c = CompareWithOracle(mesh, {}, 6);
+  ASSERT_TRUE(c.built) << c.error;
+  EXPECT_GT(c.samples, 0);
+  EXPECT_LT(c.max_position_error, 1e-5);
+  EXPECT_LT(c.max_normal_angle_regular, 1e-4);
+  EXPECT_GT(c.mean_outward, 0.0);
+}
+
+TEST(TagOptionsTest, SmoothTrianglesRefineLikeFar) {
+  ExpectRefinementMatchesFar(SmoothTriangles(), 3, "catmark_smoothtris0 (smooth)");
+}
+
+// Largest distance between the limit surfaces of two cages of the same topology (texel
+// centres of a 9 x 9 grid on every Ptex face), / bounding-box diagonal. `fast_path_equal`:
+// whether every face `a` evaluates on the regular fast path is the same on both.
+struct SurfaceDifference {
+  double max = 0;
+  int fast_path_faces = 0;
+  bool fast_path_equal = true;
+};
+
+SurfaceDifference Difference(const Mesh& a, const Mesh& b) {
+  SurfaceDifference out;
+  StatusOr<LimitSurface> sa = LimitSurface::Build(a);
+  StatusOr<LimitSurface> sb = LimitSurface::Build(b);
+  EXPECT_TRUE(sa.ok() && sb.ok());
+  if (!sa.ok() || !sb.ok()) return out;
+  LimitEvaluator ea(*sa), eb(*sb);
+  constexpr int kN = 9;
+  std::vector<float> pa(3 * kN * kN), pb(3 * kN * kN);
+  const double diag = subdiv_test::BoundsDiagonal(a);
+  for (int f = 0; f < sa->num_ptex_faces(); ++f) {
+    const std::int64_t regular_before = ea.stats().regular_faces;
+    EXPECT_TRUE(ea.EvaluateGrid(PtexFaceId(f), kN, kN, pa, {}).ok());
+    EXPECT_TRUE(eb.EvaluateGrid(PtexFaceId(f), kN, kN, pb, {}).ok());
+    double face_max = 0;
+    for (int i = 0; i < kN * kN; ++i) {
+      const double d[3] = {pa[3 * i] - pb[3 * i], pa[3 * i + 1] - pb[3 * i + 1],
+                           pa[3 * i + 2] - pb[3 * i + 2]};
+      face_max = std::max(face_max, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) / diag);
+    }
+    out.max = std::max(out.max, face_max);
+    if (ea.stats().regular_faces > regular_before) {
+      ++out.fast_path_faces;
+      out.fast_path_equal = out.fast_path_equal && face_max == 0;
+    }
+  }
+  return out;
+}
+
+// Each option moves the surface far beyond the oracle tolerances above (1e-5 of the
+// diagonal), so the oracle tests would fail if the option were dropped. Faces on the regular
+// fast path are the same under both options: it is never used where an option matters.
+TEST(TagOptionsTest, OptionsChangeTheSurface) {
+  const Mesh chaikin = ReadOrDie("dispex/chaikin_box.obj");
+  ASSERT_EQ(chaikin.tags.crease_method, CreaseMethod::kChaikin);
+  Mesh uniform = chaikin;
+  uniform.tags.crease_method = CreaseMethod::kUniform;
+  const SurfaceDifference creases = Difference(chaikin, uniform);
+  EXPECT_GT(creases.max, 1e-3);
+  EXPECT_GT(creases.fast_path_faces, 0);
+  EXPECT_TRUE(creases.fast_path_equal);
+
+  const Mesh smooth = SmoothTriangles();
+  Mesh catmark = smooth;
+  catmark.tags.triangles = TriangleSubdivision::kCatmark;
+  const SurfaceDifference triangles = Difference(smooth, catmark);
+  EXPECT_GT(triangles.max, 1e-3);
+  std::printf("  chaikin vs uniform %.3e (%d fast-path faces), smooth vs catmark %.3e\n",
+              creases.max, creases.fast_path_faces, triangles.max);
+
+  // Uniform refinement too (the refined cage of each option against the other's).
+  for (const auto& [x, y] : {std::pair(&chaikin, &uniform), std::pair(&smooth, &catmark)}) {
+    StatusOr<LimitSurface> sx = LimitSurface::Build(*x);
+    StatusOr<LimitSurface> sy = LimitSurface::Build(*y);
+    ASSERT_TRUE(sx.ok() && sy.ok());
+    StatusOr<RefinedMesh> rx = RefineUniform(*sx, 2);
+    StatusOr<RefinedMesh> ry = RefineUniform(*sy, 2);
+    ASSERT_TRUE(rx.ok() && ry.ok());
+    ASSERT_EQ(rx->mesh.num_vertices(), ry->mesh.num_vertices());
+    double max = 0;
+    for (std::size_t v = 0; v < rx->mesh.num_vertices(); ++v) {
+      const Float3 &p = rx->mesh.positions[v], &q = ry->mesh.positions[v];
+      max = std::max({max, std::abs(double(p.x) - q.x), std::abs(double(p.y) - q.y),
+                      std::abs(double(p.z) - q.z)});
+    }
+    EXPECT_GT(max / subdiv_test::BoundsDiagonal(*x), 1e-3) << x->source;
+  }
 }
 
 }  // namespace

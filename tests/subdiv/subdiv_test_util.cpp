@@ -161,10 +161,17 @@ struct Point3 {
   }
 };
 
-// The cage as an OpenSubdiv refiner (Catmull-Clark, its tags and boundary rule), built here
-// with the library's own descriptor so that the oracles do not share dispex's topology code.
+// The cage as an OpenSubdiv refiner (Catmull-Clark, its tags, boundary, crease and triangle
+// rules), built here with the library's own descriptor so that the oracles do not share
+// dispex's topology code.
 std::unique_ptr<Far::TopologyRefiner> CreateRefiner(const Mesh& cage) {
   Sdc::Options sdc;
+  if (cage.tags.crease_method == CreaseMethod::kChaikin) {
+    sdc.SetCreasingMethod(Sdc::Options::CREASE_CHAIKIN);
+  }
+  if (cage.tags.triangles == TriangleSubdivision::kSmooth) {
+    sdc.SetTriangleSubdivision(Sdc::Options::TRI_SUB_SMOOTH);
+  }
   switch (cage.tags.boundary) {
     case BoundaryInterpolation::kNone:
       sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_NONE);
