@@ -1,6 +1,7 @@
-// dispex verify BASE [SCULPT] MAP.ptx [--truth FILE] [--max-error E]
+// dispex verify BASE [SCULPT] MAP.ptx [--truth FILE [--tolerance T]] [--max-error E]
 #include <fmt/format.h>
 
+#include <cmath>
 #include <cstdio>
 
 #include "command.h"
@@ -32,6 +33,12 @@ int RunVerify(VerifyArgs& args) {
   }
   if (!(o.max_error >= 0) || !(o.max_error_rel >= 0) || !(o.max_rms >= 0)) {
     return ReportFailure(Status::Error("--max-error, --max-error-rel and --max-rms must be >= 0"),
+                         2);
+  }
+  if (!(o.tolerance >= 0) || !std::isfinite(o.tolerance) || !(o.truth_rms_factor >= 0) ||
+      !(o.truth_p99_factor >= 0) || !(o.truth_local_tolerance_factor > 0)) {
+    return ReportFailure(Status::Error("--tolerance, --truth-rms-factor and --truth-p99-factor "
+                                       "must be >= 0, --truth-local-factor > 0"),
                          2);
   }
   auto report = Verify(o);
@@ -71,6 +78,18 @@ void SetupVerify(CLI::App& app, int& exit_code) {
                   "fail when a max error exceeds this fraction of the bounding-box diagonal");
   cmd->add_option("--max-rms", o.max_rms,
                   "fail (exit 3) when an RMS error exceeds this, object units");
+  cmd->add_option("--tolerance", o.tolerance,
+                  "tau of the truth bounds (default: the map's own, from its meta data)");
+  cmd->add_option("--truth-rms-factor", o.truth_rms_factor,
+                  "fail when the truth RMS exceeds this x tau (0: off)")
+      ->capture_default_str();
+  cmd->add_option("--truth-p99-factor", o.truth_p99_factor,
+                  "fail when the truth 99th percentile exceeds this x tau (0: off)")
+      ->capture_default_str();
+  cmd->add_option("--truth-local-factor", o.truth_local_tolerance_factor,
+                  "k of the per-record bound k tau + 2 x the sculpt's local linear error")
+      ->capture_default_str();
+  cmd->add_flag("!--no-local-bound", o.truth_local_bound, "no per-record bound");
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")->capture_default_str();
   cmd->add_option("--report", args->report_path, "write a JSON report to this file");
   cmd->add_flag("-q,--quiet", args->quiet, "no summary on stdout");
