@@ -307,6 +307,21 @@ TEST_F(WrongMaps, GoodMapPassesAndShiftedScaledReversedMapsFail) {
                            dir_);
   EXPECT_EQ(passing.exit_code, 0) << passing.err;
   EXPECT_NE(testing::Slurp(dir_ / "v.json").find("\"truth\""), std::string::npos);
+  EXPECT_NE(testing::Slurp(dir_ / "v.json").find("\"records_over\": 0"), std::string::npos);
+  // The truth bounds: the scaled map breaks them (exit 3, one line); bad factors are exit 2.
+  std::string scaled_map = dir_ / "scaled.ptx";
+  auto scaled_cli = RunDispex("verify " + cage_ + " " + scaled_map + " --truth " + sculpt_ +
+                                  ".truth --tolerance " + std::to_string(tolerance_) + " -q",
+                              dir_);
+  EXPECT_EQ(scaled_cli.exit_code, 3) << scaled_cli.err;
+  EXPECT_NE(scaled_cli.err.find("records exceed 1.5 x tolerance"), std::string::npos)
+      << scaled_cli.err;
+  EXPECT_EQ(std::count(scaled_cli.err.begin(), scaled_cli.err.end(), '\n'), 1);
+  auto bad = RunDispex(
+      "verify " + cage_ + " " + scaled_map + " --truth " + sculpt_ + ".truth --truth-rms-factor -1",
+      dir_);
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
 }
 
 TEST_F(WrongMaps, MapOfAnotherMeshIsRejected) {
