@@ -99,7 +99,7 @@ inline void WriteWrongMap(const std::string& good, const std::string& out, Wrong
 }
 
 // The accuracy check of the end-to-end tests: `map` against the truth with verify's default
-// bounds at tolerance `tau` (the per-record bound tau + 2 e_v, RMS and p99 in units of tau).
+// bounds at tolerance `tau` (the per-record bound 1.5 tau + 2 e_v, RMS and p99 in units of tau).
 inline VerifyReport CheckTruth(const std::string& base, const std::string& map,
                                const std::string& truth, double tau) {
   VerifyOptions verify;
