@@ -1,4 +1,4 @@
-// dispex verify BASE [SCULPT] MAP.ptx [--truth FILE] [--max-error E]
+// dispex verify BASE [SCULPT] MAP.ptx [--truth FILE [--tolerance T]] [--max-error E]
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -74,6 +74,22 @@ void SetupVerify(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-rms", o.max_rms,
                   "fail (exit 3) when an RMS error exceeds this, object units")
       ->check(Positive());
+  cmd->add_option("--tolerance", o.tolerance,
+                  "tau of the truth bounds (default: the map's own, from its meta data)")
+      ->check(Positive());
+  cmd->add_option("--truth-rms-factor", o.truth_rms_factor,
+                  "fail when the truth RMS exceeds this x tau (0: off)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  cmd->add_option("--truth-p99-factor", o.truth_p99_factor,
+                  "fail when the truth 99th percentile exceeds this x tau (0: off)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  cmd->add_option("--truth-local-factor", o.truth_local_tolerance_factor,
+                  "k of the per-record bound k tau + 2 x the sculpt's local linear error")
+      ->check(Positive())
+      ->capture_default_str();
+  cmd->add_flag("!--no-local-bound", o.truth_local_bound, "no per-record bound");
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
       ->check(NonNegative())
       ->capture_default_str();

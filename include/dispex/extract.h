@@ -106,6 +106,9 @@ struct ExtractReport {
 
   // Sampling and rays.
   std::array<std::int64_t, 10> oversample_faces{};  // faces by log2 of the samples per side
+  // Automatic oversampling's rule: the L of a sculpt that is the base subdivided L times, or
+  // -1 when the sculpt is measured by density (area) or oversampling is fixed.
+  int oversample_subdivision_level = -1;
   std::int64_t samples = 0;
   std::uint64_t rays_cast = 0;
   std::int64_t hits_positive = 0, hits_negative = 0;

@@ -64,26 +64,49 @@ struct PatternFrame {
 // MakeSculpt evaluates through the cage's UVs).
 double EvaluatePattern(Pattern pattern, const PatternFrame& frame, const float p[3]);
 
+// How the sculpt's vertices sit on the base.
+enum class SculptLayout : std::uint8_t {
+  // The cage refined `levels` times: quads whose vertices lie exactly on the power-of-two
+  // texel grids of the Ptex faces, and which extract's oversampling recognises by face count.
+  kRefined,
+  // `density` x `density` cells per quad Ptex face, density / 2 per n-gon sub-face (so both
+  // sides of every base edge have `density` cells; density must be even on cages with
+  // n-gons), with vertices at jittered (u, v): interior ones by up to 0.3 cell in u and v, those on
+  // a Ptex face's
+  // edges by up to 0.3 cell along the edge only, corners and base edge midpoints fixed;
+  // vertices on shared edges are shared (named by base vertex, base edge and n-gon spoke), so
+  // the sculpt is watertight. Each
+  // cell is split into two triangles along a random diagonal (the other one where the
+  // random one would flip a triangle in (u, v)). Seeded by `seed`, deterministic.
+  kJittered,
+};
+// "refined", "jittered".
+std::string_view SculptLayoutName(SculptLayout layout);
+StatusOr<SculptLayout> ParseSculptLayout(std::string_view name);
+
 struct MakeSculptOptions {
   std::string cage_path;
   std::string output_path;  // the sculpt, OBJ
   std::string truth_path;   // empty: output_path + ".truth"
-  int levels = 4;           // uniform Catmull-Clark refinements, 1..8
+  int levels = 4;           // uniform Catmull-Clark refinements, 1..8 (kRefined only)
+  SculptLayout layout = SculptLayout::kRefined;
+  int density = 0;  // kJittered: cells per quad face side, 2..256 (0 for kRefined)
   Pattern pattern = Pattern::kDetail;
-  std::string image_path;   // Pattern::kImage: the height image (PNG)
-  double amplitude = 0;     // object units; 0: 1% of the base's bounding-box diagonal
-  std::uint32_t seed = 1;
+  std::string image_path;  // Pattern::kImage: the height image (PNG)
+  double amplitude = 0;    // object units; 0: 1% of the base's bounding-box diagonal
+  std::uint32_t seed = 1;  // the noise pattern's and the jittered layout's
   int threads = 0;
 };
 
 struct MakeSculptReport {
-  std::size_t vertices = 0, faces = 0;
+  std::size_t vertices = 0, faces = 0;  // faces: quads (kRefined) or triangles (kJittered)
   double amplitude = 0, diagonal = 0, edge = 0;
   double h_min = 0, h_max = 0;
-  // The sculpt's own piecewise-linear error: over every sculpt quad, the largest distance from
-  // the true displaced surface at the quad's parametric centre to the midpoints of the quad's
-  // two diagonals (where a ray tracer's triangles put the centre). A map extracted from the
-  // sculpt cannot be closer to the truth than this.
+  // The sculpt's own piecewise-linear error: over every sculpt face, the largest distance from
+  // the true displaced surface to the face at the parametric midpoints of its edges and at its
+  // centre (a quad's against the midpoints of both diagonals, where a ray tracer's triangles
+  // put it; a triangle's centroid). A map extracted from the sculpt cannot be closer to the truth
+  // than this. The truth file holds it per vertex, over the faces near the vertex (GroundTruth).
   double linear_error = 0;
   // Sculpt quads turned inside out: the displaced surface folds there (|h| x curvature >= 1),
   // so rays along the limit normal can miss it or meet another sheet.
@@ -92,20 +115,25 @@ struct MakeSculptReport {
   double seconds = 0;
 };
 
-// Refines the cage `levels` times (OpenSubdiv, tags honoured), puts each vertex on the limit
-// surface and moves it along the limit normal by h. Writes the sculpt (OBJ, quads) and the
-// truth file: for every sculpt vertex its (Ptex face, u, v) on the base and h there. With
+// Refines the cage `levels` times (OpenSubdiv, tags honoured) or lays out a jittered grid per
+// Ptex face (SculptLayout), puts each vertex on the limit surface and moves it along the limit
+// normal by h. Writes the sculpt (OBJ, quads or triangles) and the truth file (version 2): for
+// every sculpt vertex its (Ptex face, u, v) on the base, h there and the local linear error. With
 // Pattern::kImage, fails before refining (one line naming the file) when the cage has no UVs
 // on every face or the image cannot be read (missing, not a PNG, truncated, corrupt, larger
 // than 2^28 pixels).
 StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options);
 
-// The truth file: "DISPEXGT" magic, u32 version (1), u32 zero, u64 count, then count records
-// of {i32 Ptex face, f32 u, f32 v, f32 h}, little-endian.
+// The truth file: "DISPEXGT" magic, u32 version, u32 zero, u64 count, then count records,
+// little-endian: version 1 {i32 Ptex face, f32 u, f32 v, f32 h}; version 2 adds f32 e_v, the
+// sculpt's local linear error (MakeSculptReport::linear_error over the faces within two rings
+// of the vertex; infinite when one of them folds). Written as version 2 when local_error is filled,
+// else version 1.
 struct GroundTruth {
   std::vector<PtexFaceId> faces;
   std::vector<float> uvs;  // 2 per record
   std::vector<float> h;
+  std::vector<float> local_error;  // empty (version 1) or one per record
   std::size_t size() const { return h.size(); }
 };
 Status WriteGroundTruth(const std::string& path, const GroundTruth& truth);
@@ -121,7 +149,7 @@ struct VerifyOptions {
   std::string base_path;
   std::string sculpt_path;  // may be empty with truth_path: then only the truth is compared
   std::string map_path;
-  std::string truth_path;   // a make-sculpt truth file: compare the map with the exact h
+  std::string truth_path;  // a make-sculpt truth file: compare the map with the exact h
   // Samples per side of each Ptex face for the displaced surface: 0 = twice the face's map
   // resolution, between 8 and 64.
   int samples_per_face = 0;
@@ -131,7 +159,25 @@ struct VerifyOptions {
   double max_error = 0;      // fail when an error's max exceeds this (object units; 0: off)
   double max_error_rel = 0;  // the same relative to the base bounding-box diagonal
   double max_rms = 0;        // fail when an RMS error exceeds this (object units; 0: off)
+  // Bounds against the truth, scaled by the tolerance tau: this one, or 0 for the map's own
+  // (its dispex:statistics meta data); with neither they are not checked.
+  double tolerance = 0;
+  // Per record of a version-2 truth file: fail when |map - h| > k tau + 2 e_v at any record,
+  // k = truth_local_tolerance_factor and e_v the sculpt's linear error near the vertex
+  // (GroundTruth). k > 1: extract holds tau at its samples only; between them (read on a
+  // coarser texel grid) and within half a sample of a face edge (where the read is clamped)
+  // good maps reach 1.3 tau (docs/ACCURACY.md).
+  bool truth_local_bound = true;
+  double truth_local_tolerance_factor = kDefaultTruthLocalToleranceFactor;
+  // Fail when the truth RMS exceeds truth_rms_factor x tau, or its 99th percentile exceeds
+  // truth_p99_factor x tau (0: off). Good maps stay under 0.36 tau and 1.26 tau on every
+  // sculpt of docs/ACCURACY.md.
+  double truth_rms_factor = kDefaultTruthRmsFactor;
+  double truth_p99_factor = kDefaultTruthP99Factor;
   int threads = 0;
+  static constexpr double kDefaultTruthLocalToleranceFactor = 1.5;
+  static constexpr double kDefaultTruthRmsFactor = 0.5;
+  static constexpr double kDefaultTruthP99Factor = 1.5;
 };
 
 struct ErrorStats {
@@ -147,8 +193,21 @@ struct VerifyReport {
   ErrorStats map_to_sculpt;  // displaced limit surface -> nearest sculpt point
   ErrorStats sculpt_to_map;  // sculpt vertices -> nearest point of the displaced surface
   bool measured_truth = false;
-  ErrorStats truth;          // |map(face, u, v) - h| at every truth record
+  ErrorStats truth;  // |map(face, u, v) - h| at every truth record
   double truth_signed_mean = 0;
+  double truth_tolerance = 0;               // tau of the truth bounds (0: they were not checked)
+  bool truth_local_checked = false;         // the per-record bound (a version-2 truth file)
+  std::size_t truth_over_bound = 0;         // records with |map - h| > k tau + 2 e_v
+  double truth_worst_ratio = 0;             // the largest |map - h| / (k tau + 2 e_v)
+  double truth_local_tolerance_factor = 0;  // k
+  std::size_t truth_unbounded = 0;  // records near folded sculpt faces (e_v infinite): unchecked
+  struct TruthRecord {
+    std::size_t index = 0;
+    int face = -1;
+    float u = 0, v = 0, h = 0, map = 0, local_error = 0;
+  };
+  TruthRecord truth_worst;                          // the record of truth_worst_ratio
+  double truth_rms_limit = 0, truth_p99_limit = 0;  // 0: not checked
   struct WorstFace {
     int face = -1;
     double max = 0;

@@ -270,6 +270,7 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
   }
   OversamplingPlan plan = PlanOversampling(surface, sculpt, coarse.face_areas, options.oversample,
                                            options.min_oversample, options.max_oversample);
+  report.oversample_subdivision_level = plan.subdivision_level;
   coarse = {};
   report.t_search = clock.seconds();
 

@@ -59,6 +59,9 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
     if (r.oversample_faces[k]) oversample[std::to_string(1 << k)] = r.oversample_faces[k];
   }
   j["oversample_faces"] = oversample;
+  j["oversample_rule"] = r.options.oversample > 0                 ? "fixed"
+                         : r.oversample_subdivision_level >= 0 ? "subdivision level"
+                                                               : "sculpt density";
   j["samples"] = r.samples;
   j["rays_cast"] = r.rays_cast;
   j["hits"] = {{"positive", r.hits_positive}, {"negative", r.hits_negative},

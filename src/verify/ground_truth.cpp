@@ -11,12 +11,18 @@ namespace dispex {
 
 namespace {
 constexpr char kMagic[8] = {'D', 'I', 'S', 'P', 'E', 'X', 'G', 'T'};
-constexpr std::size_t kHeader = 24, kRecord = 16;
+constexpr std::size_t kHeader = 24, kRecordV1 = 16, kRecordV2 = 20;
 }  // namespace
 
 Status WriteGroundTruth(const std::string& path, const GroundTruth& truth) {
   DISPEX_ASSIGN_OR_RETURN(AtomicOutput out, AtomicOutput::Create(path));
-  std::uint32_t version = 1, zero = 0;
+  if (!truth.local_error.empty() && truth.local_error.size() != truth.size()) {
+    return Status::Error(fmt::format("{}: {} local errors for {} records", path,
+                                     truth.local_error.size(), truth.size()));
+  }
+  const bool v2 = !truth.local_error.empty();
+  const std::size_t record_size = v2 ? kRecordV2 : kRecordV1;
+  std::uint32_t version = v2 ? 2 : 1, zero = 0;
   std::uint64_t count = truth.size();
   DISPEX_RETURN_IF_ERROR(out.Write(kMagic, 8));
   DISPEX_RETURN_IF_ERROR(out.Write(&version, 4));
@@ -26,13 +32,14 @@ Status WriteGroundTruth(const std::string& path, const GroundTruth& truth) {
   constexpr std::size_t kChunk = 1 << 16;
   for (std::size_t start = 0; start < count; start += kChunk) {
     std::size_t end = std::min<std::size_t>(count, start + kChunk);
-    buffer.resize((end - start) * kRecord);
+    buffer.resize((end - start) * record_size);
     char* p = buffer.data();
-    for (std::size_t i = start; i < end; ++i, p += kRecord) {
+    for (std::size_t i = start; i < end; ++i, p += record_size) {
       std::int32_t face = truth.faces[i].value;
       std::memcpy(p, &face, 4);
       std::memcpy(p + 4, &truth.uvs[2 * i], 8);
       std::memcpy(p + 12, &truth.h[i], 4);
+      if (v2) std::memcpy(p + 16, &truth.local_error[i], 4);
     }
     DISPEX_RETURN_IF_ERROR(out.Write(buffer.data(), buffer.size()));
   }
@@ -48,8 +55,12 @@ StatusOr<GroundTruth> ReadGroundTruth(const std::string& path) {
   std::uint64_t count = 0;
   std::memcpy(&version, file.data() + 8, 4);
   std::memcpy(&count, file.data() + 16, 8);
-  if (version != 1) return Status::Error(fmt::format("{}: unsupported version {}", path, version));
-  if (count > (file.size() - kHeader) / kRecord || kHeader + count * kRecord != file.size()) {
+  if (version != 1 && version != 2) {
+    return Status::Error(fmt::format("{}: unsupported version {}", path, version));
+  }
+  const std::size_t record_size = version == 2 ? kRecordV2 : kRecordV1;
+  if (count > (file.size() - kHeader) / record_size ||
+      kHeader + count * record_size != file.size()) {
     return Status::Error(fmt::format("{}: {} records claimed but the file holds {} bytes", path,
                                      count, file.size()));
   }
@@ -57,13 +68,15 @@ StatusOr<GroundTruth> ReadGroundTruth(const std::string& path) {
   truth.faces.resize(count);
   truth.uvs.resize(2 * count);
   truth.h.resize(count);
+  if (version == 2) truth.local_error.resize(count);
   const char* p = file.data() + kHeader;
-  for (std::size_t i = 0; i < count; ++i, p += kRecord) {
+  for (std::size_t i = 0; i < count; ++i, p += record_size) {
     std::int32_t face;
     std::memcpy(&face, p, 4);
     truth.faces[i] = PtexFaceId(face);
     std::memcpy(&truth.uvs[2 * i], p + 4, 8);
     std::memcpy(&truth.h[i], p + 12, 4);
+    if (version == 2) std::memcpy(&truth.local_error[i], p + 16, 4);
   }
   return truth;
 }

@@ -1,16 +1,20 @@
-// Ground-truth sculpts: the cage refined uniformly with OpenSubdiv, every vertex on the limit
-// surface and moved along the limit normal by a known pattern h (pattern_field.h), which is
-// evaluated at each vertex's (Ptex face, u, v) and limit position.
+// Ground-truth sculpts: the cage refined uniformly with OpenSubdiv, or a jittered triangulated
+// grid on every Ptex face, every vertex on the limit surface and moved along the limit normal
+// by a known pattern h (pattern_field.h), which is evaluated at each vertex's (Ptex face, u, v)
+// and limit position.
 #include <fmt/format.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cmath>
+#include <array>
 #include <atomic>
+#include <cmath>
+#include <limits>
+#include <numeric>
 #include <optional>
-
-#include <tbb/enumerable_thread_specific.h>
+#include <unordered_map>
 
 #include "core/atomic_output.h"
 #include "core/system.h"
@@ -24,67 +28,399 @@ namespace dispex {
 
 namespace {
 
+// The sculpt before displacement: vertices on the limit surface, and where each face lies.
+struct SculptLayoutMesh {
+  Mesh mesh;
+  std::vector<float> normals;          // 3 per vertex
+  std::vector<PtexFaceId> ptex_faces;  // per vertex: the Ptex face of its truth record...
+  std::vector<float> uvs;              // ...and its (u, v) there
+  std::vector<PtexFaceId> face_ptex;   // per face: the Ptex face containing it...
+  std::vector<float> corner_uvs;       // ...and its corners' (u, v) there, 2 per face corner
+};
+
+std::uint64_t Mix(std::uint64_t x) {  // splitmix64's finaliser
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+// Uniform in [-1, 1), a pure function of its arguments.
+double Jitter(std::uint32_t seed, std::uint64_t a, std::uint64_t b, std::uint64_t c) {
+  std::uint64_t h = Mix(Mix(Mix(Mix(seed) ^ a) ^ b) ^ c);
+  return double(h >> 11) * 0x1.0p-52 - 1.0;
+}
+
+constexpr double kJitter = 0.3;  // of a cell
+
+struct KeyHash {
+  std::size_t operator()(const std::array<std::int64_t, 4>& k) const {
+    return Mix(Mix(Mix(Mix(std::uint64_t(k[0])) ^ std::uint64_t(k[1])) ^ std::uint64_t(k[2])) ^
+               std::uint64_t(k[3]));
+  }
+};
+
+// `n` cells per side of a quad Ptex face, n / 2 on n-gon sub-faces, so that both sides of a
+// base edge have n cells. A vertex on the base is named by where it lies: a cage vertex, step
+// j of a base edge (from its lower vertex), step r of the spoke from edge k's midpoint to
+// the centre of an n-gon, the centre, or a Ptex face's interior grid point. Jitter is a
+// function of that name, so every Ptex face touching a vertex puts it at the same place.
+StatusOr<SculptLayoutMesh> BuildJittered(const Mesh& cage, const LimitSurface& surface, int n,
+                                         std::uint32_t seed) {
+  const int faces = surface.num_ptex_faces();
+  for (int f = 0; f < faces; ++f) {
+    BaseFaceId base = surface.base_face(PtexFaceId(f));
+    if (surface.base_face_size(base) != 4 && n % 2 != 0) {
+      return Status::Error(
+          fmt::format("density {}: the cage has n-gons, whose sub-faces take "
+                      "density / 2 cells per side: must be even",
+                      n));
+    }
+  }
+  const int half = n / 2;
+  using Key = std::array<std::int64_t, 4>;
+  // A point of base edge (a, b) at step p of n from a: its name and its place in [0, 1] from a.
+  auto edge_point = [&](std::int32_t a, std::int32_t b, int p, Key& key) {
+    const std::int32_t lo = std::min(a, b), hi = std::max(a, b);
+    const int j = a < b ? p : n - p;
+    double q;
+    if (j == 0 || j == n) {
+      key = {0, j == 0 ? lo : hi, 0, 0};
+      q = j == 0 ? 0 : 1;
+    } else {
+      key = {1, lo, hi, j};
+      q = (j + (2 * j == n ? 0.0
+                           : kJitter * Jitter(seed, std::uint64_t(lo), std::uint64_t(hi),
+                                              std::uint64_t(j)))) /
+          n;
+    }
+    return a < b ? q : 1 - q;
+  };
+  // Step r of `half` on spoke k of base face `face` (r = 0: edge k's midpoint).
+  auto spoke_point = [&](BaseFaceId face, std::span<const std::int32_t> fv, int k, int r,
+                         Key& key) {
+    if (r == 0) {
+      edge_point(fv[k], fv[(k + 1) % fv.size()], half, key);
+      return 0.0;
+    }
+    if (r == half) {
+      key = {2, face.value, 0, 0};
+      return 1.0;
+    }
+    key = {3, face.value, k, r};
+    return (r + kJitter * Jitter(seed, std::uint64_t(face.value) + (1ull << 40), std::uint64_t(k),
+                                 std::uint64_t(r))) /
+           half;
+  };
+  // Slot (i, j) of Ptex face f on edge e at step t (counter-clockwise): its name and (u, v).
+  auto boundary = [&](int f, int e, int t, Key& key, float* uv) {
+    PtexFaceId face(f);
+    BaseFaceId base = surface.base_face(face);
+    auto fv = cage.face(std::size_t(base.value));
+    const int size = static_cast<int>(fv.size());
+    double s;
+    if (size == 4) {
+      s = edge_point(fv[e], fv[(e + 1) % 4], t, key);
+    } else {
+      const int k = surface.sub_face(face);
+      switch (e) {
+        case 0:
+          s = 2 * edge_point(fv[k], fv[(k + 1) % size], t, key);
+          break;
+        case 1:
+          s = spoke_point(base, fv, k, t, key);
+          break;
+        case 2:
+          s = 1 - spoke_point(base, fv, (k + size - 1) % size, half - t, key);
+          break;
+        default:
+          s = 2 * edge_point(fv[(k + size - 1) % size], fv[k], half + t, key) - 1;
+          break;
+      }
+    }
+    const double p[4][2] = {{s, 0}, {1, s}, {1 - s, 1}, {0, 1 - s}};
+    uv[0] = static_cast<float>(std::clamp(p[e][0], 0.0, 1.0));
+    uv[1] = static_cast<float>(std::clamp(p[e][1], 0.0, 1.0));
+  };
+  std::vector<std::size_t> first_slot(std::size_t(faces) + 1, 0);
+  std::vector<int> cells(std::size_t(faces), 0);
+  for (int f = 0; f < faces; ++f) {
+    const bool quad = surface.base_face_size(surface.base_face(PtexFaceId(f))) == 4;
+    cells[f] = surface.is_hole(PtexFaceId(f)) ? 0 : quad ? n : half;
+    const std::size_t side = std::size_t(cells[f]) + 1;
+    first_slot[f + 1] = first_slot[f] + (cells[f] ? side * side : 0);
+  }
+  const std::size_t slots = first_slot[faces];
+  if (slots >= (std::size_t{1} << 31)) {
+    return Status::Error(
+        fmt::format("density {}: {} Ptex faces would need more than 2^31 "
+                    "vertices",
+                    n, faces));
+  }
+  auto slot = [&](int f, int i, int j) {
+    return first_slot[f] + std::size_t(j) * std::size_t(cells[f] + 1) + std::size_t(i);
+  };
+  std::vector<float> uv(2 * slots);
+  std::vector<std::uint32_t> vertex(slots);
+  // One vertex per name, numbered in order of first use; its truth record is that first use,
+  // so the vertices each face adds are contiguous.
+  SculptLayoutMesh out;
+  std::unordered_map<Key, std::uint32_t, KeyHash> names;
+  std::vector<std::size_t> first_vertex(std::size_t(faces) + 1, 0);
+  for (int f = 0; f < faces; ++f) {
+    first_vertex[f] = out.ptex_faces.size();
+    const int m = cells[f];
+    for (int j = 0; j <= m && m > 0; ++j) {
+      for (int i = 0; i <= m; ++i) {
+        const std::size_t s = slot(f, i, j);
+        Key key;
+        if (i > 0 && i < m && j > 0 && j < m) {
+          key = {4, f, i, j};
+          uv[2 * s] = static_cast<float>((i + kJitter * Jitter(seed, s, 0, 1)) / m);
+          uv[2 * s + 1] = static_cast<float>((j + kJitter * Jitter(seed, s, 0, 2)) / m);
+        } else {
+          const int e = j == 0 ? 0 : i == m ? 1 : j == m ? 2 : 3;
+          const int t = e == 0 ? i : e == 1 ? j : e == 2 ? m - i : m - j;
+          boundary(f, e, t, key, &uv[2 * s]);
+        }
+        auto [it, added] = names.try_emplace(key, std::uint32_t(out.ptex_faces.size()));
+        vertex[s] = it->second;
+        if (added) {
+          out.ptex_faces.push_back(PtexFaceId(f));
+          out.uvs.push_back(uv[2 * s]);
+          out.uvs.push_back(uv[2 * s + 1]);
+        }
+      }
+    }
+  }
+  first_vertex[faces] = out.ptex_faces.size();
+  const std::size_t count = out.ptex_faces.size();
+  out.mesh.positions.resize(count);
+  out.normals.resize(3 * count);
+  // Two triangles per cell, counter-clockwise in (u, v) as the Ptex face is.
+  out.mesh.face_offsets.push_back(0);
+  for (int f = 0; f < faces; ++f) {
+    const int m = cells[f];
+    for (int j = 0; j < m; ++j) {
+      for (int i = 0; i < m; ++i) {
+        const std::size_t c[4] = {slot(f, i, j), slot(f, i + 1, j), slot(f, i + 1, j + 1),
+                                  slot(f, i, j + 1)};
+        auto area = [&](int a, int b, int d) {
+          const float* p = &uv[2 * c[a]];
+          const float* q = &uv[2 * c[b]];
+          const float* r = &uv[2 * c[d]];
+          return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+        };
+        bool first = Jitter(seed, slot(f, i, j), 0, 4) < 0;
+        if (first && !(area(0, 1, 2) > 0 && area(0, 2, 3) > 0)) first = false;
+        if (!first && !(area(0, 1, 3) > 0 && area(1, 2, 3) > 0)) first = true;
+        const int tris[2][2][3] = {{{0, 1, 3}, {1, 2, 3}}, {{0, 1, 2}, {0, 2, 3}}};
+        for (const auto& tri : tris[first ? 1 : 0]) {
+          for (int k : tri) {
+            out.mesh.face_indices.push_back(std::int32_t(vertex[c[k]]));
+            out.corner_uvs.push_back(uv[2 * c[k]]);
+            out.corner_uvs.push_back(uv[2 * c[k] + 1]);
+          }
+          out.mesh.face_offsets.push_back(std::uint32_t(out.mesh.face_indices.size()));
+          out.face_ptex.push_back(PtexFaceId(f));
+        }
+      }
+    }
+  }
+  tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
+  tbb::enumerable_thread_specific<std::vector<float>> positions;
+  std::atomic<bool> failed{false};
+  tbb::parallel_for(0, faces, [&](int f) {
+    const std::size_t begin = first_vertex[f], end = first_vertex[f + 1];
+    if (begin == end) return;
+    auto& evaluator = evaluators.local();
+    if (!evaluator) evaluator.emplace(surface);
+    std::vector<float>& p = positions.local();
+    p.resize(3 * (end - begin));
+    std::span<const float> uvs(&out.uvs[2 * begin], 2 * (end - begin));
+    std::span<float> nrm(&out.normals[3 * begin], 3 * (end - begin));
+    if (!evaluator->EvaluatePoints(PtexFaceId(f), uvs, p, nrm).ok()) failed = true;
+    for (std::size_t v = begin; v < end; ++v) {
+      const float* q = &p[3 * (v - begin)];
+      out.mesh.positions[v] = Float3{q[0], q[1], q[2]};
+    }
+  });
+  if (failed) return Status::Error("evaluating the limit surface at a sculpt vertex failed");
+  return out;
+}
+
+SculptLayoutMesh FromRefined(RefinedMesh&& refined) {
+  SculptLayoutMesh out;
+  out.mesh = std::move(refined.mesh);
+  out.normals = std::move(refined.normals);
+  out.ptex_faces = std::move(refined.ptex_faces);
+  out.uvs = std::move(refined.uvs);
+  out.face_ptex = std::move(refined.face_ptex);
+  out.corner_uvs = std::move(refined.face_uvs);  // quads: 8 per face, 2 per corner
+  return out;
+}
+
 struct SculptQuality {
+  std::vector<float> face_errors;
   double linear_error = 0;
   std::size_t folded_faces = 0;
 };
 
-// See MakeSculptReport::linear_error and folded_faces. `refined.mesh` already holds the
+// See MakeSculptReport::linear_error and folded_faces. `layout.mesh` already holds the
 // displaced positions.
-StatusOr<SculptQuality> MeasureSculpt(const LimitSurface& surface, const RefinedMesh& refined,
+StatusOr<SculptQuality> MeasureSculpt(const LimitSurface& surface, const SculptLayoutMesh& layout,
                                       const PatternField& pattern) {
-  const Mesh& mesh = refined.mesh;
+  const Mesh& mesh = layout.mesh;
   const std::size_t faces = mesh.num_faces();
-  std::vector<float> errors(faces, 0.0f);
+  SculptQuality quality;
+  quality.face_errors.assign(faces, 0.0f);
   std::vector<std::uint8_t> folded(faces, 0);
   tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
   std::atomic<bool> failed{false};
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, faces, 1024),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-    auto& evaluator = evaluators.local();
-    if (!evaluator) evaluator.emplace(surface);
-    for (std::size_t f = range.begin(); f < range.end(); ++f) {
-      auto face = mesh.face(f);
-      if (face.size() != 4) continue;
-      const float* c = &refined.face_uvs[8 * f];
-      float uv[2] = {0.25f * (c[0] + c[2] + c[4] + c[6]), 0.25f * (c[1] + c[3] + c[5] + c[7])};
-      float p[3], n[3];
-      if (!evaluator->EvaluatePoints(refined.face_ptex[f], uv, p, n).ok()) {
-        failed = true;
-        return;
-      }
-      double h = pattern(refined.face_ptex[f], uv[0], uv[1], p);
-      double truth[3] = {p[0] + h * n[0], p[1] + h * n[1], p[2] + h * n[2]};
-      auto at = [&](int k) { return mesh.positions[static_cast<std::size_t>(face[k])]; };
-      double worst = 0;
-      for (int d = 0; d < 2; ++d) {
-        Float3 a = at(d), b = at(d + 2);
-        double mx = 0.5 * (double(a.x) + b.x) - truth[0], my = 0.5 * (double(a.y) + b.y) - truth[1],
-               mz = 0.5 * (double(a.z) + b.z) - truth[2];
-        worst = std::max(worst, std::sqrt(mx * mx + my * my + mz * mz));
-      }
-      errors[f] = static_cast<float>(worst);
-      Float3 a = at(0), b = at(1), c2 = at(2), d = at(3);
-      double e1[3] = {double(c2.x) - a.x, double(c2.y) - a.y, double(c2.z) - a.z};
-      double e2[3] = {double(d.x) - b.x, double(d.y) - b.y, double(d.z) - b.z};
-      double fn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                      e1[0] * e2[1] - e1[1] * e2[0]};
-      folded[f] = fn[0] * n[0] + fn[1] * n[1] + fn[2] * n[2] < 0;
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, faces, 1024),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        auto& evaluator = evaluators.local();
+        if (!evaluator) evaluator.emplace(surface);
+        for (std::size_t f = range.begin(); f < range.end(); ++f) {
+          auto face = mesh.face(f);
+          const std::size_t size = face.size();
+          if (size != 3 && size != 4) continue;
+          const float* c = &layout.corner_uvs[2 * mesh.face_offsets[f]];
+          auto at = [&](std::size_t k) {
+            return mesh.positions[static_cast<std::size_t>(face[k])];
+          };
+          // Points of the face in (u, v), with the linear surface there: the edge midpoints, and
+          // the centre of a quad against both diagonals' midpoints or a triangle's centroid.
+          float uv[10];
+          double linear[5][3];
+          int points = 0;
+          auto add = [&](std::initializer_list<std::size_t> corners) {
+            double w = 1.0 / double(corners.size());
+            uv[2 * points] = uv[2 * points + 1] = 0;
+            for (int d = 0; d < 3; ++d) linear[points][d] = 0;
+            for (std::size_t k : corners) {
+              uv[2 * points] += float(w * c[2 * k]);
+              uv[2 * points + 1] += float(w * c[2 * k + 1]);
+              Float3 q = at(k);
+              linear[points][0] += w * q.x, linear[points][1] += w * q.y,
+                  linear[points][2] += w * q.z;
+            }
+            ++points;
+          };
+          if (size == 4) {
+            add({0, 1, 2, 3});
+            add({0, 1});
+            add({1, 2});
+            add({2, 3});
+            add({3, 0});
+          } else {
+            add({0, 1, 2});
+            add({0, 1});
+            add({1, 2});
+            add({2, 0});
+          }
+          float p[15], n[15];
+          if (!evaluator
+                   ->EvaluatePoints(layout.face_ptex[f], std::span<const float>(uv, 2 * points),
+                                    std::span<float>(p, 3 * points),
+                                    std::span<float>(n, 3 * points))
+                   .ok()) {
+            failed = true;
+            return;
+          }
+          double worst = 0;
+          for (int s = 0; s < points; ++s) {
+            double h = pattern(layout.face_ptex[f], uv[2 * s], uv[2 * s + 1], &p[3 * s]);
+            double truth[3] = {p[3 * s] + h * n[3 * s], p[3 * s + 1] + h * n[3 * s + 1],
+                               p[3 * s + 2] + h * n[3 * s + 2]};
+            auto distance = [&](const double* q) {
+              double dx = q[0] - truth[0], dy = q[1] - truth[1], dz = q[2] - truth[2];
+              return std::sqrt(dx * dx + dy * dy + dz * dz);
+            };
+            if (size == 4 && s == 0) {
+              for (int d = 0; d < 2; ++d) {
+                Float3 a = at(d), b = at(d + 2);
+                double mid[3] = {0.5 * (double(a.x) + b.x), 0.5 * (double(a.y) + b.y),
+                                 0.5 * (double(a.z) + b.z)};
+                worst = std::max(worst, distance(mid));
+              }
+            } else {
+              worst = std::max(worst, distance(linear[s]));
+            }
+          }
+          quality.face_errors[f] = static_cast<float>(worst);
+          Float3 a = at(0), b = at(1), c2 = at(2), d = size == 4 ? at(3) : at(0);
+          double e1[3], e2[3];
+          if (size == 4) {  // the diagonals
+            e1[0] = double(c2.x) - a.x, e1[1] = double(c2.y) - a.y, e1[2] = double(c2.z) - a.z;
+            e2[0] = double(d.x) - b.x, e2[1] = double(d.y) - b.y, e2[2] = double(d.z) - b.z;
+          } else {
+            e1[0] = double(b.x) - a.x, e1[1] = double(b.y) - a.y, e1[2] = double(b.z) - a.z;
+            e2[0] = double(c2.x) - a.x, e2[1] = double(c2.y) - a.y, e2[2] = double(c2.z) - a.z;
+          }
+          double fn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                          e1[0] * e2[1] - e1[1] * e2[0]};
+          folded[f] = fn[0] * n[0] + fn[1] * n[1] + fn[2] * n[2] < 0;
+        }
+      });
   if (failed) return Status::Error("evaluating the limit surface at a sculpt face centre failed");
-  SculptQuality quality;
-  if (faces) quality.linear_error = *std::max_element(errors.begin(), errors.end());
+  if (faces) {
+    quality.linear_error =
+        *std::max_element(quality.face_errors.begin(), quality.face_errors.end());
+  }
   for (std::uint8_t f : folded) quality.folded_faces += f;
+  // No bound holds near a fold (rays can meet another sheet): infinite local error there.
+  for (std::size_t f = 0; f < faces; ++f) {
+    if (folded[f]) quality.face_errors[f] = std::numeric_limits<float>::infinity();
+  }
   return quality;
+}
+
+// Per vertex, the largest face error within two rings: the faces around the vertex and every
+// face touching them. A map's value at the vertex is read from the samples around it, which
+// lie within one sample spacing (at most half a sculpt edge) and whose rays meet faces of the
+// one-ring; the second ring covers rays that leave the one-ring sideways (the normal turns
+// between the base and the sculpt) and uneven cells (jittered layouts).
+std::vector<float> LocalErrors(const Mesh& mesh, const std::vector<float>& face_errors) {
+  std::vector<float> ring1(mesh.num_vertices(), 0.0f), local(mesh.num_vertices(), 0.0f);
+  for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+    for (std::int32_t v : mesh.face(f)) ring1[v] = std::max(ring1[v], face_errors[f]);
+  }
+  for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+    float m = 0;
+    for (std::int32_t v : mesh.face(f)) m = std::max(m, ring1[v]);
+    for (std::int32_t v : mesh.face(f)) local[v] = std::max(local[v], m);
+  }
+  return local;
 }
 
 }  // namespace
 
+std::string_view SculptLayoutName(SculptLayout layout) {
+  return layout == SculptLayout::kJittered ? "jittered" : "refined";
+}
+
+StatusOr<SculptLayout> ParseSculptLayout(std::string_view name) {
+  if (name == "refined") return SculptLayout::kRefined;
+  if (name == "jittered") return SculptLayout::kJittered;
+  return Status::Error(fmt::format("unknown layout '{}' (refined, jittered)", name));
+}
+
 StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   Stopwatch clock;
-  if (options.levels < 1 || options.levels > 8) {
+  const bool jittered = options.layout == SculptLayout::kJittered;
+  if (!jittered && (options.levels < 1 || options.levels > 8)) {
     return Status::Error(fmt::format("--levels {}: must be 1..8", options.levels));
+  }
+  if (jittered && (options.density < 2 || options.density > 256)) {
+    return Status::Error(
+        fmt::format("density {}: the jittered layout needs 2..256 cells per "
+                    "Ptex face side",
+                    options.density));
+  }
+  if (!jittered && options.density != 0) {
+    return Status::Error(
+        fmt::format("density {}: only the jittered layout has a density", options.density));
   }
   if (!(std::isfinite(options.amplitude) && options.amplitude >= 0)) {
     return Status::Error(fmt::format("--amplitude {}: must be >= 0", options.amplitude));
@@ -110,7 +446,8 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   frame.center[1] = 0.5f * (box.min.y + box.max.y);
   frame.center[2] = 0.5f * (box.min.z + box.max.z);
   frame.diagonal = box.diagonal();
-  frame.edge = MedianEdgeLength(cage) / double(1 << options.levels);
+  frame.edge =
+      MedianEdgeLength(cage) / (jittered ? double(options.density) : double(1 << options.levels));
   frame.amplitude = options.amplitude > 0 ? options.amplitude : 0.01 * frame.diagonal;
   frame.seed = options.seed;
   // Before the refinement, so that a bad image or a cage without UVs fails at once.
@@ -118,37 +455,47 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
       PatternField pattern,
       PatternField::Create(options.pattern, options.image_path, frame, cage, surface));
 
-  RefineOptions refine_options;
-  refine_options.face_charts = true;
-  DISPEX_ASSIGN_OR_RETURN(RefinedMesh refined,
-                          RefineUniform(surface, options.levels, refine_options));
+  SculptLayoutMesh layout;
+  if (jittered) {
+    DISPEX_ASSIGN_OR_RETURN(layout, BuildJittered(cage, surface, options.density, options.seed));
+  } else {
+    RefineOptions refine_options;
+    refine_options.face_charts = true;
+    DISPEX_ASSIGN_OR_RETURN(RefinedMesh refined,
+                            RefineUniform(surface, options.levels, refine_options));
+    layout = FromRefined(std::move(refined));
+  }
 
-  Mesh& sculpt = refined.mesh;
+  Mesh& sculpt = layout.mesh;
   const std::size_t n = sculpt.num_vertices();
   GroundTruth truth;
-  truth.faces = std::move(refined.ptex_faces);
-  truth.uvs = std::move(refined.uvs);
+  truth.faces = layout.ptex_faces;
+  truth.uvs = layout.uvs;
   truth.h.resize(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t v = range.begin(); v < range.end(); ++v) {
                         Float3& p = sculpt.positions[v];
                         const float xyz[3] = {p.x, p.y, p.z};
-                        double h = pattern(truth.faces[v], truth.uvs[2 * v],
-                                           truth.uvs[2 * v + 1], xyz);
+                        double h =
+                            pattern(truth.faces[v], truth.uvs[2 * v], truth.uvs[2 * v + 1], xyz);
                         truth.h[v] = static_cast<float>(h);
-                        p.x = static_cast<float>(p.x + h * refined.normals[3 * v]);
-                        p.y = static_cast<float>(p.y + h * refined.normals[3 * v + 1]);
-                        p.z = static_cast<float>(p.z + h * refined.normals[3 * v + 2]);
+                        p.x = static_cast<float>(p.x + h * layout.normals[3 * v]);
+                        p.y = static_cast<float>(p.y + h * layout.normals[3 * v + 1]);
+                        p.z = static_cast<float>(p.z + h * layout.normals[3 * v + 2]);
                       }
                     });
-  DISPEX_ASSIGN_OR_RETURN(SculptQuality quality, MeasureSculpt(surface, refined, pattern));
-  const std::string pattern_name =
-      options.pattern == Pattern::kImage ? "image:" + options.image_path
-                                         : std::string(PatternName(options.pattern));
-  std::string header = fmt::format(
-      "# dispex make-sculpt: {} refined {} times, pattern {}, amplitude {}, seed {}\n",
-      options.cage_path, options.levels, pattern_name, frame.amplitude, options.seed);
+  DISPEX_ASSIGN_OR_RETURN(SculptQuality quality, MeasureSculpt(surface, layout, pattern));
+  truth.local_error = LocalErrors(sculpt, quality.face_errors);
+  const std::string pattern_name = options.pattern == Pattern::kImage
+                                       ? "image:" + options.image_path
+                                       : std::string(PatternName(options.pattern));
+  const std::string how =
+      jittered ? fmt::format("jittered {}x{} per Ptex face", options.density, options.density)
+               : fmt::format("refined {} times", options.levels);
+  std::string header =
+      fmt::format("# dispex make-sculpt: {} {}, pattern {}, amplitude {}, seed {}\n",
+                  options.cage_path, how, pattern_name, frame.amplitude, options.seed);
   DISPEX_RETURN_IF_ERROR(WriteObj(options.output_path, sculpt, header));
   std::string truth_path =
       options.truth_path.empty() ? options.output_path + ".truth" : options.truth_path;

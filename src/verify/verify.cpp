@@ -5,6 +5,8 @@
 // nearest point of the sculpt. Sculpt -> map: each sculpt vertex's distance to the nearest
 // point of the displaced surface, tessellated on the same grid. Truth: the map against the
 // exact displacement of a generated sculpt at each of its vertices' (face, u, v).
+#include "dispex/verify.h"
+
 #include <fmt/format.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
@@ -13,17 +15,15 @@
 #include <algorithm>
 #include <cmath>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <numeric>
 #include <optional>
-
-#include <nlohmann/json.hpp>
 
 #include "core/system.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
-#include "dispex/verify.h"
 
 namespace dispex {
 
@@ -49,14 +49,13 @@ ErrorStats Summarise(std::vector<float>& values) {
 }
 
 struct DisplacedSurface {
-  Mesh mesh;                       // (k+1)^2 vertices and k^2 quads per face
-  std::vector<Float3> samples;     // k^2 points per face at cell centres
+  Mesh mesh;                    // (k+1)^2 vertices and k^2 quads per face
+  std::vector<Float3> samples;  // k^2 points per face at cell centres
   std::vector<std::int32_t> sample_face;
-  std::vector<int> k;              // per face, 0 for holes
+  std::vector<int> k;  // per face, 0 for holes
 };
 
-StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const PtexFile& map,
-                                    int fixed_k) {
+StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const PtexFile& map, int fixed_k) {
   const int n = surface.num_ptex_faces();
   DisplacedSurface d;
   d.k.assign(static_cast<std::size_t>(n), 0);
@@ -161,8 +160,8 @@ std::vector<float> ClosestDistances(const Tracer& tracer, std::span<const Float3
     auto& out = results.local();
     out.resize(end - begin);
     TraceCounters counters;
-    tracer.ClosestPoints(points.subspan(begin, end - begin),
-                         std::numeric_limits<float>::infinity(), out, counters);
+    tracer.ClosestPoints(points.subspan(begin, end - begin), std::numeric_limits<float>::infinity(),
+                         out, counters);
     for (std::size_t i = begin; i < end; ++i) distances[i] = out[i - begin].distance;
   });
   return distances;
@@ -203,9 +202,10 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   r.diagonal = ComputeBounds(base).diagonal();
   r.warnings = IgnoredTagWarnings(base);
   if (map.num_faces() != surface.num_ptex_faces()) {
-    return Status::Error(fmt::format("{}: {} faces, but {} has {} Ptex faces: not a map of this "
-                                     "base mesh", options.map_path, map.num_faces(),
-                                     options.base_path, surface.num_ptex_faces()));
+    return Status::Error(fmt::format(
+        "{}: {} faces, but {} has {} Ptex faces: not a map of this "
+        "base mesh",
+        options.map_path, map.num_faces(), options.base_path, surface.num_ptex_faces()));
   }
   if (map.header().num_channels < 1) return Status::Error(options.map_path + ": no channels");
   if (const PtexMetaItem* stats = map.FindMetaData("dispex:statistics")) {
@@ -213,7 +213,8 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     if (j.is_object()) {
       r.map_misses = j.value("misses", std::int64_t{-1});
       r.map_holes_filled = j.value("holes_filled", std::int64_t{-1});
-      r.map_faces_filled_from_neighbours = j.value("faces_filled_from_neighbours", std::int64_t{-1});
+      r.map_faces_filled_from_neighbours =
+          j.value("faces_filled_from_neighbours", std::int64_t{-1});
       r.map_tolerance = j.value("tolerance", 0.0);
     }
   }
@@ -237,10 +238,36 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     double sum = 0;
     for (float e : signed_errors) sum += e;
     r.truth_signed_mean = truth.size() ? sum / double(truth.size()) : 0;
+    r.truth_tolerance = options.tolerance > 0 ? options.tolerance : r.map_tolerance;
+    if (r.truth_tolerance > 0 && options.truth_local_bound && !truth.local_error.empty()) {
+      // Sequential, so the worst record is the first of the largest ratio.
+      r.truth_local_checked = true;
+      r.truth_local_tolerance_factor = options.truth_local_tolerance_factor;
+      for (std::size_t i = 0; i < truth.size(); ++i) {
+        double bound = options.truth_local_tolerance_factor * r.truth_tolerance +
+                       2.0 * double(truth.local_error[i]);
+        if (std::isinf(bound)) {
+          ++r.truth_unbounded;
+          continue;
+        }
+        double ratio = double(errors[i]) / bound;
+        if (ratio > 1) ++r.truth_over_bound;
+        if (ratio > r.truth_worst_ratio || !std::isfinite(ratio)) {
+          r.truth_worst_ratio = ratio;
+          r.truth_worst = {
+              i,          truth.faces[i].value,          truth.uvs[2 * i],    truth.uvs[2 * i + 1],
+              truth.h[i], truth.h[i] + signed_errors[i], truth.local_error[i]};
+        }
+      }
+    }
     r.truth = Summarise(errors);
     r.measured_truth = true;
     if (r.truth.count && !std::isfinite(r.truth.max)) {
       return Status::Error(options.map_path + ": the map holds values that are not finite");
+    }
+    if (r.truth_tolerance > 0) {
+      r.truth_rms_limit = options.truth_rms_factor * r.truth_tolerance;
+      r.truth_p99_limit = options.truth_p99_factor * r.truth_tolerance;
     }
   }
 
@@ -273,11 +300,11 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
       r.map_to_sculpt = Summarise(d);
     }
     {
-      DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> map_tracer,
-                              MakeEmbreeTracer(displaced.mesh));
+      DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> map_tracer, MakeEmbreeTracer(displaced.mesh));
       std::size_t stride = 1;
       if (options.max_sculpt_points > 0 && sculpt.num_vertices() > options.max_sculpt_points) {
-        stride = (sculpt.num_vertices() + options.max_sculpt_points - 1) / options.max_sculpt_points;
+        stride =
+            (sculpt.num_vertices() + options.max_sculpt_points - 1) / options.max_sculpt_points;
       }
       std::vector<Float3> points;
       points.reserve(sculpt.num_vertices() / stride + 1);
@@ -296,6 +323,26 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     limit_abs = limit_abs > 0 ? std::min(limit_abs, rel) : rel;
   }
   const char* option = options.max_error_rel > 0 ? "--max-error-rel" : "--max-error";
+  if (r.measured_truth && r.truth_over_bound > 0) {
+    const auto& w = r.truth_worst;
+    r.passed = false;
+    r.failure = fmt::format(
+        "truth: {} of {} records exceed {} x tolerance + 2 x local linear error (worst {:.3g} "
+        "x, record {}: face {} at ({:.4g}, {:.4g}), map {:.6g}, h {:.6g}, bound {:.4g})",
+        r.truth_over_bound, r.truth.count, r.truth_local_tolerance_factor, r.truth_worst_ratio,
+        w.index, w.face, w.u, w.v, w.map, w.h,
+        r.truth_local_tolerance_factor * r.truth_tolerance + 2.0 * w.local_error);
+  }
+  if (r.measured_truth && r.passed && r.truth_rms_limit > 0 && r.truth.rms > r.truth_rms_limit) {
+    r.passed = false;
+    r.failure = fmt::format("truth RMS error {:.4g} exceeds truth_rms_factor {} x tolerance {:.4g}",
+                            r.truth.rms, options.truth_rms_factor, r.truth_tolerance);
+  }
+  if (r.measured_truth && r.passed && r.truth_p99_limit > 0 && r.truth.p99 > r.truth_p99_limit) {
+    r.passed = false;
+    r.failure = fmt::format("truth p99 error {:.4g} exceeds truth_p99_factor {} x tolerance {:.4g}",
+                            r.truth.p99, options.truth_p99_factor, r.truth_tolerance);
+  }
   if (r.measured_truth) Threshold(r, "truth", r.truth, limit_abs, option);
   if (r.measured_distances) {
     Threshold(r, "map->sculpt", r.map_to_sculpt, limit_abs, option);
@@ -312,14 +359,20 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
 
 namespace {
 nlohmann::json StatsJson(const ErrorStats& s, double diagonal) {
-  return {{"count", s.count}, {"mean", s.mean}, {"rms", s.rms}, {"p99", s.p99},
-          {"max", s.max},     {"rms_rel", s.rms / diagonal},    {"p99_rel", s.p99 / diagonal},
+  return {{"count", s.count},
+          {"mean", s.mean},
+          {"rms", s.rms},
+          {"p99", s.p99},
+          {"max", s.max},
+          {"rms_rel", s.rms / diagonal},
+          {"p99_rel", s.p99 / diagonal},
           {"max_rel", s.max / diagonal}};
 }
 std::string StatsLine(const char* what, const ErrorStats& s, double diagonal) {
-  return fmt::format("  {:<12} rms {:.4g}  p99 {:.4g}  max {:.4g}  (max {:.3g} of the diagonal; "
-                     "{} points)\n",
-                     what, s.rms, s.p99, s.max, s.max / diagonal, s.count);
+  return fmt::format(
+      "  {:<12} rms {:.4g}  p99 {:.4g}  max {:.4g}  (max {:.3g} of the diagonal; "
+      "{} points)\n",
+      what, s.rms, s.p99, s.max, s.max / diagonal, s.count);
 }
 }  // namespace
 
@@ -338,6 +391,25 @@ std::string VerifyReportJson(const VerifyReport& r) {
   if (r.measured_truth) {
     j["truth"] = StatsJson(r.truth, r.diagonal);
     j["truth"]["signed_mean"] = r.truth_signed_mean;
+    nlohmann::json bound = {{"tolerance", r.truth_tolerance},
+                            {"rms_limit", r.truth_rms_limit},
+                            {"p99_limit", r.truth_p99_limit},
+                            {"local_checked", r.truth_local_checked},
+                            {"local_tolerance_factor", r.truth_local_tolerance_factor}};
+    if (r.truth_local_checked) {
+      const auto& w = r.truth_worst;
+      bound["records_over"] = r.truth_over_bound;
+      bound["records_unbounded"] = r.truth_unbounded;
+      bound["worst_ratio"] = r.truth_worst_ratio;
+      bound["worst_record"] = {{"index", w.index},
+                               {"face", w.face},
+                               {"u", w.u},
+                               {"v", w.v},
+                               {"h", w.h},
+                               {"map", w.map},
+                               {"local_error", w.local_error}};
+    }
+    j["truth"]["bound"] = bound;
   }
   j["map"] = {{"misses", r.map_misses},
               {"holes_filled", r.map_holes_filled},
@@ -364,12 +436,23 @@ std::string VerifyReportSummary(const VerifyReport& r) {
   }
   if (r.measured_truth) {
     out += StatsLine("truth", r.truth, r.diagonal);
+    if (r.truth_local_checked) {
+      out += fmt::format(
+          "  truth bound {} x tolerance {:.4g} + 2 x local linear error: {} of {} records "
+          "over, worst {:.3g} x the bound; RMS {:.3g} and p99 {:.3g} tolerances\n",
+          r.truth_local_tolerance_factor, r.truth_tolerance, r.truth_over_bound, r.truth.count,
+          r.truth_worst_ratio, r.truth.rms / r.truth_tolerance, r.truth.p99 / r.truth_tolerance);
+      if (r.truth_unbounded > 0) {
+        out +=
+            fmt::format("  {} records near folded sculpt faces not bounded\n", r.truth_unbounded);
+      }
+    }
   }
   if (r.map_misses >= 0) {
-    out += fmt::format("  map: {} misses ({} filled in-face, {} faces from neighbours), "
-                       "tolerance {:.4g}\n",
-                       r.map_misses, r.map_holes_filled, r.map_faces_filled_from_neighbours,
-                       r.map_tolerance);
+    out += fmt::format(
+        "  map: {} misses ({} filled in-face, {} faces from neighbours), "
+        "tolerance {:.4g}\n",
+        r.map_misses, r.map_holes_filled, r.map_faces_filled_from_neighbours, r.map_tolerance);
   }
   out += r.passed ? "  passed\n" : "  FAILED: " + r.failure + "\n";
   return out;

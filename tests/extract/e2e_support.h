@@ -12,7 +12,9 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
+#include "dispex/ptex.h"
 #include "dispex/verify.h"
 
 namespace dispex::testing {
@@ -33,6 +35,81 @@ inline MakeSculptOptions SculptOptions(const std::string& cage, const std::strin
   options.pattern = pattern;
   options.amplitude = amplitude;
   return options;
+}
+
+// A jittered ground-truth sculpt: `density` x `density` cells per Ptex face.
+inline MakeSculptOptions JitteredSculptOptions(const std::string& cage, const std::string& output,
+                                               int density, Pattern pattern, double amplitude) {
+  MakeSculptOptions options = SculptOptions(cage, output, 1, pattern, amplitude);
+  options.layout = SculptLayout::kJittered;
+  options.density = density;
+  return options;
+}
+
+// Negative controls: a good map made wrong on purpose. Every accuracy check must reject each.
+enum class WrongMap { kZero, kHalf, kFourFifths, kTransposed, kSignFlipped };
+constexpr WrongMap kWrongMaps[] = {WrongMap::kZero, WrongMap::kHalf, WrongMap::kFourFifths,
+                                   WrongMap::kTransposed, WrongMap::kSignFlipped};
+inline const char* WrongMapName(WrongMap kind) {
+  switch (kind) {
+    case WrongMap::kZero:
+      return "zero";
+    case WrongMap::kHalf:
+      return "scaled by 0.5";
+    case WrongMap::kFourFifths:
+      return "scaled by 0.8";
+    case WrongMap::kTransposed:
+      return "u and v transposed";
+    default:
+      return "sign flipped";
+  }
+}
+
+// Writes the map at `good` with every face's texels changed as `kind` says (transposed: texel
+// (i, j) moved to (j, i) and the resolution swapped). Adjacency is kept; meta data is not.
+inline void WriteWrongMap(const std::string& good, const std::string& out, WrongMap kind) {
+  auto map = PtexFile::Open(good);
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  auto writer = PtexWriter::Create(out, PtexWriterOptions{}, map->num_faces());
+  ASSERT_TRUE(writer.ok()) << writer.status().message();
+  std::vector<float> texels, swapped;
+  for (int f = 0; f < map->num_faces(); ++f) {
+    PtexFaceInfo info = map->face_info(PtexFaceId(f));
+    ASSERT_TRUE(map->ReadFace(PtexFaceId(f), 0, texels).ok());
+    const float scale = kind == WrongMap::kZero          ? 0.0f
+                        : kind == WrongMap::kHalf        ? 0.5f
+                        : kind == WrongMap::kFourFifths  ? 0.8f
+                        : kind == WrongMap::kSignFlipped ? -1.0f
+                                                         : 1.0f;
+    for (float& v : texels) v *= scale;
+    if (kind == WrongMap::kTransposed && texels.size() == info.num_texels()) {
+      const int ures = info.ures(), vres = info.vres();
+      swapped.resize(texels.size());
+      for (int j = 0; j < vres; ++j) {
+        for (int i = 0; i < ures; ++i)
+          swapped[std::size_t(i) * vres + j] = texels[std::size_t(j) * ures + i];
+      }
+      texels.swap(swapped);
+      std::swap(info.ulog2, info.vlog2);
+    }
+    info.constant = false;
+    ASSERT_TRUE(writer->SetFace(PtexFaceId(f), info, texels).ok());
+  }
+  ASSERT_TRUE(writer->Finish().ok());
+}
+
+// The accuracy check of the end-to-end tests: `map` against the truth with verify's default
+// bounds at tolerance `tau` (the per-record bound 1.5 tau + 2 e_v, RMS and p99 in units of tau).
+inline VerifyReport CheckTruth(const std::string& base, const std::string& map,
+                               const std::string& truth, double tau) {
+  VerifyOptions verify;
+  verify.base_path = base;
+  verify.map_path = map;
+  verify.truth_path = truth;
+  verify.tolerance = tau;
+  auto report = Verify(verify);
+  EXPECT_TRUE(report.ok()) << report.status().message();
+  return report.ok() ? *report : VerifyReport{};
 }
 
 // A fresh folder per test, removed afterwards.

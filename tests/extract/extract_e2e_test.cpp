@@ -1,7 +1,7 @@
 // End-to-end extraction on real cages with generated sculpts of known displacement.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -18,13 +18,16 @@ namespace dispex {
 namespace {
 
 using testing::DataPath;
-using testing::SculptOptions;
 using testing::RunDispex;
+using testing::SculptOptions;
 using testing::TempDir;
 
 struct Case {
   const char* cage;
   const char* what;
+  int density = 0;  // > 0: a jittered sculpt (SculptLayout::kJittered) of this density
+  // Of the diagonal: at least ~10 tolerances, so that the maps scaled by 0.8 break the bounds.
+  double amplitude = 0.002;
 };
 
 class ExtractRealCages : public ::testing::TestWithParam<Case> {};
@@ -36,8 +39,12 @@ TEST_P(ExtractRealCages, MapMatchesTheKnownDisplacementAndTheReportAddsUp) {
   ASSERT_TRUE(base.ok()) << base.status().message();
   const double diagonal = ComputeBounds(*base).diagonal();
 
+  const int density = GetParam().density;
+  const double amplitude = GetParam().amplitude * diagonal;
   MakeSculptOptions make =
-      SculptOptions(cage, dir / "sculpt.obj", 3, Pattern::kSmooth, 0.002 * diagonal);
+      density > 0 ? testing::JitteredSculptOptions(cage, dir / "sculpt.obj", density,
+                                                   Pattern::kSmooth, amplitude)
+                  : SculptOptions(cage, dir / "sculpt.obj", 3, Pattern::kSmooth, amplitude);
   auto made = MakeSculpt(make);
   ASSERT_TRUE(made.ok()) << made.status().message();
   ASSERT_EQ(made->folded_faces, 0u);
@@ -82,33 +89,58 @@ TEST_P(ExtractRealCages, MapMatchesTheKnownDisplacementAndTheReportAddsUp) {
   EXPECT_EQ(report->misses, 0);
   EXPECT_EQ(report->hits_opposed, 0);  // the sculpt does not fold
   EXPECT_LE(report->spectral.max_measured_error, report->tolerance);
-  // A level-3 sculpt of the cage: 2^4 samples per side on quads, 2^3 on n-gon sub-faces.
-  EXPECT_EQ(report->oversample_faces[0] + report->oversample_faces[1] +
-                report->oversample_faces[2] + report->oversample_faces[5],
-            0);
+  if (density == 0) {
+    // A level-3 sculpt of the cage: 2^4 samples per side on quads, 2^3 on n-gon sub-faces.
+    EXPECT_EQ(report->oversample_subdivision_level, 3);
+    EXPECT_EQ(report->oversample_faces[0] + report->oversample_faces[1] +
+                  report->oversample_faces[2] + report->oversample_faces[5],
+              0);
+  } else {
+    // Not a subdivision of the base: by the sculpt's density (the area-based path), about
+    // two samples per cell side on average (per face it follows the face's area, not its
+    // cells: small n-gon sub-faces get fewer).
+    EXPECT_EQ(report->oversample_subdivision_level, -1);
+    auto json = nlohmann::json::parse(ExtractReportJson(*report));
+    EXPECT_EQ(json["statistics"]["oversample_rule"], "sculpt density");
+    EXPECT_GE(report->samples, static_cast<std::int64_t>(2 * made->faces));
+  }
 
-  // Sign and magnitude: the map against the exact displacement.
-  VerifyOptions verify;
-  verify.base_path = cage;
-  verify.map_path = options.output_path;
-  verify.truth_path = make.output_path + ".truth";
-  auto checked = Verify(verify);
-  ASSERT_TRUE(checked.ok()) << checked.status().message();
-  EXPECT_LE(checked->truth.max, report->tolerance + 2 * made->linear_error)
-      << GetParam().what;
-  EXPECT_LT(checked->truth.rms, 0.25 * make.amplitude) << GetParam().what;
+  // Sign and magnitude: the map against the exact displacement, with verify's bounds
+  // (1.5 tolerances + 2 x the sculpt's local linear error per vertex, RMS and p99 in
+  // tolerances).
+  const std::string truth = make.output_path + ".truth";
+  VerifyReport checked = testing::CheckTruth(cage, options.output_path, truth, report->tolerance);
+  EXPECT_TRUE(checked.passed) << GetParam().what << ": " << checked.failure;
+  EXPECT_TRUE(checked.truth_local_checked);
+  // The same check rejects every negative control.
+  for (testing::WrongMap kind : testing::kWrongMaps) {
+    testing::WriteWrongMap(options.output_path, dir / "wrong.ptx", kind);
+    VerifyReport wrong = testing::CheckTruth(cage, dir / "wrong.ptx", truth, report->tolerance);
+    EXPECT_FALSE(wrong.passed) << GetParam().what << ", " << testing::WrongMapName(kind);
+  }
+  MakeSculptOptions other = make;
+  other.pattern = Pattern::kNoise;
+  other.output_path = dir / "other.obj";
+  ASSERT_TRUE(MakeSculpt(other).ok());
+  EXPECT_FALSE(testing::CheckTruth(cage, options.output_path, other.output_path + ".truth",
+                                   report->tolerance)
+                   .passed)
+      << GetParam().what << ", another pattern";
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Cages, ExtractRealCages,
     ::testing::Values(Case{"meshes/keenan_spot/spot_control_mesh.obj", "n-gons"},
                       Case{"meshes/stanford_bunny/bun_zipper_quadriflow_1000.obj", "quads"},
-                      Case{"meshes/opensubdiv/catmark_torus_creases0.obj", "creases"},
-                      Case{"meshes/opensubdiv/catmark_tent.obj", "boundaries"}),
+                      Case{"meshes/opensubdiv/catmark_torus_creases0.obj", "creases", 0, 0.005},
+                      Case{"meshes/opensubdiv/catmark_tent.obj", "boundaries", 0, 0.004},
+                      Case{"meshes/keenan_spot/spot_control_mesh.obj", "jittered n-gons", 12},
+                      Case{"meshes/opensubdiv/catmark_torus_creases0.obj", "jittered creases", 23,
+                           0.005}),
     [](const auto& param_info) {
       std::string name = param_info.param.what;
       for (char& c : name) {
-        if (c == '-') c = '_';
+        if (c == '-' || c == ' ') c = '_';
       }
       return name;
     });
@@ -180,7 +212,8 @@ TEST_F(ExtractTest, SculptFarAwayIsAClearErrorAndWritesNothing) {
   std::string moved = dir_ / "moved.obj";
   {
     std::ofstream out(moved);
-    for (const Float3& p : sculpt->positions) out << "v " << p.x + 30 << ' ' << p.y << ' ' << p.z << '\n';
+    for (const Float3& p : sculpt->positions)
+      out << "v " << p.x + 30 << ' ' << p.y << ' ' << p.z << '\n';
     for (std::size_t f = 0; f < sculpt->num_faces(); ++f) {
       out << 'f';
       for (int v : sculpt->face(f)) out << ' ' << v + 1;
@@ -277,17 +310,17 @@ TEST_F(ExtractTest, CommandLineWritesMapAndJsonReport) {
   EXPECT_EQ(report["statistics"]["tolerance"].get<double>(), 0.0002);
   EXPECT_FALSE(report["statistics"]["tolerance_auto"].get<bool>());
   EXPECT_TRUE(report["statistics"]["search_distance_auto"].get<bool>());
-  for (const char* phase : {"read_base", "read_sculpt", "topology", "bvh", "sample_trace",
-                            "write", "total"}) {
+  for (const char* phase :
+       {"read_base", "read_sculpt", "topology", "bvh", "sample_trace", "write", "total"}) {
     EXPECT_TRUE(report["phases_seconds"].contains(phase)) << phase;
   }
   EXPECT_GT(report["output"]["bytes"].get<std::uint64_t>(), 0u);
   EXPECT_GT(report["peak_rss_bytes"].get<std::uint64_t>(), 0u);
 
   // --preview writes the atlas and the comparison render beside the map.
-  auto previewed = RunDispex("extract " + cage_ + " " + sculpt_ + " -o " + map + " -q --preview " +
-                                 (dir_ / "previews"),
-                             dir_);
+  auto previewed = RunDispex(
+      "extract " + cage_ + " " + sculpt_ + " -o " + map + " -q --preview " + (dir_ / "previews"),
+      dir_);
   ASSERT_EQ(previewed.exit_code, 0) << previewed.err;
   for (const char* png : {"previews/cli_atlas.png", "previews/cli_compare.png"}) {
     std::string bytes = testing::Slurp(dir_ / png);
@@ -300,8 +333,7 @@ TEST_F(ExtractTest, CommandLineWritesMapAndJsonReport) {
   EXPECT_EQ(quiet.err, "");
   EXPECT_EQ(quiet.out, "");
 
-  auto bad = RunDispex("extract " + cage_ + " " + sculpt_ + " -o " + map + " --tolerance -1",
-                       dir_);
+  auto bad = RunDispex("extract " + cage_ + " " + sculpt_ + " -o " + map + " --tolerance -1", dir_);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("--tolerance"), std::string::npos) << bad.err;
 }
