@@ -71,7 +71,7 @@ inline Float3 Sideways(const Float3& o, const Float3& d, float scene_scale) {
 // (e.g. (-1.7e-20, 4.9e-4, 1) from the limit normals of a flat, creased side) moves a point
 // on the ray by less than float rounding, but Embree 3.13.5's coherent packet traversal loses
 // up to a third of those rays (none once the component is zero).
-inline Float3 FlushTiny(const Float3& d) {
+[[gnu::always_inline]] inline Float3 FlushTiny(const Float3& d) {
   const float floor = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}) * 0x1p-24f;
   return Float3{std::fabs(d.x) < floor ? 0.0f : d.x, std::fabs(d.y) < floor ? 0.0f : d.y,
                 std::fabs(d.z) < floor ? 0.0f : d.z};
@@ -90,51 +90,35 @@ inline float WindowMargin(const Float3& o, const Float3& d, float scene_scale, f
 // Embree's window [lo, hi] from `o`, made non-negative (Embree asserts tnear >= 0) by starting
 // the ray -lo earlier; returns that shift, which Embree's t then includes.
 template <class Caster>
-float SetWindow(Caster& caster, int lane, Float3 o, const Float3& d, float lo, float hi) {
+[[gnu::always_inline]] inline float SetWindow(Caster& caster, int lane, Float3 o, const Float3& d,
+                                              float lo, float hi) {
   const float shift = lo < 0 ? -lo : 0.0f;
   if (shift > 0) o = Float3{o.x - shift * d.x, o.y - shift * d.y, o.z - shift * d.z};
   caster.Set(lane, o, d, lo + shift, hi + shift);
   return shift;
 }
 
-// t of the line o + t d at triangle (a, b, c), in double, and the smallest barycentric
-// coordinate of that point (< 0: outside). NaN when the line is parallel to the triangle.
-struct LineHit {
-  double t, min_bary;
-};
-inline LineHit LineTriangle(const Float3& fa, const Float3& fb, const Float3& fc, const Float3& o,
-                            const Float3& d) {
-  const double ax = fa.x, ay = fa.y, az = fa.z;
-  const double e1x = fb.x - ax, e1y = fb.y - ay, e1z = fb.z - az;
-  const double e2x = fc.x - ax, e2y = fc.y - ay, e2z = fc.z - az;
-  const double dx = d.x, dy = d.y, dz = d.z;
-  const double px = dy * e2z - dz * e2y, py = dz * e2x - dx * e2z, pz = dx * e2y - dy * e2x;
-  const double det = e1x * px + e1y * py + e1z * pz;
-  if (det == 0) return {std::numeric_limits<double>::quiet_NaN(), -1};
-  const double sx = o.x - ax, sy = o.y - ay, sz = o.z - az;
-  const double u = (sx * px + sy * py + sz * pz) / det;
-  const double qx = sy * e1z - sz * e1y, qy = sz * e1x - sx * e1z, qz = sx * e1y - sy * e1x;
-  const double v = (dx * qx + dy * qy + dz * qz) / det;
-  const double t = (e2x * qx + e2y * qy + e2z * qz) / det;
-  return {t, std::min({u, v, 1 - u - v})};
-}
-
 // The hit's t as dispex reports it: the line o + t d (the query's own origin, even when Embree
-// was given one moved sideways) at the plane of the hit triangle, computed in double and
-// rounded once. For a quad, of its two triangles (v0 v1 v3) and (v2 v3 v1) the one the line
-// passes through (or nearest to). Identical under every ISA for the same primitive; Embree's
-// own t (`fallback`) only for a degenerate primitive.
-inline float ExactT(const EmbreeScene& scene, unsigned geom, unsigned prim, const Float3& o,
-                    const Float3& d, float fallback) {
+// was given one moved sideways) at the plane of the hit triangle, in double, rounded once.
+// Of a quad's two triangles (v0 v1 v3) and (v2 v3 v1) Embree reports the second with
+// u + v > 1. Identical under every ISA for the same triangle; Embree's own t (`fallback`) only
+// for a degenerate one.
+inline float ExactT(const EmbreeScene& scene, unsigned geom, unsigned prim, float u, float v,
+                    const Float3& o, const Float3& d, float fallback) {
   const GeometryView& g = scene.geometry(geom);
-  const std::int32_t* v = g.indices + static_cast<std::size_t>(g.corners) * prim;
+  const std::int32_t* ids = g.indices + static_cast<std::size_t>(g.corners) * prim;
   const Float3* p = scene.positions();
-  LineHit h = LineTriangle(p[v[0]], p[v[1]], p[v[g.corners == 4 ? 3 : 2]], o, d);
-  if (g.corners == 4 && h.min_bary < 0) {
-    const LineHit h2 = LineTriangle(p[v[2]], p[v[3]], p[v[1]], o, d);
-    if (std::isnan(h.t) || h2.min_bary > h.min_bary) h = h2;
-  }
-  return std::isfinite(h.t) ? static_cast<float>(h.t) : fallback;
+  const bool second = g.corners == 4 && u + v > 1;
+  const Float3& fa = p[ids[second ? 2 : 0]];
+  const Float3& fb = p[ids[second ? 3 : 1]];
+  const Float3& fc = p[ids[second ? 1 : (g.corners == 4 ? 3 : 2)]];
+  const double e1x = double(fb.x) - fa.x, e1y = double(fb.y) - fa.y, e1z = double(fb.z) - fa.z;
+  const double e2x = double(fc.x) - fa.x, e2y = double(fc.y) - fa.y, e2z = double(fc.z) - fa.z;
+  const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
+  const double den = nx * d.x + ny * d.y + nz * d.z;
+  const double t =
+      (nx * (double(fa.x) - o.x) + ny * (double(fa.y) - o.y) + nz * (double(fa.z) - o.z)) / den;
+  return std::isfinite(t) ? static_cast<float>(t) : fallback;
 }
 
 // An intersect context whose filter rejects every candidate with ExactT outside [tnear, tfar]:
@@ -155,8 +139,9 @@ struct WindowContext {
     for (unsigned i = 0; i < args->N; ++i) {
       if (args->valid[i] == 0) continue;
       const float t = ExactT(*w->scene, RTCHitN_geomID(args->hit, args->N, i),
-                             RTCHitN_primID(args->hit, args->N, i), w->origin, w->direction,
-                             RTCRayN_tfar(args->ray, args->N, i));
+                             RTCHitN_primID(args->hit, args->N, i),
+                             RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i),
+                             w->origin, w->direction, RTCRayN_tfar(args->ray, args->N, i));
       if (!(t >= w->tnear && t <= w->tfar)) args->valid[i] = 0;
     }
   }
@@ -177,7 +162,8 @@ inline Candidate CastInWindow(const EmbreeScene& scene, const Float3& cast_origi
   caster.Cast(scene.scene(), &w.context, 1);
   if (!caster.Hit(0)) return Candidate{};
   const Float3 ng = caster.Ng(0);
-  return Candidate{ExactT(scene, caster.Geom(0), caster.Prim(0), origin, d, caster.T(0) - shift),
+  return Candidate{ExactT(scene, caster.Geom(0), caster.Prim(0), caster.U(0), caster.V(0), origin,
+                          d, caster.T(0) - shift),
                    caster.Geom(0), caster.Prim(0), Dot(d, ng) > 0, ng};
 }
 
@@ -203,6 +189,7 @@ class NormalBlock {
       kept_[j] = Candidate{};
       if (Finite(o[j]) && Finite(d[j]) && NonZero(d[j])) {
         d_[j] = FlushTiny(d[j]);
+        margin_[j] = WindowMargin(o[j], d_[j], scene_.scale(), query_.distance);
         list_[count++] = j;
       } else {
         ++counters.invalid;
@@ -237,16 +224,18 @@ class NormalBlock {
         const Float3 dir{sign * d_[j].x, sign * d_[j].y, sign * d_[j].z};
         // Both rays of a query move the same way: sideways of d, not of dir.
         const Float3 o = sideways ? Sideways(o_[j], d_[j], scene_.scale()) : o_[j];
-        const float m = WindowMargin(o, dir, scene_.scale(), tfar_[j]);
-        shift_[lane] = SetWindow(caster_, lane, o, dir, -m, tfar_[j] + m);
+        // The window [-m, tfar + m], started m early (Embree asserts tnear >= 0).
+        const float m = margin_[j];
+        caster_.Set(lane, Float3{o.x - m * dir.x, o.y - m * dir.y, o.z - m * dir.z}, dir, 0.0f,
+                    tfar_[j] + 2 * m);
       }
       caster_.Cast(scene_.scene(), &context_, width);
       for (int lane = 0; lane < width; ++lane) {
         if (!caster_.Hit(lane)) continue;
         const int j = ids[k0 + lane];
         const Float3 dir{sign * d_[j].x, sign * d_[j].y, sign * d_[j].z};
-        const float t = ExactT(scene_, caster_.Geom(lane), caster_.Prim(lane), o_[j], dir,
-                               caster_.T(lane) - shift_[lane]);
+        const float t = ExactT(scene_, caster_.Geom(lane), caster_.Prim(lane), caster_.U(lane),
+                               caster_.V(lane), o_[j], dir, caster_.T(lane) - margin_[j]);
         if (t < 0) {
           recast_[recasts++] = j;  // a surface in the margin before 0 hid the window's start
         } else if (t <= tfar_[j]) {
@@ -383,8 +372,8 @@ class NormalBlock {
   RTCIntersectContext context_;
   Caster caster_;
   const Float3* o_ = nullptr;
-  Float3 d_[kBlock];  // the queries' normals, FlushTiny'd
-  float shift_[Caster::kWidth];
+  Float3 d_[kBlock];      // the queries' normals, FlushTiny'd
+  float margin_[kBlock];  // WindowMargin of each query at its longest window
   std::uint64_t rays_ = 0, repair_rays_ = 0;
   int list_[kBlock], list2_[kBlock], second_ids_[kBlock], suspects_[kBlock], recast_[kBlock];
   float tfar_[kBlock];
@@ -455,8 +444,9 @@ void IntersectWith(const EmbreeScene& scene, std::span<const Ray> rays, std::spa
         for (int lane = 0; lane < width; ++lane) {
           if (!caster.Hit(lane)) continue;
           const int j = ids[k0 + lane];
-          const float t = ExactT(scene, caster.Geom(lane), caster.Prim(lane), block[j].origin,
-                                 dir[j], caster.T(lane) - shift[lane]);
+          const float t =
+              ExactT(scene, caster.Geom(lane), caster.Prim(lane), caster.U(lane), caster.V(lane),
+                     block[j].origin, dir[j], caster.T(lane) - shift[lane]);
           if (t < block[j].tnear) {
             recast[recasts++] = j;  // a surface in the margin before tnear hid the window
           } else if (t <= tfar[j]) {
