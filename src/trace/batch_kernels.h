@@ -8,12 +8,16 @@
 // stops traversing early (the measured win over two independent rays). Queries are packed
 // into casters in order, so rays from neighbouring samples of a face share a packet.
 //
+// Windows and t (the hit contract in include/dispex/trace.h): Embree only finds the
+// primitive, over a window WindowMargin() wider than the query's; ExactT() gives t and the
+// window is applied to it here, so no Embree ISA's rounding decides.
+//
 // Vertex guard. Embree 3's robust mode is watertight along shared edges but can still let a
 // ray through exactly at a shared vertex (Embree issues #181 and #387; measured here on rays
 // aimed exactly at cube-sphere vertices: ~0.3% slip through, none at edges). Such a query is
 // re-resolved from an origin moved sideways (Sideways()): far enough, 16 ulps of the
 // coordinates' magnitude, to leave the vertex's rounding zone so the rays cross a face or an
-// edge; close enough that t moves by ~1e-6 relative at most, and only for those queries.
+// edge; t is still measured from the query's own origin (ExactT), so it does not move.
 // Which queries: those that end as misses (TracerOptions::retry_misses: cheap, misses are
 // rare), and, with TracerOptions::verify_hits, those where one more sideways ray finds a
 // surface between the origin and the kept hit, which the first rays must have slipped past.
