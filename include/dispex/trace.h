@@ -182,13 +182,14 @@ struct TracerStats {
 
 // The hit contract, the same under every Embree ISA (TracerOptions::isa) and RayMode:
 //  - A hit's t is dispex's, not Embree's: the ray o + t d (its own origin and direction) meets
-//    the plane of the hit triangle (for a quad, of its two triangles v0 v1 v3 and v2 v3 v1 the
-//    one the ray passes through), computed in double and rounded to float once.
+//    the plane of the hit triangle (for a quad, whichever of its triangles v0 v1 v3 and
+//    v2 v3 v1 Embree reports), computed in double and rounded to float once.
 //  - Windows are closed: a surface is hit iff that t lies in [tnear, tfar], both ends included,
 //    so a zero-length window [a, a] hits a surface exactly at a, and a ray from a point on the
 //    surface hits it at t = 0. Embree is asked over a window 2^-18 of the scale wider at both
 //    ends and dispex applies the rule; a surface in that margin before tnear is skipped and the
-//    next one in the window found (an Embree filter that applies the same rule).
+//    next one in the window found (an Embree filter that applies the same rule). Denormal
+//    window ends count as 0 (the tracer runs with denormals-are-zero).
 //  - Rays through shared edges and vertices hit (robust mode and the vertex guard): the guard
 //    re-casts from an origin moved sideways only to find the primitive; t is still measured
 //    from the query's own origin, so the guard does not move t.
@@ -196,8 +197,8 @@ struct TracerStats {
 //    move a point on the ray by less than float rounding (and Embree's coherent 8-wide packets
 //    lose rays that carry them).
 //  - Of two surfaces closer together along the ray than Embree's rounding (~1e-7 of the
-//    scale), which one is nearest is Embree's call; hits on different primitives at a shared
-//    edge can then differ by float rounding between ISAs.
+//    scale), which one is nearest is Embree's call. At a shared edge or vertex two ISAs may
+//    pick different faces: then t differs by rounding (up to ~1e-5 relative for grazing rays).
 
 class Tracer {
  public:
