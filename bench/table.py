@@ -127,15 +127,26 @@ def targets(rows, components):
     body = next((x for x in rows if x["asset"] == "body"), None)
     if body and components and "rays_packet8" in components:
         # The median sample+trace time over the repeated runs (the phase varies by +-10% from
-        # run to run on this virtual machine), against the same rays cast alone.
-        raw = components["rays_packet8"]["seconds"] * body["rays"] / components["rays_packet8"]["rays"]
+        # run to run on this virtual machine), against dispex's own packet8 kernel on the
+        # same samples alone (its cuts, vertex guard and exact t included): what limit
+        # evaluation, spectral analysis and compression add. Embree alone (a bare
+        # rtcIntersect8 loop over the same rays) is shown beside it.
+        def scaled(key):
+            c = components[key]
+            return c["seconds"] * body["rays"] / c["rays"]
+        kernel = scaled("rays_packet8")
         times = body["sample_trace_of_all_runs"]
         median = statistics.median(times)
-        ratio = median / raw
+        ratio = median / kernel
         spread = (f' (runs {", ".join(f"{t:.2f}" for t in times)} s: '
-                  f'{times[0] / raw:.2f}-{times[-1] / raw:.2f}x)' if len(times) > 1 else "")
-        found.append((f"body sample+trace <= {TRACE_OVER_RAW_TARGET}x raw Embree time for its rays",
-                      f'median {median:.2f} s / {raw:.2f} s = {ratio:.2f}x{spread}',
+                  f'{times[0] / kernel:.2f}-{times[-1] / kernel:.2f}x)' if len(times) > 1 else "")
+        bare = ""
+        if "rays_bare_rtcintersect8" in components:
+            b = scaled("rays_bare_rtcintersect8")
+            bare = f'; bare rtcIntersect8 {b:.2f} s: {median / b:.2f}x'
+        found.append((f"body sample+trace <= {TRACE_OVER_RAW_TARGET}x dispex's packet8 kernel alone "
+                      "on its rays",
+                      f'median {median:.2f} s / {kernel:.2f} s = {ratio:.2f}x{spread}{bare}',
                       ratio <= TRACE_OVER_RAW_TARGET))
     if body:
         found.append(("body peak RSS <= 4 GB", f'{body["peak_rss_bytes"]/1e9:.2f} GB',

@@ -205,6 +205,9 @@ void SetupExtract(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--bvh-quality", args->bvh_quality, "BVH build quality: low, medium, high")
       ->capture_default_str();
+  cmd->add_option("--embree-isa", o.embree_isa,
+                  "Embree kernels: sse2, sse4.2, avx, avx2, avx512 (default: $DISPEX_EMBREE_ISA, "
+                  "else the widest this CPU runs)");
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
       ->check(NonNegative())
       ->capture_default_str();

@@ -63,6 +63,7 @@ struct ExtractOptions {
   // are not aligned). 1 turns the check off.
   double max_miss_fraction = 0.05;
   BuildQuality bvh_quality = BuildQuality::kLow;  // measured: same ray speed, a third of the build
+  std::string embree_isa;  // TracerOptions::isa: "" = $DISPEX_EMBREE_ISA, else Embree's choice
 
   int threads = 0;        // 0: all cores; the output does not depend on it
   bool progress = false;  // draw a progress bar on stderr
@@ -134,6 +135,7 @@ struct ExtractReport {
   // Output.
   std::uint64_t bytes_written = 0;
   std::uint64_t peak_rss_bytes = 0;
+  std::string tracer;  // TracerStats::backend: Embree version, ISA, build
 };
 
 // Memory an extraction is estimated to need, in bytes: before reading, from the input file

@@ -15,6 +15,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "dispex/ids.h"
 #include "dispex/mesh.h"
@@ -59,8 +60,8 @@ struct TracerOptions {
   // The vertex guard. Embree 3's robust mode still lets a small fraction of the rays that pass
   // exactly through a shared vertex slip through (none at edges). A query that ends as a
   // miss is resolved again from an origin moved sideways by ~2e-6 of the scene's coordinate
-  // magnitude, which closes those holes; it costs rays only for misses, and moves t (by
-  // ~1e-6 relative at most) only for queries that first missed.
+  // magnitude, which closes those holes; it costs rays only for misses, and does not move t
+  // (t is measured from the query's own origin, see the contract above Tracer).
   bool retry_misses = true;
   // Also catch a ray that slipped through a vertex and went on to hit something farther: one
   // more sideways ray per hit checks the stretch before the hit, and a query that finds a
@@ -73,7 +74,17 @@ struct TracerOptions {
   // When > 0, an Embree allocation that would take its total above this many bytes fails
   // and MakeEmbreeTracer returns an out-of-memory Status.
   std::int64_t memory_limit_bytes = 0;
+  // Embree's kernel set: "sse2", "sse4.2", "avx", "avx2" or "avx512". Empty: the environment
+  // variable DISPEX_EMBREE_ISA when set (so a whole test run can be forced to one), else
+  // Embree's own choice for this CPU (the widest it supports). An unknown name, or an ISA
+  // this CPU lacks, is an error of MakeEmbreeTracer. The contract of the queries below holds
+  // under every ISA; hit t values agree to the last bit wherever the same primitive is hit.
+  std::string isa;
 };
+
+// The names TracerOptions::isa accepts, narrowest first, and those this CPU can run.
+std::span<const std::string_view> EmbreeIsaNames();
+std::vector<std::string_view> SupportedEmbreeIsas();
 
 std::string_view ToString(HitPolicy policy);      // "nearest", "outside-first", "inside-first"
 std::string_view ToString(BuildQuality quality);  // "low", "medium", "high"
@@ -118,8 +129,9 @@ struct TraceCounters {
   // the answer: not after a first hit under outside-/inside-first, and not after a first hit
   // at t = 0 under nearest (its tfar would be 0 and a tie keeps the +n hit); under nearest
   // the second ray's tfar is cut to the first hit's t. Rays not cast are not counted; the
-  // vertex guard's rays (TracerOptions::retry_misses, verify_hits) are. Closest-point
-  // queries cast no rays.
+  // vertex guard's rays (TracerOptions::retry_misses, verify_hits) are, and so is a ray cast
+  // again past a surface in the margin before its window (see the hit contract above Tracer).
+  // Closest-point queries cast no rays.
   std::uint64_t rays_cast = 0;
   std::uint64_t repair_rays = 0;  // of rays_cast, the vertex guard's
   std::uint64_t hits = 0;         // queries that found something
@@ -150,7 +162,9 @@ struct ClosestPoint {
 
 // What the backend built, for reports.
 struct TracerStats {
-  // e.g. "embree 3.13.5 (avx512), low build, robust, retry misses, packet8"
+  // e.g. "embree 3.13.5 (avx2), low build, robust, retry misses, packet8"; the ISA is the one
+  // whose kernels Embree runs, with ", forced" when TracerOptions::isa or DISPEX_EMBREE_ISA
+  // chose it.
   std::string backend;
   std::size_t faces = 0;                // sculpt faces
   std::size_t quads = 0;                // primitives in the scene: quads (faces of 4 vertices) ...
@@ -166,12 +180,33 @@ struct TracerStats {
 
 // ---- The tracer ----------------------------------------------------------------------------
 
+// The hit contract, the same under every Embree ISA (TracerOptions::isa) and RayMode:
+//  - A hit's t is dispex's, not Embree's: the ray o + t d (its own origin and direction) meets
+//    the plane of the hit triangle (for a quad, whichever of its triangles v0 v1 v3 and
+//    v2 v3 v1 Embree reports), computed in double and rounded to float once.
+//  - Windows are closed: a surface is hit iff that t lies in [tnear, tfar], both ends included,
+//    so a zero-length window [a, a] hits a surface exactly at a, and a ray from a point on the
+//    surface hits it at t = 0. Embree is asked over a window 2^-18 of the scale wider at both
+//    ends and dispex applies the rule; a surface in that margin before tnear is skipped and the
+//    next one in the window found (an Embree filter that applies the same rule). Denormal
+//    window ends count as 0 (the tracer runs with denormals-are-zero).
+//  - Rays through shared edges and vertices hit (robust mode and the vertex guard): the guard
+//    re-casts from an origin moved sideways only to find the primitive; t is still measured
+//    from the query's own origin, so the guard does not move t.
+//  - Direction components smaller than 2^-24 of the largest are taken as exactly zero: they
+//    move a point on the ray by less than float rounding (and Embree's coherent 8-wide packets
+//    lose rays that carry them).
+//  - Of two surfaces closer together along the ray than Embree's rounding (~1e-7 of the
+//    scale), which one is nearest is Embree's call. At a shared edge or vertex two ISAs may
+//    pick different faces: then t differs by rounding (up to ~1e-5 relative for grazing rays).
+
 class Tracer {
  public:
   virtual ~Tracer() = default;
 
   // Normal queries: for each i, the line origins[i] + t normals[i] against the sculpt with
-  // t in [-query.distance, +query.distance], resolved by query.policy (see HitPolicy). The
+  // t in [-query.distance, +query.distance] (ends included), resolved by query.policy (see
+  // HitPolicy); the hit at t = 0 of an origin on the surface is the +n ray's. The
   // result t is the ray parameter, i.e. a distance when the normal is unit length. A query
   // whose origin or normal is not finite, or whose normal is zero, is a miss and counts as
   // invalid. Requires origins.size() == normals.size() == out.t.size() == out.flags.size(),
@@ -181,7 +216,8 @@ class Tracer {
                             const NormalQuery& query, const NormalHits& out,
                             TraceCounters& counters) const = 0;
 
-  // Arbitrary rays: the nearest hit with t in [rays[i].tnear, rays[i].tfar]. A ray with a
+  // Arbitrary rays: the nearest hit with t in [rays[i].tnear, rays[i].tfar], ends included
+  // (see the contract above; tfar may be infinity). A ray with a
   // non-finite or zero direction, a non-finite origin, tnear < 0 or tnear > tfar (NaN
   // included) is a miss and counts as invalid. Requires hits.size() == rays.size().
   virtual void Intersect(std::span<const Ray> rays, std::span<RayHit> hits,

@@ -237,8 +237,10 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
   Stopwatch clock;
   TracerOptions tracer_options;
   tracer_options.quality = options.bvh_quality;
+  tracer_options.isa = options.embree_isa;
   DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer, MakeEmbreeTracer(sculpt, tracer_options));
   report.t_bvh = clock.seconds();
+  report.tracer = tracer->stats().backend;
   if (CancelRequested()) return Cancelled();
 
   // 3. Automatic settings: tolerance, search distance, oversampling.

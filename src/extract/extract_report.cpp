@@ -39,6 +39,7 @@ std::string ExtractReportJson(const ExtractReport& r) {
   j["mrays_per_second"] =
       r.t_sample_trace > 0 ? double(r.rays_cast) / r.t_sample_trace / 1e6 : 0.0;
   j["peak_rss_bytes"] = r.peak_rss_bytes;
+  j["tracer"] = r.tracer;
   j["warnings"] = r.warnings;
   return j.dump(2) + "\n";
 }

@@ -8,12 +8,16 @@
 // stops traversing early (the measured win over two independent rays). Queries are packed
 // into casters in order, so rays from neighbouring samples of a face share a packet.
 //
+// Windows and t (the hit contract in include/dispex/trace.h): Embree only finds the
+// primitive, over a window WindowMargin() wider than the query's; ExactT() gives t and the
+// window is applied to it here, so no Embree ISA's rounding decides.
+//
 // Vertex guard. Embree 3's robust mode is watertight along shared edges but can still let a
 // ray through exactly at a shared vertex (Embree issues #181 and #387; measured here on rays
 // aimed exactly at cube-sphere vertices: ~0.3% slip through, none at edges). Such a query is
 // re-resolved from an origin moved sideways (Sideways()): far enough, 16 ulps of the
 // coordinates' magnitude, to leave the vertex's rounding zone so the rays cross a face or an
-// edge; close enough that t moves by ~1e-6 relative at most, and only for those queries.
+// edge; t is still measured from the query's own origin (ExactT), so it does not move.
 // Which queries: those that end as misses (TracerOptions::retry_misses: cheap, misses are
 // rare), and, with TracerOptions::verify_hits, those where one more sideways ray finds a
 // surface between the origin and the kept hit, which the first rays must have slipped past.
@@ -28,6 +32,7 @@
 
 #include "dispex/trace.h"
 #include "trace/embree_scene.h"
+#include "trace/ray_casters.h"
 
 namespace dispex::trace {
 
@@ -48,7 +53,8 @@ struct Candidate {
   float t = 0;
   unsigned geom = RTC_INVALID_GEOMETRY_ID;
   unsigned prim = 0;
-  bool back = false;
+  bool back = false;  // dot(ray direction, Ng) > 0
+  Float3 ng;          // Embree's unnormalised geometric normal
   bool hit() const { return geom != RTC_INVALID_GEOMETRY_ID; }
 };
 
@@ -63,6 +69,106 @@ inline Float3 Sideways(const Float3& o, const Float3& d, float scene_scale) {
   const float scale = std::max({scene_scale, std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)});
   const float step = scale * 0x1p-19f / std::sqrt(Dot(e, e));
   return Float3{o.x + step * e.x, o.y + step * e.y, o.z + step * e.z};
+}
+
+// Direction components smaller than 2^-24 of the largest set to exactly zero. Such noise
+// (e.g. (-1.7e-20, 4.9e-4, 1) from the limit normals of a flat, creased side) moves a point
+// on the ray by less than float rounding, but Embree 3.13.5's coherent packet traversal loses
+// up to a third of those rays (none once the component is zero).
+[[gnu::always_inline]] inline Float3 FlushTiny(const Float3& d) {
+  const float floor = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}) * 0x1p-24f;
+  return Float3{std::fabs(d.x) < floor ? 0.0f : d.x, std::fabs(d.y) < floor ? 0.0f : d.y,
+                std::fabs(d.z) < floor ? 0.0f : d.z};
+}
+
+// The window handed to Embree is wider than the query's by this margin at both ends, so that
+// Embree's own rounding at the ends (which differs between its SSE, AVX, AVX2 and AVX-512
+// kernels) never decides; dispex then decides with ExactT. 2^-18 of the coordinates' scale
+// along the ray plus of the window's end: 32 float ulps.
+inline float WindowMargin(const Float3& o, const Float3& d, float scene_scale, float end) {
+  const float dmax = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+  const float scale = std::max({scene_scale, std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)});
+  return (scale / dmax + (std::isfinite(end) ? std::fabs(end) : 0.0f)) * 0x1p-18f;
+}
+
+// Embree's window [lo, hi] from `o`, made non-negative (Embree asserts tnear >= 0) by starting
+// the ray -lo earlier; returns that shift, which Embree's t then includes.
+template <class Caster>
+[[gnu::always_inline]] inline float SetWindow(Caster& caster, int lane, Float3 o, const Float3& d,
+                                              float lo, float hi) {
+  const float shift = lo < 0 ? -lo : 0.0f;
+  if (shift > 0) o = Float3{o.x - shift * d.x, o.y - shift * d.y, o.z - shift * d.z};
+  caster.Set(lane, o, d, lo + shift, hi + shift);
+  return shift;
+}
+
+// The hit's t as dispex reports it: the line o + t d (the query's own origin, even when Embree
+// was given one moved sideways) at the plane of the hit triangle, in double, rounded once.
+// Of a quad's two triangles (v0 v1 v3) and (v2 v3 v1) Embree reports the second with
+// u + v > 1. Identical under every ISA for the same triangle; Embree's own t (`fallback`) only
+// for a degenerate one.
+inline float ExactT(const EmbreeScene& scene, unsigned geom, unsigned prim, float u, float v,
+                    const Float3& o, const Float3& d, float fallback) {
+  const GeometryView& g = scene.geometry(geom);
+  const std::int32_t* ids = g.indices + static_cast<std::size_t>(g.corners) * prim;
+  const Float3* p = scene.positions();
+  const bool second = g.corners == 4 && u + v > 1;
+  const Float3& fa = p[ids[second ? 2 : 0]];
+  const Float3& fb = p[ids[second ? 3 : 1]];
+  const Float3& fc = p[ids[second ? 1 : (g.corners == 4 ? 3 : 2)]];
+  const double e1x = double(fb.x) - fa.x, e1y = double(fb.y) - fa.y, e1z = double(fb.z) - fa.z;
+  const double e2x = double(fc.x) - fa.x, e2y = double(fc.y) - fa.y, e2z = double(fc.z) - fa.z;
+  const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
+  const double den = nx * d.x + ny * d.y + nz * d.z;
+  const double t =
+      (nx * (double(fa.x) - o.x) + ny * (double(fa.y) - o.y) + nz * (double(fa.z) - o.z)) / den;
+  return std::isfinite(t) ? static_cast<float>(t) : fallback;
+}
+
+// An intersect context whose filter rejects every candidate with ExactT outside [tnear, tfar]:
+// Embree then goes on to the next surface. Used only to re-cast the rare ray whose nearest
+// candidate lay in the margin before the window (see WindowMargin).
+struct WindowContext {
+  RTCIntersectContext context;  // first: Embree hands the filter this pointer
+  const EmbreeScene* scene = nullptr;
+  Float3 origin, direction;
+  float tnear = 0, tfar = 0;
+
+  explicit WindowContext(const EmbreeScene& s) : scene(&s) {
+    rtcInitIntersectContext(&context);
+    context.filter = &Filter;
+  }
+  static void Filter(const RTCFilterFunctionNArguments* args) {
+    const auto* w = reinterpret_cast<const WindowContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+      if (args->valid[i] == 0) continue;
+      const float t = ExactT(*w->scene, RTCHitN_geomID(args->hit, args->N, i),
+                             RTCHitN_primID(args->hit, args->N, i),
+                             RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i),
+                             w->origin, w->direction, RTCRayN_tfar(args->ray, args->N, i));
+      if (!(t >= w->tnear && t <= w->tfar)) args->valid[i] = 0;
+    }
+  }
+};
+
+// One ray from `cast_origin` whose hit must have ExactT (measured from `origin`) in
+// [tnear, tfar]: nothing nearer is returned, whatever Embree's rounding.
+inline Candidate CastInWindow(const EmbreeScene& scene, const Float3& cast_origin,
+                              const Float3& origin, const Float3& d, float tnear, float tfar) {
+  WindowContext w(scene);
+  w.origin = origin;
+  w.direction = d;
+  w.tnear = tnear;
+  w.tfar = tfar;
+  const float m = WindowMargin(cast_origin, d, scene.scale(), tfar);
+  SingleCaster caster;
+  const float shift = SetWindow(caster, 0, cast_origin, d, tnear - m, tfar + m);
+  caster.Cast(scene.scene(), &w.context, 1);
+  if (!caster.Hit(0)) return Candidate{};
+  const Float3 ng = caster.Ng(0);
+  return Candidate{ExactT(scene, caster.Geom(0), caster.Prim(0), caster.U(0), caster.V(0), origin,
+                          d, caster.T(0) - shift),
+                   caster.Geom(0), caster.Prim(0), Dot(d, ng) > 0, ng};
 }
 
 // The normal-query kernel for one block of at most kBlock queries.
@@ -82,11 +188,12 @@ class NormalBlock {
   void Run(const Float3* o, const Float3* d, int m, const NormalHits& out, std::size_t base,
            TraceCounters& counters) {
     o_ = o;
-    d_ = d;
     int count = 0;
     for (int j = 0; j < m; ++j) {
       kept_[j] = Candidate{};
       if (Finite(o[j]) && Finite(d[j]) && NonZero(d[j])) {
+        d_[j] = FlushTiny(d[j]);
+        margin_[j] = WindowMargin(o[j], d_[j], scene_.scale(), query_.distance);
         list_[count++] = j;
       } else {
         ++counters.invalid;
@@ -113,24 +220,41 @@ class NormalBlock {
   // o[j] (moved sideways when `sideways`), storing its hit in result[j].
   void Cast(const int* ids, int count, float sign, Candidate* result, bool sideways) {
     constexpr int W = Caster::kWidth;
+    int recasts = 0;
     for (int k0 = 0; k0 < count; k0 += W) {
       const int width = std::min(W, count - k0);
       for (int lane = 0; lane < width; ++lane) {
         const int j = ids[k0 + lane];
         const Float3 dir{sign * d_[j].x, sign * d_[j].y, sign * d_[j].z};
         // Both rays of a query move the same way: sideways of d, not of dir.
-        caster_.Set(lane, sideways ? Sideways(o_[j], d_[j], scene_.scale()) : o_[j], dir, 0.0f,
-                    tfar_[j]);
+        const Float3 o = sideways ? Sideways(o_[j], d_[j], scene_.scale()) : o_[j];
+        // The window [-m, tfar + m], started m early (Embree asserts tnear >= 0).
+        const float m = margin_[j];
+        caster_.Set(lane, Float3{o.x - m * dir.x, o.y - m * dir.y, o.z - m * dir.z}, dir, 0.0f,
+                    tfar_[j] + 2 * m);
       }
       caster_.Cast(scene_.scene(), &context_, width);
       for (int lane = 0; lane < width; ++lane) {
         if (!caster_.Hit(lane)) continue;
         const int j = ids[k0 + lane];
-        const float facing = sign * Dot(d_[j], caster_.Ng(lane));
-        result[j] = Candidate{caster_.T(lane), caster_.Geom(lane), caster_.Prim(lane), facing > 0};
+        const Float3 dir{sign * d_[j].x, sign * d_[j].y, sign * d_[j].z};
+        const float t = ExactT(scene_, caster_.Geom(lane), caster_.Prim(lane), caster_.U(lane),
+                               caster_.V(lane), o_[j], dir, caster_.T(lane) - margin_[j]);
+        if (t < 0) {
+          recast_[recasts++] = j;  // a surface in the margin before 0 hid the window's start
+        } else if (t <= tfar_[j]) {
+          const Float3 ng = caster_.Ng(lane);
+          result[j] = Candidate{t, caster_.Geom(lane), caster_.Prim(lane), Dot(dir, ng) > 0, ng};
+        }
       }
     }
-    (sideways ? repair_rays_ : rays_) += static_cast<std::uint64_t>(count);
+    for (int k = 0; k < recasts; ++k) {
+      const int j = recast_[k];
+      const Float3 dir{sign * d_[j].x, sign * d_[j].y, sign * d_[j].z};
+      result[j] = CastInWindow(scene_, sideways ? Sideways(o_[j], d_[j], scene_.scale()) : o_[j],
+                               o_[j], dir, 0.0f, tfar_[j]);
+    }
+    (sideways ? repair_rays_ : rays_) += static_cast<std::uint64_t>(count + recasts);
   }
 
   // Both rays of the listed queries and the policy's choice, into kept_ and kept_sign_.
@@ -252,9 +376,10 @@ class NormalBlock {
   RTCIntersectContext context_;
   Caster caster_;
   const Float3* o_ = nullptr;
-  const Float3* d_ = nullptr;
+  Float3 d_[kBlock];      // the queries' normals, FlushTiny'd
+  float margin_[kBlock];  // WindowMargin of each query at its longest window
   std::uint64_t rays_ = 0, repair_rays_ = 0;
-  int list_[kBlock], list2_[kBlock], second_ids_[kBlock], suspects_[kBlock];
+  int list_[kBlock], list2_[kBlock], second_ids_[kBlock], suspects_[kBlock], recast_[kBlock];
   float tfar_[kBlock];
   float reach_plus_[kBlock], reach_minus_[kBlock], segment_start_[kBlock];
   float kept_sign_[kBlock], saved_sign_[kBlock];
@@ -287,8 +412,10 @@ void IntersectWith(const EmbreeScene& scene, std::span<const Ray> rays, std::spa
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float scale = scene.scale();
 
-  int list[kBlock], repair[kBlock];
+  int list[kBlock], repair[kBlock], recast[kBlock];
   float tfar[kBlock];
+  Float3 dir[kBlock];  // the rays' directions, FlushTiny'd
+  float shift[W];
   std::uint64_t cast = 0, repairs = 0, found = 0, invalid = 0;
   const std::size_t n = rays.size();
   for (std::size_t base = 0; base < n; base += kBlock) {
@@ -297,31 +424,49 @@ void IntersectWith(const EmbreeScene& scene, std::span<const Ray> rays, std::spa
     RayHit* out = hits.data() + base;
 
     // Casts rays ids[0..count) over [tnear, tfar[j]] from their origin (moved sideways when
-    // `sideways`); on_hit(j, lane) for each ray that hits.
-    auto cast_rays = [&](const int* ids, int count, bool sideways, auto on_hit) {
+    // `sideways`) and stores the hits; `count` and `recasts` rays in all.
+    auto store = [&](int j, const Candidate& c) {
+      const float length = std::sqrt(Dot(c.ng, c.ng));
+      const float inv = length > 0 ? 1.0f / length : 0.0f;
+      out[j].t = c.t;
+      out[j].prim = SculptPrimId(scene.FaceOf(c.geom, c.prim));
+      out[j].normal = Float3{c.ng.x * inv, c.ng.y * inv, c.ng.z * inv};
+    };
+    auto cast_rays = [&](const int* ids, int count, bool sideways) {
+      int recasts = 0;
       for (int k0 = 0; k0 < count; k0 += W) {
         const int width = std::min(W, count - k0);
         for (int lane = 0; lane < width; ++lane) {
           const int j = ids[k0 + lane];
           const Ray& ray = block[j];
           Float3 o = ray.origin;
-          if (sideways) o = Sideways(o, ray.direction, scale);
-          caster.Set(lane, o, ray.direction, ray.tnear, tfar[j]);
+          if (sideways) o = Sideways(o, dir[j], scale);
+          const float margin = WindowMargin(o, dir[j], scale, tfar[j]);
+          shift[lane] = SetWindow(caster, lane, o, dir[j], ray.tnear - margin, tfar[j] + margin);
         }
         caster.Cast(scene.scene(), &context, width);
         for (int lane = 0; lane < width; ++lane) {
-          if (caster.Hit(lane)) on_hit(ids[k0 + lane], lane);
+          if (!caster.Hit(lane)) continue;
+          const int j = ids[k0 + lane];
+          const float t =
+              ExactT(scene, caster.Geom(lane), caster.Prim(lane), caster.U(lane), caster.V(lane),
+                     block[j].origin, dir[j], caster.T(lane) - shift[lane]);
+          if (t < block[j].tnear) {
+            recast[recasts++] = j;  // a surface in the margin before tnear hid the window
+          } else if (t <= tfar[j]) {
+            store(j, Candidate{t, caster.Geom(lane), caster.Prim(lane), false, caster.Ng(lane)});
+          }
         }
       }
-      (sideways ? repairs : cast) += static_cast<std::uint64_t>(count);
-    };
-    auto store = [&](int j, int lane) {
-      const Float3 ng = caster.Ng(lane);
-      const float length = std::sqrt(Dot(ng, ng));
-      const float inv = length > 0 ? 1.0f / length : 0.0f;
-      out[j].t = caster.T(lane);
-      out[j].prim = SculptPrimId(scene.FaceOf(caster.Geom(lane), caster.Prim(lane)));
-      out[j].normal = Float3{ng.x * inv, ng.y * inv, ng.z * inv};
+      for (int k = 0; k < recasts; ++k) {
+        const int j = recast[k];
+        const Ray& ray = block[j];
+        const Candidate c =
+            CastInWindow(scene, sideways ? Sideways(ray.origin, dir[j], scale) : ray.origin,
+                         ray.origin, dir[j], ray.tnear, tfar[j]);
+        if (c.hit()) store(j, c);
+      }
+      (sideways ? repairs : cast) += static_cast<std::uint64_t>(count + recasts);
     };
 
     int count = 0;
@@ -332,12 +477,13 @@ void IntersectWith(const EmbreeScene& scene, std::span<const Ray> rays, std::spa
       const bool valid = Finite(ray.origin) && Finite(ray.direction) && NonZero(ray.direction) &&
                          std::isfinite(ray.tnear) && ray.tnear >= 0 && ray.tnear <= ray.tfar;
       if (valid) {
+        dir[j] = FlushTiny(ray.direction);
         list[count++] = j;
       } else {
         ++invalid;
       }
     }
-    cast_rays(list, count, false, store);
+    cast_rays(list, count, false);
 
     // The vertex guard (see the file comment): misses, and hits with a surface before them
     // that a sideways ray over [tnear, t) finds, are cast again from sideways.
@@ -355,9 +501,8 @@ void IntersectWith(const EmbreeScene& scene, std::span<const Ray> rays, std::spa
         const float t = out[j].t;
         if (!out[j].hit() || !(t > block[j].tnear)) continue;
         const Float3& o = block[j].origin;
-        const Float3& dir = block[j].direction;
         const float step = std::max({scale, std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)}) *
-                           0x1p-19f / std::sqrt(Dot(dir, dir));
+                           0x1p-19f / std::sqrt(Dot(dir[j], dir[j]));
         tfar[j] = t - std::max(1e-4f * (t - block[j].tnear), 64 * step);
         if (tfar[j] > block[j].tnear) segment_ids[segments++] = j;
       }
@@ -371,12 +516,10 @@ void IntersectWith(const EmbreeScene& scene, std::span<const Ray> rays, std::spa
         for (int lane = 0; lane < width; ++lane) {
           const int j = segment_ids[k0 + lane];
           const Ray& ray = block[j];
-          const Float3 s = Sideways(ray.origin, ray.direction, scale);
+          const Float3 s = Sideways(ray.origin, dir[j], scale);
           const float a = ray.tnear;
-          caster.Set(lane,
-                     Float3{s.x + a * ray.direction.x, s.y + a * ray.direction.y,
-                            s.z + a * ray.direction.z},
-                     ray.direction, 0.0f, tfar[j]);
+          caster.Set(lane, Float3{s.x + a * dir[j].x, s.y + a * dir[j].y, s.z + a * dir[j].z},
+                     dir[j], 0.0f, tfar[j]);
         }
         caster.Cast(scene.scene(), &context, width);
         for (int lane = 0; lane < width; ++lane) {
@@ -386,7 +529,7 @@ void IntersectWith(const EmbreeScene& scene, std::span<const Ray> rays, std::spa
       repairs += static_cast<std::uint64_t>(segments);
     }
     for (int k = 0; k < suspects; ++k) tfar[repair[k]] = block[repair[k]].tfar;
-    cast_rays(repair, suspects, true, store);
+    cast_rays(repair, suspects, true);
 
     for (int k = 0; k < count; ++k) found += out[list[k]].hit() ? 1 : 0;
   }

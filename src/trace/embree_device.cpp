@@ -1,6 +1,12 @@
 #include "trace/embree_device.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <iterator>
+#include <vector>
 
 namespace dispex::trace {
 
@@ -24,7 +30,39 @@ const char* RtcErrorName(RTCError code) {
   return "RTC_ERROR_(unknown code)";
 }
 
+bool CpuHasIsa(std::string_view isa) {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_cpu_init();
+  if (isa == "sse2") return __builtin_cpu_supports("sse2");
+  if (isa == "sse4.2") return __builtin_cpu_supports("sse4.2") && __builtin_cpu_supports("popcnt");
+  if (isa == "avx") return __builtin_cpu_supports("avx");
+  if (isa == "avx2") {
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+           __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
+  }
+  if (isa == "avx512") {
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+           __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
+           __builtin_cpu_supports("avx512cd");
+  }
+#endif
+  return false;
+}
+
 namespace {
+
+// Embree's own pick: the 16- and 8-wide native packet properties are the device's answer
+// to "AVX-512 kernels?" and "AVX kernels?"; AVX against AVX2, and SSE4.2 against SSE2, is
+// told by the CPU features Embree requires for them.
+std::string AutoIsa(RTCDevice device) {
+  if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0) {
+    return "avx512";
+  }
+  if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0) {
+    return CpuHasIsa("avx2") ? "avx2" : "avx";
+  }
+  return CpuHasIsa("sse4.2") ? "sse4.2" : "sse2";
+}
 
 Status ErrorStatus(RTCError code, const std::string& message) {
   if (code == RTC_ERROR_OUT_OF_MEMORY) {
@@ -39,13 +77,44 @@ Status ErrorStatus(RTCError code, const std::string& message) {
 
 EmbreeDevice::EmbreeDevice(std::int64_t memory_limit_bytes) : limit_(memory_limit_bytes) {}
 
-StatusOr<std::unique_ptr<EmbreeDevice>> EmbreeDevice::Create(std::int64_t memory_limit_bytes) {
+std::string ChosenIsa(const std::string& requested, std::string* source) {
+  if (!requested.empty()) {
+    *source = "isa";
+    return requested;
+  }
+  const char* env = std::getenv("DISPEX_EMBREE_ISA");
+  if (env != nullptr && *env != '\0') {
+    *source = "DISPEX_EMBREE_ISA";
+    return env;
+  }
+  *source = "isa";
+  return "";
+}
+
+StatusOr<std::unique_ptr<EmbreeDevice>> EmbreeDevice::Create(std::int64_t memory_limit_bytes,
+                                                             const std::string& isa,
+                                                             const std::string& isa_source) {
+  // Embree reads an unknown name as sse2 without a word: check it here.
+  if (!isa.empty() &&
+      std::find(std::begin(kEmbreeIsas), std::end(kEmbreeIsas), isa) == std::end(kEmbreeIsas)) {
+    return Status::Error(fmt::format("{} '{}': unknown Embree ISA (valid: {})", isa_source, isa,
+                                     fmt::join(kEmbreeIsas, ", ")));
+  }
   std::unique_ptr<EmbreeDevice> device(new EmbreeDevice(memory_limit_bytes));
-  device->device_ = rtcNewDevice(nullptr);
+  const std::string config = isa.empty() ? std::string() : "isa=" + isa;
+  device->device_ = rtcNewDevice(config.empty() ? nullptr : config.c_str());
   if (device->device_ == nullptr) {
     const RTCError code = rtcGetDeviceError(nullptr);
+    if (code == RTC_ERROR_UNSUPPORTED_CPU && !isa.empty()) {
+      return Status::Error(fmt::format(
+          "{} '{}': this CPU lacks the instructions of these Embree "
+          "kernels (it supports: {}) ({})",
+          isa_source, isa, fmt::join(dispex::SupportedEmbreeIsas(), ", "), RtcErrorName(code)));
+    }
     return Status::Error(fmt::format("embree: could not create a device ({})", RtcErrorName(code)));
   }
+  device->isa_forced_ = !isa.empty();
+  device->isa_ = isa.empty() ? AutoIsa(device->device_) : isa;
   rtcSetDeviceErrorFunction(device->device_, &EmbreeDevice::OnError, device.get());
   rtcSetDeviceMemoryMonitorFunction(device->device_, &EmbreeDevice::OnMemory, device.get());
   return device;
@@ -102,28 +171,27 @@ Status EmbreeDevice::PeekError() const {
 }
 
 std::string EmbreeDevice::Describe() const {
-  const char* isa = "sse2";
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-      __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
-      __builtin_cpu_supports("avx512cd")) {
-    isa = "avx512";
-  } else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
-             __builtin_cpu_supports("bmi2")) {
-    isa = "avx2";
-  } else if (__builtin_cpu_supports("avx")) {
-    isa = "avx";
-  } else if (__builtin_cpu_supports("sse4.2")) {
-    isa = "sse4.2";
-  }
-#else
-  isa = "native";
-#endif
-  return fmt::format("embree {}.{}.{} ({})",
+  return fmt::format("embree {}.{}.{} ({}{})",
                      rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_VERSION_MAJOR),
                      rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_VERSION_MINOR),
-                     rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_VERSION_PATCH), isa);
+                     rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_VERSION_PATCH), isa_,
+                     isa_forced_ ? ", forced" : "");
 }
 
 }  // namespace dispex::trace
+
+namespace dispex {
+
+std::span<const std::string_view> EmbreeIsaNames() {
+  return trace::kEmbreeIsas;
+}
+
+std::vector<std::string_view> SupportedEmbreeIsas() {
+  std::vector<std::string_view> names;
+  for (const std::string_view isa : trace::kEmbreeIsas) {
+    if (trace::CpuHasIsa(isa)) names.push_back(isa);
+  }
+  return names;
+}
+
+}  // namespace dispex

@@ -35,6 +35,11 @@ RTCBuildQuality ToRtc(BuildQuality quality) {
 StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Mesh& mesh,
                                                           const TracerOptions& options) {
   std::unique_ptr<EmbreeScene> scene(new EmbreeScene());
+  // The device first: its errors (an ISA this CPU lacks) are not the sculpt's.
+  std::string isa_source;
+  const std::string isa = ChosenIsa(options.isa, &isa_source);
+  DISPEX_ASSIGN_OR_RETURN(scene->device_,
+                          EmbreeDevice::Create(options.memory_limit_bytes, isa, isa_source));
   Status status;
   try {
     status = scene->Setup(mesh, options);
@@ -80,10 +85,11 @@ Status EmbreeScene::Setup(const Mesh& mesh, const TracerOptions& options) {
   SculptCounts counts;
   DISPEX_RETURN_IF_ERROR(CheckSculpt(mesh, &counts));
 
-  DISPEX_ASSIGN_OR_RETURN(device_, EmbreeDevice::Create(options.memory_limit_bytes));
   scene_ = rtcNewScene(device_->get());
   if (scene_ == nullptr) return device_->TakeError();
-  int flags = RTC_SCENE_FLAG_NONE;
+  // The context filter is used only by the rare re-cast past a surface before a ray's
+  // window (batch_kernels.h, CastInWindow); Embree requires the flag to call it.
+  int flags = RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION;
   if (options.robust) flags |= RTC_SCENE_FLAG_ROBUST;
   if (options.compact) flags |= RTC_SCENE_FLAG_COMPACT;
   rtcSetSceneFlags(scene_, static_cast<RTCSceneFlags>(flags));

@@ -3,7 +3,7 @@
 //
 //   Set(lane, origin, direction, tnear, tfar)   fill lane `lane` (0 <= lane < kWidth)
 //   Cast(scene, context, count)                 intersect lanes [0, count)
-//   Hit(lane), T(lane), Geom(lane), Prim(lane), Ng(lane)   read the result of a lane
+//   Hit(lane), T(lane), Geom(lane), Prim(lane), U(lane), V(lane), Ng(lane)   a lane's result
 //
 // The packet casters keep the rays in Embree's SoA layout (RTCRayHit4/8/16) and pass a
 // valid mask; the stream caster keeps AoS RTCRayHit records for rtcIntersect1M; the single
@@ -75,6 +75,8 @@ class PacketCaster {
   float T(int i) const { return rh_.ray.tfar[i]; }
   unsigned Geom(int i) const { return rh_.hit.geomID[i]; }
   unsigned Prim(int i) const { return rh_.hit.primID[i]; }
+  float U(int i) const { return rh_.hit.u[i]; }
+  float V(int i) const { return rh_.hit.v[i]; }
   Float3 Ng(int i) const { return {rh_.hit.Ng_x[i], rh_.hit.Ng_y[i], rh_.hit.Ng_z[i]}; }
 
  private:
@@ -116,6 +118,8 @@ class RecordCaster {
   float T(int i) const { return rh_[i].ray.tfar; }
   unsigned Geom(int i) const { return rh_[i].hit.geomID; }
   unsigned Prim(int i) const { return rh_[i].hit.primID; }
+  float U(int i) const { return rh_[i].hit.u; }
+  float V(int i) const { return rh_[i].hit.v; }
   Float3 Ng(int i) const { return {rh_[i].hit.Ng_x, rh_[i].hit.Ng_y, rh_[i].hit.Ng_z}; }
 
  private:

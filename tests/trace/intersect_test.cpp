@@ -63,6 +63,73 @@ TEST(IntersectTest, WindowSelectsWhichSheetIsHit) {
   for (std::size_t k = 5; k < rays.size(); ++k) EXPECT_FALSE(hits[k].hit()) << k;
 }
 
+// The closed-window contract at the ends (include/dispex/trace.h): two sheets 1e-6 apart, much
+// closer than Embree's window margin, in every RayMode.
+TEST(IntersectTest, WindowEndsAreClosedOnDispexT) {
+  const float gap = 1e-6f;
+  Mesh mesh = trace_test::NewMesh({{-1, -1, 0},
+                                   {1, -1, 0},
+                                   {1, 1, 0},
+                                   {-1, 1, 0},
+                                   {-1, -1, gap},
+                                   {1, -1, gap},
+                                   {1, 1, gap},
+                                   {-1, 1, gap}});
+  trace_test::AddFace(mesh, {0, 1, 2, 3});
+  trace_test::AddFace(mesh, {4, 5, 6, 7});
+  const float inf = std::numeric_limits<float>::infinity();
+  const Float3 up{0, 0, 1};
+  const Float3 below{0.3f, -0.2f, -1};
+  const float t_a = 1.0f;                                   // sheet 0 from below
+  const float t_b = static_cast<float>(1.0 + double(gap));  // sheet 1, as dispex rounds it
+  const std::vector<Ray> rays{
+      {below, 0, up, inf},                          // sheet 0 at t = 1
+      {below, std::nextafter(t_a, 2.0f), up, inf},  // starts just past sheet 0: sheet 1
+      {below, t_b, up, t_b},                        // zero-length window on sheet 1
+      {below, t_a, up, t_a},                        // zero-length window on sheet 0
+      {below, 0, up, std::nextafter(t_a, 0.0f)},    // ends just before sheet 0: miss
+      {{0.3f, -0.2f, 0}, 0, up, inf},               // origin on sheet 0: hit at t = 0
+      {{0.3f, -0.2f, 0}, 1e-7f, up, inf},           // skips it: sheet 1
+  };
+  for (const RayMode mode : {RayMode::kSingle, RayMode::kPacket4, RayMode::kPacket8,
+                             RayMode::kPacket16, RayMode::kStream}) {
+    TracerOptions options;
+    options.ray_mode = mode;
+    auto tracer = MakeEmbreeTracer(mesh, options);
+    ASSERT_TRUE(tracer.ok()) << tracer.status().message();
+    std::vector<RayHit> hits(rays.size());
+    TraceCounters counters;
+    (*tracer)->Intersect(rays, hits, counters);
+    const char* name = ToString(mode).data();
+    EXPECT_EQ(hits[0].t, t_a) << name;
+    EXPECT_EQ(hits[0].prim.value, 0) << name;
+    EXPECT_EQ(hits[1].t, t_b) << name;
+    EXPECT_EQ(hits[1].prim.value, 1) << name;
+    EXPECT_EQ(hits[2].t, t_b) << name;
+    EXPECT_EQ(hits[2].prim.value, 1) << name;
+    EXPECT_EQ(hits[3].t, t_a) << name;
+    EXPECT_EQ(hits[3].prim.value, 0) << name;
+    EXPECT_FALSE(hits[4].hit()) << name;
+    EXPECT_EQ(hits[5].t, 0.0f) << name;
+    EXPECT_EQ(hits[5].prim.value, 0) << name;
+    EXPECT_EQ(hits[6].t, gap) << name;
+    EXPECT_EQ(hits[6].prim.value, 1) << name;
+
+    // A normal query from a point on sheet 0: the +n ray's hit at t = 0.
+    const std::vector<Float3> origins{{0.3f, -0.2f, 0}};
+    const std::vector<Float3> normals{up};
+    std::vector<float> t(1);
+    std::vector<std::uint8_t> flags(1);
+    std::vector<SculptPrimId> prim(1);
+    (*tracer)->TraceNormals(origins, normals, NormalQuery{0.5f}, NormalHits{t, prim, flags},
+                            counters);
+    EXPECT_EQ(t[0], 0.0f) << name;
+    EXPECT_EQ(prim[0].value, 0) << name;
+    // Its direction leaves through the sheet's front (+z): a back-face hit by definition.
+    EXPECT_EQ(flags[0], HitFlags::kHit | HitFlags::kBackFace) << name;
+  }
+}
+
 TEST(IntersectTest, MatchesBruteForceOnARealMesh) {
   const Mesh blub =
       trace_test::LoadObj(DISPEX_TEST_DATA_DIR "/meshes/keenan_blub/blub_control_mesh.obj");
