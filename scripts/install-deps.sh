@@ -7,7 +7,7 @@ packages=(
   build-essential cmake pkg-config git
   libosd-dev libembree-dev libtbb-dev
   libdeflate-dev zlib1g-dev libfftw3-dev
-  libfast-float-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev
+  libfast-float-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libpng-dev libgtest-dev libgmock-dev libbenchmark-dev
 )
 if [[ "${DISPEX_WITH_FUZZ:-0}" == 1 ]]; then
