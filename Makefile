@@ -32,14 +32,15 @@ test: build
 bench: build
 	@DISPEX_BUILD=$(BUILD) bench/run $(BENCH_ARGS)
 
-# Unit tests built with AddressSanitizer and UndefinedBehaviorSanitizer.
+# The whole test suite (unit, end-to-end, accuracy) built with AddressSanitizer and
+# UndefinedBehaviorSanitizer.
 test-sanitize: deps
 	@cmake -S . -B $(BUILD)-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDISPEX_SANITIZE=ON \
 	  -DDISPEX_BUILD_BENCH=OFF -DDISPEX_WERROR=$(WERROR) $(CMAKE_FLAGS) >/dev/null
 	@cmake --build $(BUILD)-sanitize -j$(JOBS)
 	@cd $(BUILD)-sanitize && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-	  ctest --output-on-failure -j$(JOBS) -L unit --timeout 900
+	  ctest --output-on-failure -j$(JOBS) --timeout 900
 
 # The extraction pipeline (TBB tasks at 4 threads) under ThreadSanitizer.
 test-tsan: deps
