@@ -1,5 +1,5 @@
 // Zlib-stream mutation of Ptex files; see ptex_stream_mutator.h. The layout followed is the
-// one of the Ptex 1.4 header (wdas/ptex PtexIO.h; the shared docs/ptex-format.md): a 64-byte
+// one of the Ptex 1.4 header (wdas/ptex PtexIO.h; docs/ptex.md, "Header"): a 64-byte
 // header, the extended header, face info, constant data, level info, level data (each
 // level: a zlib block of face data headers, then the face blocks), meta data, an 8-byte
 // barrier, the large meta data header. Nothing here is trusted: a field that points outside

@@ -2,8 +2,8 @@
 // Catmull-Clark base mesh.
 //
 // The on-disk format is the one of the reference implementation (wdas/ptex, file format
-// 1.4), described in docs/ptex-format.md of the shared documentation; docs/ptex.md says
-// what this module supports and how it was checked. Texels are always passed as
+// 1.4); docs/ptex.md describes the format ("The file format") and says what this module
+// supports and how it was checked. Texels are always passed as
 // channel-interleaved rows, v-major: texel (u, v) of a face with resolution ures x vres
 // starts at index (v * ures + u) * num_channels; texel (i, j) covers
 // u in [i/ures, (i+1)/ures), v in [j/vres, (j+1)/vres).

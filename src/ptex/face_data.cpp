@@ -1,5 +1,6 @@
-// Decoding face data of an opened Ptex file (guide §8, §9, §11): block lookup by level and
-// reduction order, inflation with the exact expected size, undifferencing, channel merge,
+// Decoding face data of an opened Ptex file (docs/ptex.md, "Level data and reduction order", "Face
+// data blocks and tiles", "Texel order, channel split and diff encoding"): block lookup by level
+// and reduction order, inflation with the exact expected size, undifferencing, channel merge,
 // tiles; plus bilinear sampling (texel centres at (i + 0.5) / res, clamped at the border).
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -265,8 +266,8 @@ float PtexFile::Sample(PtexFaceId face, float u, float v, int channel) const {
   v = std::clamp(std::isnan(v) ? 0.0f : v, 0.0f, 1.0f);
 
   if (header.mesh_type == PtexMeshType::kTriangle) {
-    // The triangular texel containing (u, v) (guide §16); points past u + v = 1 are pulled
-    // back onto the hypotenuse.
+    // The triangular texel containing (u, v) (docs/ptex.md, "The triangle rule"); points past
+    // u + v = 1 are pulled back onto the hypotenuse.
     const int n = ures;
     if (u + v > 1.0f) {
       const float s = u + v;

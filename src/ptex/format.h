@@ -1,5 +1,5 @@
 // On-disk constants and little-endian helpers of the Ptex file format 1.4 (wdas/ptex
-// PtexIO.h, described in the shared docs/ptex-format.md). Everything here is internal to
+// PtexIO.h, described in docs/ptex.md, "The file format"). Everything here is internal to
 // src/ptex; the public types are in include/dispex/ptex.h.
 #pragma once
 
@@ -128,7 +128,8 @@ inline int ReductionKey(const PtexFaceInfo& f) {
   return f.constant ? 1 : std::min<int>(f.ulog2, f.vlog2);
 }
 
-// Face ids sorted by decreasing ReductionKey, stable (the "reduction order", guide §8.2).
+// Face ids sorted by decreasing ReductionKey, stable (the "reduction order": docs/ptex.md,
+// "Level data and reduction order").
 // Entry r of a reduction level holds face result[r].
 inline std::vector<std::int32_t> ReductionOrder(std::span<const PtexFaceInfo> faces) {
   std::vector<std::int32_t> order(faces.size());

@@ -1,4 +1,5 @@
-// Meta data item records (guide §13): encoding for the writer, parsing for the reader.
+// Meta data item records (docs/ptex.md, "Meta data records"): encoding for the writer,
+// parsing for the reader.
 #pragma once
 
 #include <cstdint>

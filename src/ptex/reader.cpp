@@ -1,9 +1,9 @@
-// PtexFile::Open / ParsePtex: reads the structure of a Ptex 1.4 file (guide §2-§14) and
-// validates it completely before anything is allocated from its numbers. The reference
-// reader (wdas/ptex PtexReader.cpp) trusts the file; this one checks every size, offset and
-// count against the file size, against what a zlib block can inflate to (at most ~1032x its
-// size, so a header claiming 2^32 faces in 200 bytes fails at once), and against the
-// format's limits, and inflates every stream into a buffer of exactly the expected size.
+// PtexFile::Open / ParsePtex: reads the structure of a Ptex 1.4 file (docs/ptex.md, "File layout"
+// to "Edit blocks") and validates it completely before anything is allocated from its numbers. The
+// reference reader (wdas/ptex PtexReader.cpp) trusts the file; this one checks every size, offset
+// and count against the file size, against what a zlib block can inflate to (at most ~1032x its
+// size, so a header claiming 2^32 faces in 200 bytes fails at once), and against the format's
+// limits, and inflates every stream into a buffer of exactly the expected size.
 #include <algorithm>
 #include <cstring>
 
@@ -382,8 +382,8 @@ Status PtexFile::Impl::Parse() {
                 " bytes without a header");
   }
 
-  // Edit blocks (guide §14): at max(editdatapos, end of large meta data); editdatapos 0
-  // (files before 1.3) means "scan to the end of the file".
+  // Edit blocks (docs/ptex.md, "Edit blocks"): at max(editdatapos, end of large meta data);
+  // editdatapos 0 (files before 1.3) means "scan to the end of the file".
   edit_block.assign(nfaces, -1);
   std::uint64_t edit_start = std::max(edit_pos, lmd_end), edit_end = 0;
   if (edit_pos == 0) {

@@ -1,9 +1,9 @@
 // Ptex faces and adjacency of a Catmull-Clark base mesh, from its topology alone.
 //
 // Follows OpenSubdiv 3.5: Far::PtexIndices (numbering: a quad is one Ptex face, an n-gon n
-// sub-faces) and Far::PtexIndices::GetAdjacency (guide §18), with edges identified as Vtr
-// does (Vtr::Level::completeTopologyFromFaceVertices, see BuildEdges), and an edge has a
-// neighbour only when exactly two face corners use it. tests/ptex compares the result
+// sub-faces) and Far::PtexIndices::GetAdjacency (docs/ptex.md, "OpenSubdiv Ptex adjacency"), with
+// edges identified as Vtr does (Vtr::Level::completeTopologyFromFaceVertices, see BuildEdges), and
+// an edge has a neighbour only when exactly two face corners use it. tests/ptex compares the result
 // with OpenSubdiv itself on every cage in tests/data/meshes.
 #include <algorithm>
 #include <array>

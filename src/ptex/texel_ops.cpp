@@ -1,6 +1,7 @@
 // Texel operations following the reference Ptex library's PtexUtils (reduce, reduceTri,
 // multalpha, divalpha, encodeDifference, deinterleave) so stored reductions match the
-// reference writer's; averages are exact means instead of float32 sums (guide §12.4).
+// reference writer's; averages are exact means instead of float32 sums (docs/ptex.md,
+// "Averages").
 #include "ptex/texel_ops.h"
 
 #include <algorithm>

@@ -32,7 +32,8 @@ void DecodeDifference(std::uint8_t* data, std::size_t bytes, PtexDataType type);
 // summed left to right in float32 then times 0.25, half through float, integers floor(sum/4).
 void ReduceQuad(const std::uint8_t* src, int ulog2, int vlog2, PtexDataType type, int num_channels,
                 std::uint8_t* dst);
-// Triangle rule (guide §16) on a square (log2, log2) face stored as the N x N square.
+// Triangle rule (docs/ptex.md, "The triangle rule") on a square (log2, log2) face stored as
+// the N x N square.
 void ReduceTriangle(const std::uint8_t* src, int log2, PtexDataType type, int num_channels,
                     std::uint8_t* dst);
 

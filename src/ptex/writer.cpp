@@ -1,4 +1,5 @@
-// PtexWriter: a streaming writer of Ptex 1.4 files (guide §2-§13 and §19.2).
+// PtexWriter: a streaming writer of Ptex 1.4 files (docs/ptex.md, "File layout" to "Meta data
+// records", and "What the writer always writes").
 //
 // It follows the reference writer (wdas/ptex PtexWriter.cpp) in everything that decides the
 // file's bytes: which reductions are stored (levels 1 .. min(ulog2, vlog2) - 2), their
@@ -320,7 +321,8 @@ void PtexWriter::Impl::StoreFace(int face_id, const PtexFaceInfo& given, const s
   face.headers.assign(1 + std::size_t(reductions), 0);
   face.headers[0] = WriteFaceData(data, info.ulog2, info.vlog2, s);
 
-  // Reductions and the average are computed from premultiplied texels (guide §17).
+  // Reductions and the average are computed from premultiplied texels (docs/ptex.md,
+  // "Premultiplication for reductions").
   const std::uint8_t* base = data;
   if (options.alpha_channel >= 0) {
     s.premult.assign(data, data + count * pixel_size);

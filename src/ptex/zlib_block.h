@@ -1,4 +1,5 @@
-// The zlib streams of a Ptex file (RFC 1950; every block its own stream, guide §10):
+// The zlib streams of a Ptex file (RFC 1950; every block its own stream, docs/ptex.md,
+// "zlib blocks"):
 // compression with libdeflate or zlib, and inflation with libdeflate into a buffer of the
 // exact expected size.
 #pragma once

@@ -1,5 +1,6 @@
-// Edit blocks (guide §14), which the dispex writer never produces: files assembled here with
-// zlib, with face data edits (replacing a face, making one constant) and a meta data edit.
+// Edit blocks (docs/ptex.md, "Edit blocks"), which the dispex writer never produces: files
+// assembled here with zlib, with face data edits (replacing a face, making one constant) and a meta
+// data edit.
 #include <gtest/gtest.h>
 
 #include <string>

@@ -261,7 +261,8 @@ TEST(PtexFixtureRead, TriangleFloat1) {
   EXPECT_EQ(Avg(file, 3), 3.22705078125f);
   ExpectLevel(file, 1, {{3, 3, 3}, {0, 2, 2}});
   ExpectLevel(file, 2, {{3, 2, 2}});
-  // Triangle rule of guide §16, written out here independently of the library.
+  // Triangle rule (docs/ptex.md, "The triangle rule"), written out here independently of the
+  // library.
   auto tri = [](const std::vector<float>& s, int n) {
     std::vector<float> r;
     auto at = [&](int u, int v) { return static_cast<double>(s[std::size_t(v * n + u)]); };

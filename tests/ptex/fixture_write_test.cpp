@@ -1,11 +1,11 @@
 // The writer against the reference writer: each fixture's content (from its README) is
 // written by dispex and compared with the file the reference library wrote.
 //
-// With zlib at level 6 (the reference's compressor and level) the files must be identical
-// byte for byte, except that dispex always writes the 8-byte barrier, which the reference
-// omits without meta data (guide §2): then ours = reference + 8 zero bytes, with editdatapos
-// moved by 8. With libdeflate (the default) compressed bytes differ, so everything else is
-// compared: header fields other than sizes, and every section inflated by zlib.
+// With zlib at level 6 (the reference's compressor and level) the files must be identical byte for
+// byte, except that dispex always writes the 8-byte barrier, which the reference omits without meta
+// data (docs/ptex.md, "File layout"): then ours = reference + 8 zero bytes, with editdatapos moved
+// by 8. With libdeflate (the default) compressed bytes differ, so everything else is compared:
+// header fields other than sizes, and every section inflated by zlib.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -42,7 +42,8 @@ inline std::vector<float> GoldenFace(int face, const PtexFaceInfo& info, int nch
 inline std::vector<GoldenCase> GoldenCases() {
   std::vector<GoldenCase> cases;
   {
-    // The guide's Catmull-Clark example: a quad, a pentagon, a quad and a triangle.
+    // The Catmull-Clark example of docs/ptex.md ("OpenSubdiv Ptex adjacency"): a quad, a
+    // pentagon, a quad and a triangle.
     GoldenCase c{"pentagon_triangle_float", {}, 10, nullptr};
     c.fill = [](PtexWriter& w) -> Status {
       Mesh mesh;

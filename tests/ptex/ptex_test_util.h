@@ -207,7 +207,7 @@ void Put(std::vector<std::uint8_t>& out, T v) {
   std::memcpy(out.data() + at, &v, sizeof(T));
 }
 
-// A second, minimal Ptex file assembler written from the guide with zlib, for building
+// A second, minimal Ptex file assembler written from docs/ptex.md with zlib, for building
 // files the dispex writer never makes (edit blocks, hand-made corruptions). It lays out the
 // given raw sections and computes every size and offset.
 struct RawPtex {

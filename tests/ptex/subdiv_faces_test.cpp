@@ -1,6 +1,7 @@
 // ComputeSubdivPtexFaces against OpenSubdiv itself (Far::PtexIndices numbering and
-// GetAdjacency) on every cage in tests/data/meshes, and against the guide's worked example
-// (§18.3, fixture cc_pentagon_triangle.ptx, written by the reference library).
+// GetAdjacency) on every cage in tests/data/meshes, and against the worked example of
+// docs/ptex.md, "Example: a quad, a pentagon, a quad and a triangle" (fixture
+// cc_pentagon_triangle.ptx, written by the reference library).
 #include <gtest/gtest.h>
 #include <opensubdiv/far/ptexIndices.h>
 #include <opensubdiv/far/topologyDescriptor.h>
@@ -34,7 +35,8 @@ Mesh PentagonTriangleMesh() {
   return mesh;
 }
 
-// The table of guide §18.3 and of the fixture's README.
+// The table of docs/ptex.md, "Example: a quad, a pentagon, a quad and a triangle", and of the
+// fixture's README.
 TEST(PtexSubdivFaces, GuideWorkedExample) {
   StatusOr<SubdivPtexFaces> layout = ComputeSubdivPtexFaces(PentagonTriangleMesh());
   ASSERT_TRUE(layout.ok()) << layout.status().message();

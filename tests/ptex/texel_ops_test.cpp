@@ -1,5 +1,6 @@
-// Texel operations against the guide's worked values and against naive implementations
-// written here from the guide's formulas (§11, §12.2, §16, §17).
+// Texel operations against the worked values of docs/ptex.md and against naive
+// implementations written here from its formulas ("Texel order, channel split and diff
+// encoding", "Reductions", "The triangle rule", "Premultiplication for reductions").
 #include "ptex/texel_ops.h"
 
 #include <gtest/gtest.h>

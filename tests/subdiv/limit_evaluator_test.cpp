@@ -82,10 +82,10 @@ TEST(LimitEvaluatorOracleTest, CodeBuiltCages) {
   ExpectMatchesOracle(holes);
 }
 
-// The pitfall of docs/DESIGN.md: Bfr's default approximation (approx_level_smooth = 2) moves
-// limit points near extraordinary vertices. dispex's defaults must match the patch table at
-// OpenSubdiv's deepest isolation (10) there, and the comparison must be able to see the
-// difference (it also sees level 6, which is why the default is 10).
+// The pitfall of docs/ARCHITECTURE.md, "OpenSubdiv pitfalls": Bfr's default approximation
+// (approx_level_smooth = 2) moves limit points near extraordinary vertices. dispex's defaults must
+// match the patch table at OpenSubdiv's deepest isolation (10) there, and the comparison must be
+// able to see the difference (it also sees level 6, which is why the default is 10).
 TEST(LimitEvaluatorOracleTest, ApproximationLevelRegression) {
   for (const Mesh& cage : {MakeCube(), MakePentagonPrism(), MakePentagonFan()}) {
     SCOPED_TRACE(cage.source);

@@ -28,8 +28,8 @@ double BoundsDiagonal(const Mesh& mesh);
 std::array<double, 3> Centroid(const Mesh& mesh);
 
 // Far::PatchTable reference evaluation of a cage's limit surface (settings from
-// docs/DESIGN.md: Gregory-basis end caps, useInfSharpPatch, no legacy sharp corners, double
-// precision, adaptive isolation `isolation`).
+// docs/ARCHITECTURE.md, "OpenSubdiv pitfalls": Gregory-basis end caps, useInfSharpPatch, no legacy
+// sharp corners, double precision, adaptive isolation `isolation`).
 class PatchOracle {
  public:
   PatchOracle(const Mesh& cage, int isolation);
