@@ -1,0 +1,73 @@
+// Reading a Ptex map at any point as the renderers that use it do, to measure what they see
+// where faces meet (docs/ptex.md, "Reading across face edges").
+//
+// Two readers:
+//  - Per face: bilinear between the face's own texel centres ((i + 0.5) / ures,
+//    (j + 0.5) / vres), clamped to its outermost texels (PtexFile::Sample; GPU Ptex without
+//    border texels, and any reader that does not filter across faces).
+//  - Across faces: the reference library's bilinear filter at zero filter width (wdas/ptex
+//    PtexBilinearFilter on PtexSeparableFilter). A 2 x 2 kernel at the face's resolution;
+//    where it reaches over an edge, the overhanging part is rotated into the neighbour and
+//    applied there at the coarser of the two resolutions (the kernel is merged pairwise when
+//    the neighbour is coarser; the neighbour's texels are box-reduced when it is finer);
+//    over a corner it goes to the diagonal face at a regular (valence-4) vertex, is made
+//    symmetric and shared by all corner faces at a valence-5+ vertex, and is dropped (the
+//    weights renormalised) at a valence-2 or -3 vertex; at an edge without neighbour it is
+//    folded back into the face (clamp). Sub-faces of n-gons follow the reference's sub-face
+//    rules. Differences from the reference: arithmetic is in double and reductions are exact
+//    box averages (the reference rounds each halving to the file's data type), so values
+//    agree to float rounding.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "dispex/ids.h"
+#include "dispex/ptex.h"
+
+namespace dispex {
+
+class PtexMapSampler {
+ public:
+  // `faces`: the map's face records (resolution, adjacency, sub-face flags); `texels`: per
+  // face one channel of its level-0 texels, ures x vres values v-major, or a single value for
+  // a constant face. Both must outlive the sampler. Precondition: one entry per face, sizes
+  // as stated, adjacency within range.
+  PtexMapSampler(std::span<const PtexFaceInfo> faces, std::span<const std::vector<float>> texels);
+  ~PtexMapSampler();
+  PtexMapSampler(PtexMapSampler&&) noexcept;
+  PtexMapSampler& operator=(PtexMapSampler&&) noexcept;
+
+  int num_faces() const;
+
+  // The per-face reader at (u, v), clamped to [0, 1].
+  double SampleFace(PtexFaceId face, double u, double v) const;
+  // The reference bilinear filter at (u, v), clamped to [0, 1]. Thread-safe: box reductions
+  // are built on first use, per face.
+  double SampleAcrossFaces(PtexFaceId face, double u, double v) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Where on its edge `edge` (0 bottom, 1 right, 2 top, 3 left) face parameter t in [0, 1]
+// lies, counter-clockwise: (t, 0), (1, t), (1 - t, 1), (0, 1 - t).
+void PtexEdgePoint(int edge, double t, double& u, double& v);
+
+// The same point of the surface seen from across the edge: the neighbour and its edge and
+// parameter. Between two faces or two sub-faces the parameter is reversed (1 - t); from a
+// sub-face to the quad it borders, the sub-face's edge is half of the quad's (the half met
+// first along the quad's edge when the quad names this sub-face, the second half otherwise).
+// Returns false when the edge has no neighbour, or when `face` is a quad bordering sub-faces
+// (measure those edges from the sub-face side, which covers them).
+struct PtexEdgeSide {
+  PtexFaceId face;
+  int edge = 0;
+  double t = 0;
+};
+bool PtexAcrossEdge(std::span<const PtexFaceInfo> faces, PtexFaceId face, int edge, double t,
+                    PtexEdgeSide& other);
+
+}  // namespace dispex
