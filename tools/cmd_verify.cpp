@@ -1,4 +1,5 @@
-// dispex verify BASE [SCULPT] MAP.ptx [--truth FILE [--tolerance T]] [--max-error E]
+// dispex verify BASE [SCULPT] MAP.ptx [--truth FILE] [--tolerance T] [--max-error E]
+//               [--max-edge-step K] [--max-edge-step-p99 K]
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -23,12 +24,9 @@ int RunVerify(VerifyArgs& args) {
     o.base_path = args.files[0];
     o.sculpt_path = args.files[1];
     o.map_path = args.files[2];
-  } else if (args.files.size() == 2 && !o.truth_path.empty()) {
+  } else {
     o.base_path = args.files[0];
     o.map_path = args.files[1];
-  } else {
-    return ReportFailure(
-        Status::Error("expected BASE SCULPT MAP.ptx (or BASE MAP.ptx with --truth)"), 2);
   }
   auto report = Verify(o);
   if (!report.ok()) return ReportFailure(report.status());
@@ -53,8 +51,10 @@ void SetupVerify(CLI::App& app, int& exit_code) {
   CLI::App* cmd = app.add_subcommand(
       "verify",
       "Measure a displacement map: the base limit surface displaced by MAP against the "
-      "sculpt, both ways (and/or against a make-sculpt truth file)");
-  cmd->add_option("files", args->files, "BASE SCULPT MAP.ptx, or BASE MAP.ptx with --truth")
+      "sculpt, both ways (and/or against a make-sculpt truth file), and the steps at shared "
+      "face edges");
+  cmd->add_option("files", args->files,
+                  "BASE SCULPT MAP.ptx, or BASE MAP.ptx (edge steps, and --truth if given)")
       ->required()
       ->expected(2, 3);
   cmd->add_option("--truth", o.truth_path, "make-sculpt truth file: compare with the exact h");
@@ -75,7 +75,7 @@ void SetupVerify(CLI::App& app, int& exit_code) {
                   "fail (exit 3) when an RMS error exceeds this, object units")
       ->check(Positive());
   cmd->add_option("--tolerance", o.tolerance,
-                  "tau of the truth bounds (default: the map's own, from its meta data)")
+                  "tau of the truth and edge bounds (default: the map's own, from its meta data)")
       ->check(Positive());
   cmd->add_option("--truth-rms-factor", o.truth_rms_factor,
                   "fail when the truth RMS exceeds this x tau (0: off)")
@@ -90,6 +90,12 @@ void SetupVerify(CLI::App& app, int& exit_code) {
       ->check(Positive())
       ->capture_default_str();
   cmd->add_flag("!--no-local-bound", o.truth_local_bound, "no per-record bound");
+  cmd->add_option("--max-edge-step", o.max_edge_step,
+                  "fail when a step at a shared face edge (either reader) exceeds this x tau")
+      ->check(Positive());
+  cmd->add_option("--max-edge-step-p99", o.max_edge_step_p99,
+                  "fail when the 99th percentile of the edge steps exceeds this x tau")
+      ->check(Positive());
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
       ->check(NonNegative())
       ->capture_default_str();

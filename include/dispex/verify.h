@@ -174,6 +174,12 @@ struct VerifyOptions {
   // sculpt of docs/ACCURACY.md.
   double truth_rms_factor = kDefaultTruthRmsFactor;
   double truth_p99_factor = kDefaultTruthP99Factor;
+  // Steps where faces meet (docs/ACCURACY.md, "Watertight edges"): fail when the largest
+  // step on a shared edge, under either reader, exceeds max_edge_step x tau, or their 99th
+  // percentile exceeds max_edge_step_p99 x tau (0: off). tau as for the truth bounds. Edges
+  // on infinitely sharp creases of the base are counted, not checked.
+  double max_edge_step = 0;
+  double max_edge_step_p99 = 0;
   int threads = 0;
   static constexpr double kDefaultTruthLocalToleranceFactor = 1.5;
   static constexpr double kDefaultTruthRmsFactor = 0.5;
@@ -213,6 +219,22 @@ struct VerifyReport {
     double max = 0;
   };
   std::vector<WorstFace> worst_faces;  // by map -> sculpt max, at most 10
+  // Steps at shared edges, object units, one per point (include/dispex/ptex_sampler.h for
+  // the readers): the per-face reader (clamped at the face's border) and the reference
+  // filter across faces.
+  bool measured_edges = false;
+  std::size_t edges = 0;         // shared edges between faces with a surface
+  std::size_t crease_edges = 0;  // of those, on infinitely sharp creases: not measured
+  ErrorStats edge_per_face, edge_across_faces;
+  double edge_tolerance = 0;  // tau the steps are checked against (0: not checked)
+  double edge_max_limit = 0, edge_p99_limit = 0;  // object units; 0: not checked
+  struct WorstEdge {
+    int face = -1, edge = 0, neighbour = -1;
+    double t = 0;     // along the face's edge, counter-clockwise
+    double step = 0;  // object units
+    const char* reader = "";  // "per-face" or "across-faces"
+  };
+  std::vector<WorstEdge> worst_edges;  // largest step first, at most 10
   // From the map's own meta data, when dispex wrote it.
   std::int64_t map_misses = -1, map_holes_filled = -1, map_faces_filled_from_neighbours = -1;
   double map_tolerance = 0;
@@ -223,7 +245,8 @@ struct VerifyReport {
 };
 
 // Re-displaces the base limit surface with the map (read bilinearly, as a renderer would) and
-// measures it against the sculpt both ways, and/or against a truth file.
+// measures it against the sculpt both ways, and/or against a truth file; measures the steps
+// at shared face edges always.
 StatusOr<VerifyReport> Verify(const VerifyOptions& options);
 
 std::string VerifyReportJson(const VerifyReport& report);

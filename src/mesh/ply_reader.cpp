@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/check.h"
+#include "core/first_error.h"
 #include "core/mapped_file.h"
 #include "dispex/mesh.h"
 #include "mesh/parallel.h"
@@ -36,24 +37,6 @@ using ply::Property;
 using ply::Type;
 
 constexpr std::size_t kBlock = 1 << 16;  // vertices or faces per parallel task
-
-// The first error by element index among errors found by parallel blocks.
-class FirstError {
- public:
-  void Offer(std::uint64_t index, std::string message) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!message_ || index < index_) {
-      index_ = index;
-      message_ = std::move(message);
-    }
-  }
-  const std::optional<std::string>& message() const { return message_; }
-
- private:
-  std::mutex mutex_;
-  std::uint64_t index_ = 0;
-  std::optional<std::string> message_;
-};
 
 // ---- Binary values ---------------------------------------------------------------------
 
@@ -304,7 +287,7 @@ class BinaryReader {
       for (int k = 0; k < 3; ++k) {
         const Type type = element.properties[static_cast<std::size_t>(axes[k])].type;
         if (auto message = ToCoordinate(LoadReal(data_ + at[k], type, swap_), xyz[k])) {
-          error.Offer(v, fmt::format("{}: vertex {}: {}", name_, v, *message));
+          error.Record(std::int64_t(v), Status::Error(fmt::format("{}: vertex {}: {}", name_, v, *message)));
           return false;
         }
       }
@@ -326,7 +309,7 @@ class BinaryReader {
     } else {
       // Lists in the vertex element (rare): records have no fixed stride, walk them.
       std::size_t pos = start;
-      for (std::size_t v = 0; v < n && !error.message(); ++v) {
+      for (std::size_t v = 0; v < n && !error.failed(); ++v) {
         std::size_t at[3] = {0, 0, 0};
         for (std::size_t k = 0; k < element.properties.size(); ++k) {
           for (int axis = 0; axis < 3; ++axis) {
@@ -338,7 +321,7 @@ class BinaryReader {
         convert(v, at, error);
       }
     }
-    if (error.message()) return Status::Error(*error.message());
+    if (error.failed()) return error.status();
     return Status::Ok();
   }
 
@@ -367,9 +350,10 @@ class BinaryReader {
             for (std::uint32_t i = 0; i < size; ++i, pos += item_size) {
               const std::int64_t index = LoadInt(data_ + pos, list.type, swap_);
               if (index < 0 || index >= num_vertices) {
-                error.Offer(
-                    f, fmt::format("{}: face {}: vertex index {} out of range ({} vertices)", name_,
-                                   f, index, num_vertices));
+                error.Record(std::int64_t(f),
+                             Status::Error(fmt::format(
+                                 "{}: face {}: vertex index {} out of range ({} vertices)", name_,
+                                 f, index, num_vertices)));
                 return;
               }
               out[i] = static_cast<std::int32_t>(index);
@@ -378,7 +362,7 @@ class BinaryReader {
         }
       });
     });
-    if (error.message()) return Status::Error(*error.message());
+    if (error.failed()) return error.status();
     return Status::Ok();
   }
 

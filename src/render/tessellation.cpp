@@ -27,6 +27,7 @@
 #include <optional>
 
 #include "core/check.h"
+#include "core/first_error.h"
 
 namespace dispex::render {
 
@@ -182,25 +183,6 @@ Float3 Sub(const Float3& a, const Float3& b) {
 double Length2(const Float3& a) {
   return double(a.x) * a.x + double(a.y) * a.y + double(a.z) * a.z;
 }
-
-// The lowest failing face's status, whatever the thread count.
-class FirstError {
- public:
-  void Set(int face, Status status) {
-    std::lock_guard lock(mutex_);
-    if (face < face_) {
-      face_ = face;
-      status_ = std::move(status);
-    }
-  }
-  bool failed() const { return face_ != std::numeric_limits<int>::max(); }
-  Status status() const { return status_; }
-
- private:
-  std::mutex mutex_;
-  int face_ = std::numeric_limits<int>::max();
-  Status status_;
-};
 
 Status MapValueError(const PtexFile& map, int face) {
   std::vector<float> texels;
@@ -458,7 +440,7 @@ StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface
       s.uv[2 * (k - begin) + 1] = r.v;
     }
     Status st = evaluator_for_thread().EvaluatePoints(PtexFaceId(f), s.uv, s.p, s.nrm);
-    if (!st.ok()) return error.Set(f, st);
+    if (!st.ok()) return error.Record(f, st);
     for (std::size_t k = begin; k < end; ++k) {
       const auto v = static_cast<std::size_t>(owners[k].second);
       float h = 0;
@@ -468,7 +450,7 @@ StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface
           const float value =
               map->Sample(PtexFaceId(records[r].face), records[r].u, records[r].v, channel);
           if (!std::isfinite(value))
-            return error.Set(records[r].face, MapValueError(*map, records[r].face));
+            return error.Record(records[r].face, MapValueError(*map, records[r].face));
           sum += value;
         }
         h = static_cast<float>(sum / double(vertex_records[v + 1] - vertex_records[v]));
@@ -512,12 +494,12 @@ StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface
       s.p.resize(3 * count);
       s.nrm.resize(3 * count);
       Status st = evaluator_for_thread().EvaluatePoints(PtexFaceId(f), s.uv, s.p, s.nrm);
-      if (!st.ok()) return error.Set(f, st);
+      if (!st.ok()) return error.Record(f, st);
       for (std::size_t k = 0; k < count; ++k) {
         float h = 0;
         if (map) {
           h = map->Sample(PtexFaceId(f), s.uv[2 * k], s.uv[2 * k + 1], channel);
-          if (!std::isfinite(h)) return error.Set(f, MapValueError(*map, f));
+          if (!std::isfinite(h)) return error.Record(f, MapValueError(*map, f));
         }
         const std::size_t i = 3 * k;
         limit_normals[first + k] = {s.nrm[i], s.nrm[i + 1], s.nrm[i + 2]};

@@ -19,11 +19,13 @@
 #include <numeric>
 #include <optional>
 
+#include "core/first_error.h"
 #include "core/system.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
+#include "verify/edge_steps.h"
 
 namespace dispex {
 
@@ -182,11 +184,88 @@ void RmsThreshold(VerifyReport& r, const char* what, const ErrorStats& s, double
 
 }  // namespace
 
+Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFile& map,
+                    const VerifyOptions& options, VerifyReport& r) {
+  const std::vector<PtexFaceInfo> faces = MapFacesOnSurface(surface, map);
+  std::vector<std::vector<float>> texels(faces.size());
+  std::vector<std::uint8_t> holes(faces.size());
+  FirstError error;
+  tbb::parallel_for(std::size_t{0}, faces.size(), [&](std::size_t f) {
+    const PtexFaceId face(static_cast<std::int32_t>(f));
+    holes[f] = surface.is_hole(face);
+    const int channels = map.header().num_channels;
+    if (map.BlockInfo(face, 0).encoding == PtexBlockInfo::Encoding::kConstant) {
+      std::vector<float> value(static_cast<std::size_t>(channels));
+      map.ConstantValue(face, value.data());
+      texels[f] = {value[0]};
+    } else {
+      std::vector<float> all;
+      Status read = map.ReadFace(face, 0, all);
+      if (!read.ok()) return error.Record(static_cast<int>(f), read);
+      texels[f].resize(all.size() / static_cast<std::size_t>(channels));
+      for (std::size_t i = 0; i < texels[f].size(); ++i) {
+        texels[f][i] = all[i * static_cast<std::size_t>(channels)];
+      }
+    }
+    for (float x : texels[f]) {
+      if (!std::isfinite(x)) {
+        return error.Record(static_cast<int>(f),
+                         Status::Error(fmt::format("{}: face {} holds a value that is not finite",
+                                                   map.name(), f)));
+      }
+    }
+  });
+  if (error.failed()) return error.status();
+  EdgeSteps steps = MeasureEdgeSteps(faces, texels, SharpCreaseEdges(base, surface), holes);
+  r.measured_edges = true;
+  r.edges = steps.edges;
+  r.crease_edges = steps.crease_edges;
+  r.edge_per_face = Summarise(steps.per_face);
+  r.edge_across_faces = Summarise(steps.across_faces);
+  r.worst_edges = std::move(steps.worst);
+  const double tau = options.tolerance > 0 ? options.tolerance : r.map_tolerance;
+  if ((options.max_edge_step > 0 || options.max_edge_step_p99 > 0) && !(tau > 0)) {
+    return Status::Error(fmt::format(
+        "{}: the edge-step bounds are in tolerances, and the map carries none (no "
+        "dispex:statistics): give the tolerance",
+        map.name()));
+  }
+  r.edge_tolerance = tau;
+  r.edge_max_limit = options.max_edge_step * tau;
+  r.edge_p99_limit = options.max_edge_step_p99 * tau;
+  return Status::Ok();
+}
+
+void EdgeThresholds(VerifyReport& r, const VerifyOptions& options) {
+  if (!r.passed) return;
+  const std::pair<const char*, const ErrorStats*> readers[] = {
+      {"per-face", &r.edge_per_face}, {"across-faces", &r.edge_across_faces}};
+  for (const auto& [reader, stats] : readers) {
+    if (r.edge_max_limit > 0 && stats->max > r.edge_max_limit) {
+      r.passed = false;
+      r.failure = fmt::format(
+          "edge steps ({} reader): max {:.4g} exceeds max_edge_step {} x tolerance {:.4g}", reader,
+          stats->max, options.max_edge_step, r.edge_tolerance);
+    } else if (r.edge_p99_limit > 0 && stats->p99 > r.edge_p99_limit) {
+      r.passed = false;
+      r.failure = fmt::format(
+          "edge steps ({} reader): p99 {:.4g} exceeds max_edge_step_p99 {} x tolerance {:.4g}",
+          reader, stats->p99, options.max_edge_step_p99, r.edge_tolerance);
+    }
+    if (!r.passed) {
+      for (const auto& w : r.worst_edges) {
+        if (std::string_view(w.reader) != reader) continue;
+        r.failure += fmt::format(" (worst: face {} edge {} at t {:.4g}, neighbour {}, step {:.4g})",
+                                 w.face, w.edge, w.t, w.neighbour, w.step);
+        break;
+      }
+      return;
+    }
+  }
+}
+
 StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   Stopwatch clock;
-  if (options.sculpt_path.empty() && options.truth_path.empty()) {
-    return Status::Error("nothing to compare the map with: give a sculpt or --truth");
-  }
   if (options.samples_per_face < 0 || options.samples_per_face > 512) {
     return Status::Error(fmt::format("--samples {}: must be 0..512", options.samples_per_face));
   }
@@ -218,6 +297,8 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
       r.map_tolerance = j.value("tolerance", 0.0);
     }
   }
+
+  DISPEX_RETURN_IF_ERROR(MeasureEdges(base, surface, map, options, r));
 
   if (!options.truth_path.empty()) {
     DISPEX_ASSIGN_OR_RETURN(GroundTruth truth, ReadGroundTruth(options.truth_path));
@@ -348,6 +429,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     Threshold(r, "map->sculpt", r.map_to_sculpt, limit_abs, option);
     Threshold(r, "sculpt->map", r.sculpt_to_map, limit_abs, option);
   }
+  EdgeThresholds(r, options);
   if (r.measured_truth) RmsThreshold(r, "truth", r.truth, options.max_rms);
   if (r.measured_distances) {
     RmsThreshold(r, "map->sculpt", r.map_to_sculpt, options.max_rms);
@@ -411,6 +493,33 @@ std::string VerifyReportJson(const VerifyReport& r) {
     }
     j["truth"]["bound"] = bound;
   }
+  if (r.measured_edges) {
+    auto steps = [&](const ErrorStats& s) {
+      nlohmann::json out = StatsJson(s, r.diagonal);
+      if (r.edge_tolerance > 0) {
+        out["p99_tolerances"] = s.p99 / r.edge_tolerance;
+        out["max_tolerances"] = s.max / r.edge_tolerance;
+      }
+      return out;
+    };
+    nlohmann::json worst = nlohmann::json::array();
+    for (const auto& w : r.worst_edges) {
+      worst.push_back({{"face", w.face},
+                       {"edge", w.edge},
+                       {"neighbour", w.neighbour},
+                       {"t", w.t},
+                       {"step", w.step},
+                       {"reader", w.reader}});
+    }
+    j["edges"] = {{"shared", r.edges},
+                  {"sharp_creases", r.crease_edges},
+                  {"tolerance", r.edge_tolerance},
+                  {"max_limit", r.edge_max_limit},
+                  {"p99_limit", r.edge_p99_limit},
+                  {"per_face", steps(r.edge_per_face)},
+                  {"across_faces", steps(r.edge_across_faces)},
+                  {"worst", worst}};
+  }
   j["map"] = {{"misses", r.map_misses},
               {"holes_filled", r.map_holes_filled},
               {"faces_filled_from_neighbours", r.map_faces_filled_from_neighbours},
@@ -446,6 +555,29 @@ std::string VerifyReportSummary(const VerifyReport& r) {
         out +=
             fmt::format("  {} records near folded sculpt faces not bounded\n", r.truth_unbounded);
       }
+    }
+  }
+  if (r.measured_edges) {
+    auto line = [&](const char* what, const ErrorStats& s) {
+      std::string tolerances;
+      if (r.edge_tolerance > 0) {
+        tolerances = fmt::format(" ({:.3g} / {:.3g} tolerances)", s.p99 / r.edge_tolerance,
+                                 s.max / r.edge_tolerance);
+      }
+      return fmt::format("  {:<12} p99 {:.4g}  max {:.4g}{}\n", what, s.p99, s.max, tolerances);
+    };
+    out += fmt::format("  edge steps on {} shared edges ({} points; {} on sharp creases not "
+                       "measured):\n",
+                       r.edges - r.crease_edges, r.edge_per_face.count, r.crease_edges);
+    out += line("per-face", r.edge_per_face);
+    out += line("across-faces", r.edge_across_faces);
+    if (!r.worst_edges.empty()) {
+      out += "  worst edges:";
+      for (std::size_t i = 0; i < std::min<std::size_t>(3, r.worst_edges.size()); ++i) {
+        const auto& w = r.worst_edges[i];
+        out += fmt::format(" face {} edge {} ({}, {:.3g})", w.face, w.edge, w.reader, w.step);
+      }
+      out += "\n";
     }
   }
   if (r.map_misses >= 0) {
