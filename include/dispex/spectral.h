@@ -62,6 +62,12 @@ struct SpectralOptions {
   // When false the bound alone decides: the band-limited series is then within tolerance at
   // every sample, but a bilinear read-back may deviate more.
   bool verify = true;
+  // kErrorBound with verify: also step up until the per-face reader's value on each of the
+  // face's edges (its outermost texels, clamped) is within this of the displacement there
+  // (extrapolated from the two outermost sample rows), so that two faces read on their own
+  // meet within twice this (0: off). Where even the samples cannot meet it the face stays at
+  // the sample resolution (SpectralFaceStats::edge_limited).
+  double edge_tolerance = 0.0;
   // kNonzero: |F(u,v)| above this counts as non-zero (>= 0, finite; orthonormal scale).
   double nonzero_threshold = 0.0;
   // kFixed: the resolution, 0..kMaxSpectralLog2 each.
@@ -88,6 +94,10 @@ struct SpectralFaceStats {
   int bound_vlog2 = 0;
   int step_ups = 0;
   bool constant = false;
+  // With an edge tolerance: the per-face reader's largest error on the face's edges, and
+  // whether the edge tolerance was out of reach at the sample resolution.
+  double edge_error = 0.0;
+  bool edge_limited = false;
 };
 
 // Totals over faces. Every member is a count or a maximum, so the totals do not depend on the
@@ -101,6 +111,8 @@ struct SpectralTotals {
   std::int64_t texels_after = 0;
   double max_bound = 0.0;
   double max_measured_error = 0.0;
+  double max_edge_error = 0.0;
+  std::int64_t edge_limited_faces = 0;
   // Faces by final ulog2 / vlog2.
   std::array<std::int64_t, kMaxSpectralLog2 + 1> ulog2_faces{};
   std::array<std::int64_t, kMaxSpectralLog2 + 1> vlog2_faces{};
@@ -143,7 +155,8 @@ class SpectralAnalyzer {
   // Chooses the face's resolution and computes its texels (see SpectralOptions).
   // `samples` holds nx * ny finite values. Errors (Status): nx or ny not a power of two in
   // 1..512, samples.size() != nx * ny, a non-finite sample (named by (i, j)), invalid options.
-  // Guarantee with kErrorBound and verify: stats.measured_error <= tolerance.
+  // Guarantee with kErrorBound and verify: stats.measured_error <= tolerance, and
+  // stats.edge_error <= edge_tolerance unless stats.edge_limited.
   StatusOr<SpectralFace> Analyze(std::span<const float> samples, int nx, int ny,
                                  const SpectralOptions& options);
 

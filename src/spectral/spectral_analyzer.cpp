@@ -30,6 +30,7 @@
 #include "spectral/block_shape.h"
 #include "spectral/dct2d.h"
 #include "spectral/dct_scale.h"
+#include "spectral/edge_readback.h"
 #include "spectral/nonzero_rule.h"
 #include "spectral/truncation_bounds.h"
 
@@ -163,17 +164,36 @@ StatusOr<SpectralFace> SpectralAnalyzer::Analyze(std::span<const float> samples,
   SpectralFace face;
   face.stats.texels_before = static_cast<std::int64_t>(shape.count());
   const double tolerance = options.tolerance;
+  const bool verify = options.rule == ResolutionRule::kErrorBound && options.verify;
+  // With an edge tolerance, a resolution is accepted when both the read-back error and the
+  // per-face reader's error on the face's edges are within theirs; candidates compete on the
+  // larger of the two ratios.
+  const double edge_tolerance = verify ? options.edge_tolerance : 0.0;
+  auto edge_error = [&](const float* texels, const BlockShape& res) {
+    return edge_tolerance > 0 ? spectral::MaxEdgeReadError(texels, res, m.samples.data(), shape)
+                              : 0.0;
+  };
+  auto score = [&](double error, double edge) {
+    return edge_tolerance > 0 ? std::max(error / tolerance, edge / edge_tolerance) : error;
+  };
+  auto accepted = [&](double error, double edge) {
+    return error <= tolerance && (edge_tolerance <= 0 || edge <= edge_tolerance);
+  };
   if (options.rule == ResolutionRule::kErrorBound && summary.max_deviation <= tolerance) {
     float* texel = m.texels[0].Reserve(1);
     texel[0] = summary.mean;
-    face.constant = true;
-    face.constant_value = summary.mean;
-    face.texels = std::span<const float>(texel, 1);
-    face.stats.texels_after = 1;
-    face.stats.bound = summary.max_deviation;
-    face.stats.measured_error = summary.max_deviation;
-    face.stats.constant = true;
-    return face;
+    const double edge = edge_error(texel, ShapeOfLog2(0, 0));
+    if (accepted(summary.max_deviation, edge)) {
+      face.constant = true;
+      face.constant_value = summary.mean;
+      face.texels = std::span<const float>(texel, 1);
+      face.stats.texels_after = 1;
+      face.stats.bound = summary.max_deviation;
+      face.stats.measured_error = summary.max_deviation;
+      face.stats.edge_error = edge;
+      face.stats.constant = true;
+      return face;
+    }
   }
 
   m.dct.Forward(shape.lx, shape.ly, m.samples.data(), m.coefficients.Reserve(shape.count()));
@@ -196,39 +216,51 @@ StatusOr<SpectralFace> SpectralAnalyzer::Analyze(std::span<const float> samples,
   face.stats.bound_ulog2 = kx;
   face.stats.bound_vlog2 = ky;
 
-  const bool verify = options.rule == ResolutionRule::kErrorBound && options.verify;
   int slot = 0;
   const float* texels = m.ResampleLoaded(shape, ShapeOfLog2(kx, ky), summary.mean, slot);
+  const bool early_stop = verify && edge_tolerance <= 0;
   double error = spectral::MaxReadBackError(texels, ShapeOfLog2(kx, ky), m.samples.data(), shape,
                                             verify ? tolerance : kInfinity);
-  while (verify && error > tolerance) {
+  double edge = edge_error(texels, ShapeOfLog2(kx, ky));
+  while (verify && !accepted(error, edge)) {
     // Candidates: u doubled into one free slot, v doubled into the other. The v candidate's
     // measurement may stop once it exceeds the u candidate's (it has lost: ties go to u).
     const bool can_u = kx < shape.lx;
     const bool can_v = ky < shape.ly;
-    DISPEX_CHECK(can_u || can_v);  // the full resolution reads back exactly
+    if (!can_u && !can_v) {
+      // The full resolution reads back exactly; only the edge criterion can still fail, where
+      // the samples themselves are too coarse for it.
+      DISPEX_CHECK(error <= tolerance);
+      face.stats.edge_limited = true;
+      break;
+    }
     const int slot_u = (slot + 1) % 3;
     const int slot_v = (slot + 2) % 3;
-    double error_u = kInfinity;
-    double error_v = kInfinity;
+    double error_u = kInfinity, edge_u = kInfinity;
+    double error_v = kInfinity, edge_v = kInfinity;
     if (can_u) {
       const BlockShape res = ShapeOfLog2(kx + 1, ky);
       const float* t = m.ResampleLoaded(shape, res, summary.mean, slot_u);
       error_u = spectral::MaxReadBackError(t, res, m.samples.data(), shape, kInfinity);
+      edge_u = edge_error(t, res);
     }
     if (can_v) {
       const BlockShape res = ShapeOfLog2(kx, ky + 1);
       const float* t = m.ResampleLoaded(shape, res, summary.mean, slot_v);
-      error_v = spectral::MaxReadBackError(t, res, m.samples.data(), shape, error_u);
+      error_v = spectral::MaxReadBackError(t, res, m.samples.data(), shape,
+                                           early_stop ? error_u : kInfinity);
+      edge_v = edge_error(t, res);
     }
-    if (can_u && error_u <= error_v) {
+    if (can_u && score(error_u, edge_u) <= score(error_v, edge_v)) {
       ++kx;
       slot = slot_u;
       error = error_u;
+      edge = edge_u;
     } else {
       ++ky;
       slot = slot_v;
       error = error_v;
+      edge = edge_v;
     }
     ++face.stats.step_ups;
   }
@@ -242,6 +274,7 @@ StatusOr<SpectralFace> SpectralAnalyzer::Analyze(std::span<const float> samples,
   face.stats.texels_after = static_cast<std::int64_t>(res.count());
   face.stats.bound = m.bounds.Bound(kx, ky);
   face.stats.measured_error = error;
+  face.stats.edge_error = edge;
   face.stats.constant = face.constant;
   return face;
 }

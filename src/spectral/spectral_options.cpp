@@ -43,6 +43,10 @@ Status ValidateSpectralOptions(const SpectralOptions& options) {
     return Status::Error(
         fmt::format("tolerance {} must be finite and >= 0 (object units)", options.tolerance));
   }
+  if (!std::isfinite(options.edge_tolerance) || options.edge_tolerance < 0) {
+    return Status::Error(fmt::format("edge tolerance {} must be finite and >= 0 (object units)",
+                                     options.edge_tolerance));
+  }
   if (!std::isfinite(options.nonzero_threshold) || options.nonzero_threshold < 0) {
     return Status::Error(
         fmt::format("nonzero threshold {} must be finite and >= 0", options.nonzero_threshold));
@@ -66,6 +70,8 @@ void SpectralTotals::Add(const SpectralFaceStats& face, int ulog2, int vlog2) {
   texels_after += face.texels_after;
   max_bound = std::max(max_bound, face.bound);
   max_measured_error = std::max(max_measured_error, face.measured_error);
+  max_edge_error = std::max(max_edge_error, face.edge_error);
+  edge_limited_faces += face.edge_limited ? 1 : 0;
   ++ulog2_faces[std::clamp(ulog2, 0, kMaxSpectralLog2)];
   ++vlog2_faces[std::clamp(vlog2, 0, kMaxSpectralLog2)];
 }
@@ -79,6 +85,8 @@ void SpectralTotals::Merge(const SpectralTotals& other) {
   texels_after += other.texels_after;
   max_bound = std::max(max_bound, other.max_bound);
   max_measured_error = std::max(max_measured_error, other.max_measured_error);
+  max_edge_error = std::max(max_edge_error, other.max_edge_error);
+  edge_limited_faces += other.edge_limited_faces;
   for (int l = 0; l <= kMaxSpectralLog2; ++l) {
     ulog2_faces[l] += other.ulog2_faces[l];
     vlog2_faces[l] += other.vlog2_faces[l];

@@ -371,3 +371,48 @@ TEST(ResolutionTest, RejectsBadInput) {
 
 }  // namespace
 }  // namespace dispex
+
+namespace dispex {
+namespace {
+
+// A ramp across u, f = 0.5 u (500 tolerances of 1e-3 over the face). The read-back check
+// already covers the clamped strip between the outermost texel centre and the outermost
+// sample, half a sample from the edge: 0.5 (1 / (2 rx) - 1 / (2 nx)) <= 1e-3 needs rx = 256.
+// On the edge itself the per-face reader misses by 0.5 / (2 rx) = 9.8e-4, twice the edge
+// tolerance 5e-4, which takes rx = 512.
+TEST(ResolutionTest, EdgeToleranceRaisesTheResolutionAcrossASlope) {
+  const int nx = 512, ny = 4;
+  std::vector<float> samples(nx * ny);
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) samples[j * nx + i] = float(0.5 * (i + 0.5) / nx);
+  }
+  SpectralAnalyzer analyzer;
+  SpectralOptions options;
+  options.tolerance = 1e-3;
+  auto plain = analyzer.Analyze(samples, nx, ny, options);
+  ASSERT_TRUE(plain.ok());
+  EXPECT_EQ(plain->ulog2, 8);
+  EXPECT_EQ(plain->stats.edge_error, 0.0);  // not measured without an edge tolerance
+
+  options.edge_tolerance = 5e-4;
+  auto watertight = analyzer.Analyze(samples, nx, ny, options);
+  ASSERT_TRUE(watertight.ok());
+  EXPECT_EQ(watertight->ulog2, 9);
+  EXPECT_EQ(watertight->vlog2, 0);
+  EXPECT_LE(watertight->stats.edge_error, 5e-4);
+  EXPECT_FALSE(watertight->stats.edge_limited);
+
+  // Coarser samples cannot hold it: the face stays at the sample resolution, flagged.
+  std::vector<float> coarse(64 * ny);
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < 64; ++i) coarse[j * 64 + i] = float(0.5 * (i + 0.5) / 64);
+  }
+  auto limited = analyzer.Analyze(coarse, 64, ny, options);
+  ASSERT_TRUE(limited.ok());
+  EXPECT_EQ(limited->ulog2, 6);
+  EXPECT_TRUE(limited->stats.edge_limited);
+  EXPECT_GT(limited->stats.edge_error, 5e-4);
+}
+
+}  // namespace
+}  // namespace dispex
