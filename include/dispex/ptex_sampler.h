@@ -19,6 +19,7 @@
 //    agree to float rounding.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <vector>
@@ -69,5 +70,32 @@ struct PtexEdgeSide {
 };
 bool PtexAcrossEdge(std::span<const PtexFaceInfo> faces, PtexFaceId face, int edge, double t,
                     PtexEdgeSide& other);
+
+// ---- Steps where faces meet ------------------------------------------------------------------
+
+// The largest step of one edge: from `face`'s edge `edge` at parameter t, to `neighbour`.
+struct PtexEdgeStep {
+  int face = -1, edge = 0, neighbour = -1;
+  double t = 0;
+  double step = 0;
+  bool across_faces = false;  // the cross-face reader's step (else the per-face reader's)
+};
+
+// Steps on every edge between two faces, at t = j / n (j = 0..n) along it, n = max(16, 2 x
+// the finer side's texels along the edge): every texel centre and edge of either side, where
+// the piecewise-linear steps have their extremes, so the largest is exact. Edges flagged in
+// `skip_edges` (bit e of a face's entry: its edge e, e.g. an infinitely sharp crease where
+// the displacement itself jumps) are counted, not measured; faces flagged in `skip_faces`
+// (holes) are left out with their edges. Deterministic: face by face in id order. `faces`
+// and `texels` as for PtexMapSampler.
+struct PtexEdgeSteps {
+  std::size_t edges = 0, skipped_edges = 0;
+  std::vector<float> per_face, across_faces;  // one |step| per point, in edge order
+  std::vector<PtexEdgeStep> edge_max;         // per measured edge its largest step
+};
+PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
+                                   std::span<const std::vector<float>> texels,
+                                   std::span<const std::uint8_t> skip_edges,
+                                   std::span<const std::uint8_t> skip_faces);
 
 }  // namespace dispex

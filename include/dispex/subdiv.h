@@ -212,4 +212,9 @@ struct RefinedMesh {
 StatusOr<RefinedMesh> RefineUniform(const LimitSurface& surface, int levels,
                                     const RefineOptions& options = {});
 
+// Per Ptex face of `surface` (built from `cage`), bit e set when its edge e lies on an
+// infinitely sharp crease of the cage (sharpness >= 10): the limit normal, and with it any
+// displacement along it, is discontinuous there.
+std::vector<std::uint8_t> SharpCreaseEdges(const Mesh& cage, const LimitSurface& surface);
+
 }  // namespace dispex

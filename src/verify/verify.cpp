@@ -25,7 +25,7 @@
 #include "dispex/ptex.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
-#include "verify/edge_steps.h"
+#include "dispex/ptex_sampler.h"
 
 namespace dispex {
 
@@ -184,6 +184,26 @@ void RmsThreshold(VerifyReport& r, const char* what, const ErrorStats& s, double
 
 }  // namespace
 
+// The map's face table for the sampler: resolutions from the map, adjacency and sub-face
+// flags from the base's limit surface (the map's own adjacency is not trusted).
+std::vector<PtexFaceInfo> MapFacesOnSurface(const LimitSurface& surface, const PtexFile& map) {
+  std::vector<PtexFaceInfo> faces(static_cast<std::size_t>(surface.num_ptex_faces()));
+  for (int f = 0; f < surface.num_ptex_faces(); ++f) {
+    const PtexFaceInfo& stored = map.face_info(PtexFaceId(f));
+    PtexFaceInfo& info = faces[std::size_t(f)];
+    info.ulog2 = stored.ulog2;
+    info.vlog2 = stored.vlog2;
+    info.subface = surface.num_ptex_faces(surface.base_face(PtexFaceId(f))) != 1;
+    const PtexAdjacency& adjacency = surface.adjacency(PtexFaceId(f));
+    for (int e = 0; e < 4; ++e) {
+      info.adjfaces[std::size_t(e)] = adjacency.faces[std::size_t(e)].value;
+      info.adjedges[std::size_t(e)] =
+          adjacency.faces[std::size_t(e)].valid() ? std::uint8_t(adjacency.edges[std::size_t(e)]) : 0;
+    }
+  }
+  return faces;
+}
+
 Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFile& map,
                     const VerifyOptions& options, VerifyReport& r) {
   const std::vector<PtexFaceInfo> faces = MapFacesOnSurface(surface, map);
@@ -216,13 +236,20 @@ Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFil
     }
   });
   if (error.failed()) return error.status();
-  EdgeSteps steps = MeasureEdgeSteps(faces, texels, SharpCreaseEdges(base, surface), holes);
+  PtexEdgeSteps steps =
+      MeasurePtexEdgeSteps(faces, texels, SharpCreaseEdges(base, surface), holes);
   r.measured_edges = true;
   r.edges = steps.edges;
-  r.crease_edges = steps.crease_edges;
+  r.crease_edges = steps.skipped_edges;
   r.edge_per_face = Summarise(steps.per_face);
   r.edge_across_faces = Summarise(steps.across_faces);
-  r.worst_edges = std::move(steps.worst);
+  std::stable_sort(steps.edge_max.begin(), steps.edge_max.end(),
+                   [](const auto& x, const auto& y) { return x.step > y.step; });
+  for (const PtexEdgeStep& s : steps.edge_max) {
+    if (r.worst_edges.size() == 10 || s.step == 0) break;
+    r.worst_edges.push_back(
+        {s.face, s.edge, s.neighbour, s.t, s.step, s.across_faces ? "across-faces" : "per-face"});
+  }
   const double tau = options.tolerance > 0 ? options.tolerance : r.map_tolerance;
   if ((options.max_edge_step > 0 || options.max_edge_step_p99 > 0) && !(tau > 0)) {
     return Status::Error(fmt::format(

@@ -1,0 +1,78 @@
+// Edge steps of a map under both readers (include/dispex/ptex_sampler.h).
+#include "dispex/ptex_sampler.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace dispex {
+
+PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
+                                   std::span<const std::vector<float>> texels,
+                                   std::span<const std::uint8_t> skip_edges,
+                                   std::span<const std::uint8_t> skip_faces) {
+  const PtexMapSampler sampler(faces, texels);
+  const std::size_t n = faces.size();
+  struct FaceSteps {
+    std::size_t edges = 0, skipped_edges = 0;
+    std::vector<float> per_face, across_faces;
+    std::vector<PtexEdgeStep> edge_max;
+  };
+  std::vector<FaceSteps> per(n);
+  auto along = [&](int f, int e) {
+    const PtexFaceInfo& info = faces[std::size_t(f)];
+    return e % 2 == 0 ? info.ures() : info.vres();
+  };
+  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t fi) {
+    const int f = static_cast<int>(fi);
+    if (skip_faces[fi]) return;
+    FaceSteps& out = per[fi];
+    for (int e = 0; e < 4; ++e) {
+      PtexEdgeSide first;
+      if (!PtexAcrossEdge(faces, PtexFaceId(f), e, 0.0, first)) continue;
+      const int a = first.face.value;
+      if (skip_faces[std::size_t(a)]) continue;
+      // Between faces of one kind, each edge once: from the lower id (or lower edge on itself).
+      if (faces[fi].subface == faces[std::size_t(a)].subface && (a < f || (a == f && first.edge < e))) {
+        continue;
+      }
+      ++out.edges;
+      if (skip_edges[fi] & (1u << e)) {
+        ++out.skipped_edges;
+        continue;
+      }
+      const int points = std::max(16, 2 * std::max(along(f, e), along(a, first.edge)));
+      PtexEdgeStep worst{f, e, a, 0, 0, false};
+      for (int j = 0; j <= points; ++j) {
+        const double t = double(j) / points;
+        PtexEdgeSide other;
+        PtexAcrossEdge(faces, PtexFaceId(f), e, t, other);
+        double u = 0, v = 0, ou = 0, ov = 0;
+        PtexEdgePoint(e, t, u, v);
+        PtexEdgePoint(other.edge, other.t, ou, ov);
+        const double face_step =
+            std::abs(sampler.SampleFace(PtexFaceId(f), u, v) - sampler.SampleFace(other.face, ou, ov));
+        const double filter_step = std::abs(sampler.SampleAcrossFaces(PtexFaceId(f), u, v) -
+                                            sampler.SampleAcrossFaces(other.face, ou, ov));
+        out.per_face.push_back(static_cast<float>(face_step));
+        out.across_faces.push_back(static_cast<float>(filter_step));
+        if (face_step > worst.step) worst = {f, e, a, t, face_step, false};
+        if (filter_step > worst.step) worst = {f, e, a, t, filter_step, true};
+      }
+      out.edge_max.push_back(worst);
+    }
+  });
+  PtexEdgeSteps steps;
+  for (FaceSteps& p : per) {
+    steps.edges += p.edges;
+    steps.skipped_edges += p.skipped_edges;
+    steps.per_face.insert(steps.per_face.end(), p.per_face.begin(), p.per_face.end());
+    steps.across_faces.insert(steps.across_faces.end(), p.across_faces.begin(), p.across_faces.end());
+    steps.edge_max.insert(steps.edge_max.end(), p.edge_max.begin(), p.edge_max.end());
+  }
+  return steps;
+}
+
+}  // namespace dispex
