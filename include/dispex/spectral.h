@@ -68,6 +68,11 @@ struct SpectralOptions {
   // meet within twice this (0: off). Where even the samples cannot meet it the face stays at
   // the sample resolution (SpectralFaceStats::edge_limited).
   double edge_tolerance = 0.0;
+  // kErrorBound: the least resolution (log2 per side, capped at the sample grid's), e.g. for
+  // a face whose neighbours need it to meet without a step. Faces with a floor are never
+  // made constant.
+  int min_ulog2 = 0;
+  int min_vlog2 = 0;
   // kNonzero: |F(u,v)| above this counts as non-zero (>= 0, finite; orthonormal scale).
   double nonzero_threshold = 0.0;
   // kFixed: the resolution, 0..kMaxSpectralLog2 each.

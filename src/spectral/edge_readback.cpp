@@ -48,6 +48,19 @@ double MaxEdgeReadError(const float* texels, const BlockShape& res, const float*
     const double at_right = Extrapolate(s[nx - 1], nx > 1 ? s[nx - 2] : 0, nx > 1);
     worst = std::max({worst, std::fabs(left - at_left), std::fabs(right - at_right)});
   }
+  // The corners: the corner texel, against the samples extrapolated both ways.
+  for (int cj : {0, 1}) {
+    for (int ci : {0, 1}) {
+      const int i0 = ci ? nx - 1 : 0, i1 = ci ? nx - 2 : 1;
+      const int j0 = cj ? ny - 1 : 0, j1 = cj ? ny - 2 : 1;
+      auto at = [&](int i, int j) { return double(samples[std::ptrdiff_t(j) * row + i]); };
+      auto edge_value = [&](int j) { return Extrapolate(at(i0, j), nx > 1 ? at(i1, j) : 0, nx > 1); };
+      const double corner =
+          Extrapolate(edge_value(j0), ny > 1 ? edge_value(j1) : 0, ny > 1);
+      const double texel = texels[std::ptrdiff_t(cj ? ry - 1 : 0) * rx + (ci ? rx - 1 : 0)];
+      worst = std::max(worst, std::fabs(texel - corner));
+    }
+  }
   return worst;
 }
 

@@ -9,7 +9,8 @@
 
 namespace dispex::spectral {
 
-// max over the edges' sample positions of |edge read - extrapolated edge value|, in double.
+// max over the edges' sample positions and the four corners of |edge read - extrapolated
+// edge value|, in double.
 double MaxEdgeReadError(const float* texels, const BlockShape& res, const float* samples,
                         const BlockShape& samples_shape);
 

@@ -179,7 +179,9 @@ StatusOr<SpectralFace> SpectralAnalyzer::Analyze(std::span<const float> samples,
   auto accepted = [&](double error, double edge) {
     return error <= tolerance && (edge_tolerance <= 0 || edge <= edge_tolerance);
   };
-  if (options.rule == ResolutionRule::kErrorBound && summary.max_deviation <= tolerance) {
+  const bool has_floor = options.min_ulog2 > 0 || options.min_vlog2 > 0;
+  if (options.rule == ResolutionRule::kErrorBound && summary.max_deviation <= tolerance &&
+      !has_floor) {
     float* texel = m.texels[0].Reserve(1);
     texel[0] = summary.mean;
     const double edge = edge_error(texel, ShapeOfLog2(0, 0));
@@ -215,6 +217,10 @@ StatusOr<SpectralFace> SpectralAnalyzer::Analyze(std::span<const float> samples,
   }
   face.stats.bound_ulog2 = kx;
   face.stats.bound_vlog2 = ky;
+  if (options.rule == ResolutionRule::kErrorBound) {
+    kx = std::max(kx, std::min(options.min_ulog2, shape.lx));
+    ky = std::max(ky, std::min(options.min_vlog2, shape.ly));
+  }
 
   int slot = 0;
   const float* texels = m.ResampleLoaded(shape, ShapeOfLog2(kx, ky), summary.mean, slot);

@@ -51,6 +51,12 @@ Status ValidateSpectralOptions(const SpectralOptions& options) {
     return Status::Error(
         fmt::format("nonzero threshold {} must be finite and >= 0", options.nonzero_threshold));
   }
+  for (int l : {options.min_ulog2, options.min_vlog2}) {
+    if (l < 0 || l > kMaxSpectralLog2) {
+      return Status::Error(fmt::format("least resolution log2 {} x {}: {} is outside 0..{}",
+                                       options.min_ulog2, options.min_vlog2, l, kMaxSpectralLog2));
+    }
+  }
   for (int l : {options.fixed_ulog2, options.fixed_vlog2}) {
     if (l < 0 || l > kMaxSpectralLog2) {
       return Status::Error(fmt::format("fixed resolution log2 {} x {}: {} is outside 0..{}",

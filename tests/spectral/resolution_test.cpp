@@ -416,3 +416,29 @@ TEST(ResolutionTest, EdgeToleranceRaisesTheResolutionAcrossASlope) {
 
 }  // namespace
 }  // namespace dispex
+
+namespace dispex {
+namespace {
+
+// A least resolution is honoured (capped at the sample grid) and keeps a flat face from
+// becoming constant.
+TEST(ResolutionTest, LeastResolutionIsAFloor) {
+  const std::vector<float> flat(32 * 16, 0.25f);
+  SpectralAnalyzer analyzer;
+  SpectralOptions options;
+  options.tolerance = 1e-3;
+  auto plain = analyzer.Analyze(flat, 32, 16, options);
+  ASSERT_TRUE(plain.ok());
+  EXPECT_TRUE(plain->constant);
+  options.min_ulog2 = 3;
+  options.min_vlog2 = 6;
+  auto floored = analyzer.Analyze(flat, 32, 16, options);
+  ASSERT_TRUE(floored.ok());
+  EXPECT_FALSE(floored->constant);
+  EXPECT_EQ(floored->ulog2, 3);
+  EXPECT_EQ(floored->vlog2, 4);
+  for (float t : floored->texels) EXPECT_FLOAT_EQ(t, 0.25f);
+}
+
+}  // namespace
+}  // namespace dispex
