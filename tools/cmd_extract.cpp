@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "command.h"
+#include "flag_names.h"
 #include "core/atomic_output.h"
 #include "core/cancel.h"
 #include "dispex/extract.h"
@@ -11,6 +12,25 @@
 
 namespace dispex::cli {
 namespace {
+
+constexpr FlagName kExtractFlags[] = {
+    {"output_path", "-o"},
+    {"oversample", "--oversample"},
+    {"0 (automatic)", "'auto'"},
+    {"max_oversample", "--max-oversample"},
+    {"min_oversample", "--min-oversample"},
+    {"search_distance", "--search-distance"},
+    {"tolerance", "--tolerance"},
+    {"tolerance_fraction", "--tolerance-fraction"},
+    {"nonzero_threshold", "--nonzero-threshold"},
+    {"fixed_ulog2 x fixed_vlog2", "--fixed-resolution (log2)"},
+    {"data_type", "--data-type"},
+    {"compression_level", "--compression-level"},
+    {"holes", "--holes"},
+    {"max_miss_fraction", "--max-miss-fraction"},
+    {"threads", "--threads"},
+    {"max_memory", "--max-memory"},
+};
 
 struct ExtractArgs {
   ExtractOptions options;
@@ -121,12 +141,12 @@ Status Resolve(ExtractArgs& a) {
 
 int RunExtract(ExtractArgs& args) {
   Status resolved = Resolve(args);
-  if (!resolved.ok()) return ReportFailure(resolved, 2);
+  if (!resolved.ok()) return ReportFailure(resolved, kExtractFlags, 2);
   InstallCancelSignalHandlers();
   auto report = Extract(args.options);
   if (!report.ok()) {
     int sig = CancelSignal();
-    return ReportFailure(report.status(), sig ? 128 + sig : 1);
+    return ReportFailure(report.status(), kExtractFlags, sig ? 128 + sig : 1);
   }
   if (!args.report_path.empty()) {
     std::string json = ExtractReportJson(*report);

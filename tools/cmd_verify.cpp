@@ -4,11 +4,18 @@
 #include <cstdio>
 
 #include "command.h"
+#include "flag_names.h"
 #include "core/atomic_output.h"
 #include "dispex/verify.h"
 
 namespace dispex::cli {
 namespace {
+
+constexpr FlagName kVerifyFlags[] = {
+    {"sculpt_path", "a SCULPT"},     {"truth_path", "--truth"},
+    {"samples_per_face", "--samples"}, {"max_error", "--max-error"},
+    {"max_error_rel", "--max-error-rel"}, {"max_rms", "--max-rms"},
+};
 
 struct VerifyArgs {
   std::vector<std::string> files;
@@ -31,7 +38,7 @@ int RunVerify(VerifyArgs& args) {
         Status::Error("expected BASE SCULPT MAP.ptx (or BASE MAP.ptx with --truth)"), 2);
   }
   auto report = Verify(o);
-  if (!report.ok()) return ReportFailure(report.status());
+  if (!report.ok()) return ReportFailure(report.status(), kVerifyFlags);
   if (!args.report_path.empty()) {
     std::string json = VerifyReportJson(*report);
     Status written = WriteFileAtomically(args.report_path, json.data(), json.size());
@@ -42,7 +49,7 @@ int RunVerify(VerifyArgs& args) {
     std::fputs(VerifyReportSummary(*report).c_str(), stdout);
   }
   if (!report->passed) {
-    return ReportFailure(Status::Error(o.map_path + ": " + report->failure), 3);
+    return ReportFailure(Status::Error(o.map_path + ": " + report->failure), kVerifyFlags, 3);
   }
   return 0;
 }

@@ -252,7 +252,7 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
                          : options.tolerance;
   if (!(report.tolerance > 0)) {
     return Status::Error(fmt::format("{}: cannot derive a tolerance (median edge length {}); "
-                                     "give --tolerance", options.sculpt_path,
+                                     "set tolerance", options.sculpt_path,
                                      report.sculpt_median_edge));
   }
   DISPEX_ASSIGN_OR_RETURN(CoarseSampling coarse, SampleCoarsely(surface));
@@ -384,7 +384,7 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
       if (options.holes == HolePolicy::kFail) {
         return Status::Error(fmt::format(
             "Ptex face {}: {} of {} rays missed the sculpt within the search distance {:.6g} "
-            "(--holes fail)", f, r.misses, count, report.search_distance));
+            "(holes = fail)", f, r.misses, count, report.search_distance));
       }
       if (r.misses == static_cast<std::int32_t>(count) && options.holes == HolePolicy::kFill) {
         r.all_missed = true;  // filled from the neighbours once every face is done

@@ -36,20 +36,20 @@ Status ValidateSpectralOptions(const SpectralOptions& options) {
     case ResolutionRule::kFixed:
       break;
     default:
-      return Status::Error(fmt::format("resolution rule {} is not one of bound, nonzero, fixed",
+      return Status::Error(fmt::format("rule = {}: not one of bound, nonzero, fixed",
                                        static_cast<int>(options.rule)));
   }
   if (!std::isfinite(options.tolerance) || options.tolerance < 0) {
     return Status::Error(
-        fmt::format("tolerance {} must be finite and >= 0 (object units)", options.tolerance));
+        fmt::format("tolerance = {}: must be finite and >= 0 (object units)", options.tolerance));
   }
   if (!std::isfinite(options.nonzero_threshold) || options.nonzero_threshold < 0) {
     return Status::Error(
-        fmt::format("nonzero threshold {} must be finite and >= 0", options.nonzero_threshold));
+        fmt::format("nonzero_threshold = {}: must be finite and >= 0", options.nonzero_threshold));
   }
   for (int l : {options.fixed_ulog2, options.fixed_vlog2}) {
     if (l < 0 || l > kMaxSpectralLog2) {
-      return Status::Error(fmt::format("fixed resolution log2 {} x {}: {} is outside 0..{}",
+      return Status::Error(fmt::format("fixed_ulog2 x fixed_vlog2 = {} x {}: {} is outside 0..{}",
                                        options.fixed_ulog2, options.fixed_vlog2, l,
                                        kMaxSpectralLog2));
     }

@@ -294,7 +294,7 @@ TEST_F(ExtractTest, HolesFailMakesAnyMissAnError) {
   o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 1e-5};
   auto report = Extract(o);
   ASSERT_FALSE(report.ok());
-  EXPECT_NE(report.status().message().find("--holes fail"), std::string::npos)
+  EXPECT_NE(report.status().message().find("holes = fail"), std::string::npos)
       << report.status().message();
   EXPECT_FALSE(testing::fs::exists(o.output_path));
 }
