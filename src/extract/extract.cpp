@@ -28,6 +28,7 @@
 #include "extract/extract_meta.h"
 #include "extract/hole_fill.h"
 #include "extract/oversampling.h"
+#include "extract/ptex_face_table.h"
 
 namespace dispex {
 
@@ -200,13 +201,8 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
   const LimitSurface& surface = surface_built->value();
   DISPEX_ASSIGN_OR_RETURN(report.base_fingerprint, FileFingerprint(options.base_path));
   DISPEX_ASSIGN_OR_RETURN(report.sculpt_fingerprint, std::move(sculpt_fingerprint));
-  DISPEX_ASSIGN_OR_RETURN(SubdivPtexFaces ptex_faces, ComputeSubdivPtexFaces(base));
+  const std::vector<PtexFaceInfo> ptex_faces = PtexFaceTable(surface);
   const int num_faces = surface.num_ptex_faces();
-  if (ptex_faces.num_faces() != num_faces) {
-    return Status::Error(fmt::format("{}: {} Ptex faces from the mesh topology but {} from "
-                                     "OpenSubdiv", options.base_path, ptex_faces.num_faces(),
-                                     num_faces));
-  }
   LimitSurfaceStats surface_stats = surface.stats();
   report.base_vertices = base.num_vertices();
   report.base_faces = base.num_faces();
@@ -310,7 +306,7 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
   Progress progress("extract", static_cast<std::uint64_t>(num_faces), "faces", options.progress);
 
   auto face_info = [&](int f, int ulog2, int vlog2) {
-    PtexFaceInfo info = ptex_faces.faces[static_cast<std::size_t>(f)];
+    PtexFaceInfo info = ptex_faces[static_cast<std::size_t>(f)];
     info.ulog2 = static_cast<std::int8_t>(ulog2);
     info.vlog2 = static_cast<std::int8_t>(vlog2);
     return info;
@@ -429,25 +425,18 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
 
   // 6. Faces whose rays all missed: from their neighbours' shared edges.
   std::vector<std::uint8_t> has_values(static_cast<std::size_t>(num_faces), 1);
-  std::vector<std::int32_t> adjfaces(4 * static_cast<std::size_t>(num_faces));
-  std::vector<std::int8_t> adjedges(4 * static_cast<std::size_t>(num_faces));
   bool any_hit = false;
   for (int f = 0; f < num_faces; ++f) {
     const FaceResult& r = results[static_cast<std::size_t>(f)];
     has_values[f] = !r.all_missed && !surface.is_hole(PtexFaceId(f));
     any_hit |= r.samples > r.misses;
-    const PtexFaceInfo& info = ptex_faces.faces[static_cast<std::size_t>(f)];
-    for (int e = 0; e < 4; ++e) {
-      adjfaces[4 * f + e] = info.adjfaces[e];
-      adjedges[4 * f + e] = static_cast<std::int8_t>(info.adjedges[e]);
-    }
   }
   if (!any_hit) {
     return Status::Error(fmt::format(
         "no ray from {} hit {} within the search distance {:.6g}: the meshes do not overlap",
         options.base_path, options.sculpt_path, report.search_distance));
   }
-  CrossFaceFill cross = FillEmptyFaces(has_values, edge_means, adjfaces.data(), adjedges.data());
+  CrossFaceFill cross = FillEmptyFaces(has_values, edge_means, ptex_faces);
   for (std::size_t k = 0; k < cross.faces.size(); ++k) {
     int f = cross.faces[k];
     DISPEX_RETURN_IF_ERROR(writer.SetConstantFace(PtexFaceId(f), face_info(f, 0, 0),
