@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "command.h"
+#include "flag_names.h"
 #include "core/atomic_output.h"
 #include "core/cancel.h"
 #include "dispex/extract.h"
@@ -11,6 +12,25 @@
 
 namespace dispex::cli {
 namespace {
+
+constexpr FlagName kExtractFlags[] = {
+    {"output_path", "-o"},
+    {"oversample", "--oversample"},
+    {"0 (automatic)", "'auto'"},
+    {"max_oversample", "--max-oversample"},
+    {"min_oversample", "--min-oversample"},
+    {"search_distance", "--search-distance"},
+    {"tolerance", "--tolerance"},
+    {"tolerance_fraction", "--tolerance-fraction"},
+    {"nonzero_threshold", "--nonzero-threshold"},
+    {"fixed_ulog2 x fixed_vlog2", "--fixed-resolution (log2)"},
+    {"data_type", "--data-type"},
+    {"compression_level", "--compression-level"},
+    {"holes", "--holes"},
+    {"max_miss_fraction", "--max-miss-fraction"},
+    {"threads", "--threads"},
+    {"max_memory", "--max-memory"},
+};
 
 struct ExtractArgs {
   ExtractOptions options;
@@ -66,10 +86,6 @@ Status Resolve(ExtractArgs& a) {
     if (a.search_distance != "auto") {
       return Status::Error("give --search-distance or --search-distance-rel, not both");
     }
-    if (!(a.search_distance_rel > 0)) {
-      return Status::Error(fmt::format("--search-distance-rel {}: must be > 0",
-                                       a.search_distance_rel));
-    }
     o.search_distance = {SearchDistanceSpec::Kind::kRelative, a.search_distance_rel};
   } else {
     auto spec = ParseSearchDistance(a.search_distance);
@@ -121,12 +137,12 @@ Status Resolve(ExtractArgs& a) {
 
 int RunExtract(ExtractArgs& args) {
   Status resolved = Resolve(args);
-  if (!resolved.ok()) return ReportFailure(resolved, 2);
+  if (!resolved.ok()) return ReportFailure(resolved, kExtractFlags, 2);
   InstallCancelSignalHandlers();
   auto report = Extract(args.options);
   if (!report.ok()) {
     int sig = CancelSignal();
-    return ReportFailure(report.status(), sig ? 128 + sig : 1);
+    return ReportFailure(report.status(), kExtractFlags, sig ? 128 + sig : 1);
   }
   if (!args.report_path.empty()) {
     std::string json = ExtractReportJson(*report);
@@ -157,35 +173,34 @@ void SetupExtract(CLI::App& app, int& exit_code) {
                   "power of two 1..512")
       ->capture_default_str();
   cmd->add_option("--max-oversample", o.max_oversample, "cap for automatic oversampling")
-      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--min-oversample", o.min_oversample, "floor for automatic oversampling")
-      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--search-distance", args->search_distance,
                   "how far along ±normal to look: 'auto', a length, or N% of the base "
                   "bounding-box diagonal")
       ->capture_default_str();
+  // 0 stands for "not given" here, so 0 itself is refused as a value.
   cmd->add_option("--search-distance-rel", args->search_distance_rel,
                   "search distance as a fraction of the base bounding-box diagonal")
       ->check(Positive());
   cmd->add_option("--ray-policy", args->ray_policy,
                   "hit kept when both directions hit: nearest, outside-first, inside-first")
       ->capture_default_str();
+  // The library reads tolerance 0 as automatic; here automatic is the option left out, so 0 is
+  // refused rather than taken silently.
   cmd->add_option("--tolerance", o.tolerance,
                   "largest allowed error per face, object units (default: "
                   "--tolerance-fraction x the sculpt's median edge length)")
       ->check(Positive());
   cmd->add_option("--tolerance-fraction", o.tolerance_fraction,
                   "automatic tolerance as a fraction of the sculpt's median edge length")
-      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--resolution-rule", args->resolution_rule,
                   "per-face resolution: bound (error bound), nonzero (published rule), fixed")
       ->capture_default_str();
   cmd->add_option("--nonzero-threshold", o.nonzero_threshold,
                   "|DCT coefficient| counted as non-zero by --resolution-rule nonzero")
-      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_option("--fixed-resolution", args->fixed_resolution,
                   "WxH for --resolution-rule fixed")
@@ -201,7 +216,6 @@ void SetupExtract(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-miss-fraction", o.max_miss_fraction,
                   "fail when more than this fraction of the samples miss the sculpt after the "
                   "second search (0..1; 1: never)")
-      ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--bvh-quality", args->bvh_quality, "BVH build quality: low, medium, high")
       ->capture_default_str();
@@ -209,7 +223,6 @@ void SetupExtract(CLI::App& app, int& exit_code) {
                   "Embree kernels: sse2, sse4.2, avx, avx2, avx512 (default: $DISPEX_EMBREE_ISA, "
                   "else the widest this CPU runs)");
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
-      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_option("--max-memory", args->max_memory,
                   "refuse work estimated to need more memory than this (e.g. 8G; default: the "

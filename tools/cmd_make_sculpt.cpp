@@ -3,10 +3,16 @@
 #include <fmt/format.h>
 
 #include "command.h"
+#include "flag_names.h"
 #include "dispex/verify.h"
 
 namespace dispex::cli {
 namespace {
+
+constexpr FlagName kMakeSculptFlags[] = {
+    {"output_path", "-o"}, {"levels", "--levels"}, {"density", "--density"},
+    {"amplitude", "--amplitude"}, {"threads", "--threads"},
+};
 
 struct MakeSculptArgs {
   MakeSculptOptions options;
@@ -35,7 +41,7 @@ int RunMakeSculpt(MakeSculptArgs& args) {
         Status::Error(fmt::format("--density {}: must be 2..256", args.options.density)), 2);
   }
   auto report = MakeSculpt(args.options);
-  if (!report.ok()) return ReportFailure(report.status());
+  if (!report.ok()) return ReportFailure(report.status(), kMakeSculptFlags);
   if (!args.quiet) {
     for (const std::string& w : report->warnings) fmt::print(stderr, "dispex: warning: {}\n", w);
     std::string truth = args.options.truth_path.empty() ? args.options.output_path + ".truth"

@@ -5,11 +5,17 @@
 #include <cmath>
 
 #include "command.h"
+#include "flag_names.h"
 #include "dispex/ptex.h"
 #include "dispex/render.h"
 
 namespace dispex::cli {
 namespace {
+
+constexpr FlagName kPreviewFlags[] = {
+    {"range", "--range"},   {"channel", "--channel"}, {"min_tile", "--tile"},
+    {"max_tile", "--max-tile"}, {"width", "--width"}, {"threads", "--threads"},
+};
 
 struct PreviewArgs {
   std::string map_path;
@@ -42,12 +48,12 @@ Status Resolve(PreviewArgs& a) {
 
 int RunPreview(PreviewArgs& args) {
   Status resolved = Resolve(args);
-  if (!resolved.ok()) return ReportFailure(resolved, 2);
+  if (!resolved.ok()) return ReportFailure(resolved, kPreviewFlags, 2);
   auto map = PtexFile::Open(args.map_path);
   if (!map.ok()) return ReportFailure(map.status());
   AtlasLayout layout;
   auto image = RenderAtlas(*map, args.options, &layout);
-  if (!image.ok()) return ReportFailure(image.status());
+  if (!image.ok()) return ReportFailure(image.status(), kPreviewFlags);
   Status written = WritePng(args.output_path, *image);
   if (!written.ok()) return ReportFailure(written);
   if (!args.quiet) {

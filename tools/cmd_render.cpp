@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "command.h"
+#include "flag_names.h"
 #include "core/system.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
@@ -12,6 +13,15 @@
 
 namespace dispex::cli {
 namespace {
+
+constexpr FlagName kRenderFlags[] = {
+    {"width x height", "--size"}, {"density", "--density"},
+    {"min_density", "--min-density"}, {"max_density", "--max-density"},
+    {"supersample", "--supersample"}, {"ao_samples", "--ao"},
+    {"ao_distance", "--ao-distance"}, {"channel", "--channel"},
+    {"threads", "--threads"}, {"azimuth", "--azimuth"},
+    {"elevation", "--elevation"}, {"fov_degrees", "--fov"},
+};
 
 struct RenderArgs {
   std::vector<std::string> files;
@@ -53,7 +63,7 @@ Status Resolve(RenderArgs& a) {
 
 int RunRender(RenderArgs& args) {
   Status resolved = Resolve(args);
-  if (!resolved.ok()) return ReportFailure(resolved, 2);
+  if (!resolved.ok()) return ReportFailure(resolved, kRenderFlags, 2);
   Stopwatch clock;
   ReadOptions read;
   read.threads = args.options.threads;
@@ -79,7 +89,7 @@ int RunRender(RenderArgs& args) {
   StatusOr<Image> image =
       args.compare ? RenderComparison(*base, *map, sculpt ? &*sculpt : nullptr, args.options)
                    : RenderSurface(*base, map ? &*map : nullptr, args.options);
-  if (!image.ok()) return ReportFailure(image.status());
+  if (!image.ok()) return ReportFailure(image.status(), kRenderFlags);
   Status written = WritePng(args.output_path, *image);
   if (!written.ok()) return ReportFailure(written);
   if (!args.quiet) {

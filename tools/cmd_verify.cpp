@@ -5,11 +5,18 @@
 #include <cstdio>
 
 #include "command.h"
+#include "flag_names.h"
 #include "core/atomic_output.h"
 #include "dispex/verify.h"
 
 namespace dispex::cli {
 namespace {
+
+constexpr FlagName kVerifyFlags[] = {
+    {"sculpt_path", "a SCULPT"},     {"truth_path", "--truth"},
+    {"samples_per_face", "--samples"}, {"max_error", "--max-error"},
+    {"max_error_rel", "--max-error-rel"}, {"max_rms", "--max-rms"},
+};
 
 struct VerifyArgs {
   std::vector<std::string> files;
@@ -29,7 +36,7 @@ int RunVerify(VerifyArgs& args) {
     o.map_path = args.files[1];
   }
   auto report = Verify(o);
-  if (!report.ok()) return ReportFailure(report.status());
+  if (!report.ok()) return ReportFailure(report.status(), kVerifyFlags);
   if (!args.report_path.empty()) {
     std::string json = VerifyReportJson(*report);
     Status written = WriteFileAtomically(args.report_path, json.data(), json.size());
@@ -40,7 +47,7 @@ int RunVerify(VerifyArgs& args) {
     std::fputs(VerifyReportSummary(*report).c_str(), stdout);
   }
   if (!report->passed) {
-    return ReportFailure(Status::Error(o.map_path + ": " + report->failure), 3);
+    return ReportFailure(Status::Error(o.map_path + ": " + report->failure), kVerifyFlags, 3);
   }
   return 0;
 }

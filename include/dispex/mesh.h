@@ -192,7 +192,7 @@ struct MeshValidation {
 MeshValidation ValidateMesh(const Mesh& mesh);
 
 // OK when validation.clean(); otherwise an error "<source>: mesh is not clean: <warnings
-// joined by '; '>" (the --strict flag).
+// joined by '; '>".
 Status RequireClean(const Mesh& mesh, const MeshValidation& validation);
 
 // One line per distinct ignored tag name (tags.ignored_tag_names, first appearance first),

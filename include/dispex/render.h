@@ -87,8 +87,8 @@ struct AtlasOptions {
   int threads = 0;  // 0: all cores
 };
 
-// Checks the ranges of the options that do not depend on a map; the message names the option
-// as the command line spells it (--tile, --max-tile, --width, --range, --threads).
+// Checks the ranges of the options that do not depend on a map; the message names the field
+// and its value ("max_tile = 8: must be 16..4096").
 Status ValidateAtlasOptions(const AtlasOptions& options);
 
 struct AtlasRect {
@@ -203,9 +203,9 @@ struct SurfaceRenderOptions {
   int threads = 0;            // 0: all cores
 };
 
-// Checks every option's range, the view's included (--size, --density, --min-density,
-// --max-density, --supersample, --ao, --ao-distance, --channel, --threads, --azimuth,
-// --elevation, --fov, margin); the message names the option.
+// Checks every option's range, the view's included (width, height, density, min_density,
+// max_density, supersample, ao_samples, ao_distance, channel, threads, azimuth, elevation,
+// fov_degrees, margin); the message names the field and its value.
 Status ValidateSurfaceRenderOptions(const SurfaceRenderOptions& options);
 
 // Renders the limit surface of the Catmull-Clark cage `base`, displaced along its limit normal
@@ -233,7 +233,7 @@ StatusOr<Image> RenderMesh(const Mesh& mesh, std::span<const Float3> frame,
 StatusOr<Image> RenderComparison(const Mesh& base, const PtexFile& map, const Mesh* sculpt,
                                  const SurfaceRenderOptions& options);
 
-// For `dispex extract --preview DIR`: writes DIR/<stem>_atlas.png (signed atlas, automatic
+// The preview images of a map: writes DIR/<stem>_atlas.png (signed atlas, automatic
 // range) and DIR/<stem>_compare.png (base | base + map, 960 x 360, iso view), <stem> being
 // the map's file name without its extension. Creates DIR when missing. Fails naming the file
 // that could not be read or written.

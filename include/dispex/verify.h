@@ -45,7 +45,7 @@ std::string_view PatternName(Pattern pattern);
 // One of the names above except "image" (which needs a file: ParsePatternArgument).
 StatusOr<Pattern> ParsePattern(std::string_view name);
 
-// The --pattern argument of make-sculpt: a pattern name, or "image:FILE.png".
+// A pattern given by name: a pattern name, or "image:FILE.png".
 struct PatternArgument {
   Pattern pattern = Pattern::kDetail;
   std::string image_path;  // kImage only

@@ -32,43 +32,43 @@ bool IsPowerOfTwoIn(int v, int lo, int hi) {
 Status ValidateExtractOptions(const ExtractOptions& o) {
   if (o.base_path.empty()) return Status::Error("no base mesh given");
   if (o.sculpt_path.empty()) return Status::Error("no sculpt mesh given");
-  if (o.output_path.empty()) return Status::Error("no output file given (-o OUT.ptx)");
+  if (o.output_path.empty()) return Status::Error("no output file given (output_path)");
   if (o.output_path == o.base_path || o.output_path == o.sculpt_path) {
     return Status::Error(fmt::format("output {} is also an input; refusing to overwrite it",
                                      o.output_path));
   }
   if (o.oversample != 0 && !IsPowerOfTwoIn(o.oversample, 1, kMaxSpectralSize)) {
     return Status::Error(fmt::format(
-        "--oversample {}: must be 'auto' or a power of two from 1 to {}", o.oversample,
+        "oversample = {}: must be 0 (automatic) or a power of two from 1 to {}", o.oversample,
         kMaxSpectralSize));
   }
   if (!IsPowerOfTwoIn(o.max_oversample, 1, kMaxSpectralSize)) {
-    return Status::Error(fmt::format("--max-oversample {}: must be a power of two from 1 to {}",
+    return Status::Error(fmt::format("max_oversample = {}: must be a power of two from 1 to {}",
                                      o.max_oversample, kMaxSpectralSize));
   }
   if (!IsPowerOfTwoIn(o.min_oversample, 1, o.max_oversample)) {
     return Status::Error(fmt::format(
-        "--min-oversample {}: must be a power of two from 1 to --max-oversample ({})",
+        "min_oversample = {}: must be a power of two from 1 to max_oversample ({})",
         o.min_oversample, o.max_oversample));
   }
   if (!(std::isfinite(o.tolerance) && o.tolerance >= 0)) {
-    return Status::Error(fmt::format("--tolerance {}: must be a finite length > 0", o.tolerance));
+    return Status::Error(fmt::format("tolerance = {}: must be a finite length > 0", o.tolerance));
   }
   if (!(std::isfinite(o.tolerance_fraction) && o.tolerance_fraction > 0)) {
-    return Status::Error(fmt::format("--tolerance-fraction {}: must be > 0", o.tolerance_fraction));
+    return Status::Error(fmt::format("tolerance_fraction = {}: must be > 0", o.tolerance_fraction));
   }
   if (o.search_distance.kind != SearchDistanceSpec::Kind::kAuto &&
       !(std::isfinite(o.search_distance.value) && o.search_distance.value > 0)) {
-    return Status::Error(fmt::format("--search-distance {}: must be > 0", o.search_distance.value));
+    return Status::Error(fmt::format("search_distance = {}: must be > 0", o.search_distance.value));
   }
   if (o.data_type != PtexDataType::kFloat && o.data_type != PtexDataType::kHalf) {
-    return Status::Error("--data-type: must be float or half");
+    return Status::Error("data_type: must be float or half");
   }
   if (!(o.max_miss_fraction >= 0 && o.max_miss_fraction <= 1)) {
     return Status::Error(
-        fmt::format("max_miss_fraction {}: must be in [0, 1]", o.max_miss_fraction));
+        fmt::format("max_miss_fraction = {}: must be in [0, 1]", o.max_miss_fraction));
   }
-  if (o.threads < 0) return Status::Error(fmt::format("--threads {}: must be >= 0", o.threads));
+  if (o.threads < 0) return Status::Error(fmt::format("threads = {}: must be >= 0", o.threads));
   SpectralOptions spectral;
   spectral.rule = o.resolution_rule;
   spectral.tolerance = o.tolerance > 0 ? o.tolerance : 1.0;

@@ -117,7 +117,7 @@ EdgeMeans ComputeEdgeMeans(const float* values, int nx, int ny) {
 }
 
 CrossFaceFill FillEmptyFaces(std::vector<std::uint8_t>& filled, std::vector<EdgeMeans>& edges,
-                             const std::int32_t* adjfaces, const std::int8_t* adjedges) {
+                             std::span<const PtexFaceInfo> faces) {
   CrossFaceFill result;
   const std::size_t num_faces = filled.size();
   std::vector<std::int32_t> pending;
@@ -133,9 +133,10 @@ CrossFaceFill FillEmptyFaces(std::vector<std::uint8_t>& filled, std::vector<Edge
       double sum = 0;
       int count = 0;
       for (int e = 0; e < 4; ++e) {
-        std::int32_t g = adjfaces[4 * f + e];
+        const PtexFaceInfo& info = faces[static_cast<std::size_t>(f)];
+        std::int32_t g = info.adjfaces[static_cast<std::size_t>(e)];
         if (g < 0 || static_cast<std::size_t>(g) >= num_faces || !filled[g]) continue;
-        int ge = adjedges[4 * f + e] & 3;
+        int ge = info.adjedges[static_cast<std::size_t>(e)] & 3;
         sum += edges[g].mean[ge];
         ++count;
       }

@@ -9,7 +9,10 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
+
+#include "dispex/ptex.h"
 
 namespace dispex {
 
@@ -32,8 +35,7 @@ struct EdgeMeans {
 EdgeMeans ComputeEdgeMeans(const float* values, int nx, int ny);
 
 // Faces whose rays all missed, filled from their neighbours. `filled[f]` is true for faces with
-// values; `edges[f]` their edge means; `adjfaces/adjedges` the Ptex adjacency (4 per face,
-// -1 = none). For each empty face the value across each edge is the neighbour's mean along
+// values; `edges[f]` their edge means; `faces` the Ptex face table (its adjacency: -1 = none). For each empty face the value across each edge is the neighbour's mean along
 // the shared edge; the face becomes the constant mean of those. Faces reached only through
 // other empty faces are filled in later rounds (breadth-first, deterministic). Returns, per
 // face, the constant value, and marks it filled; faces no filled face can reach stay unfilled.
@@ -43,6 +45,6 @@ struct CrossFaceFill {
   std::size_t unreachable = 0;      // empty faces with no filled face in their component
 };
 CrossFaceFill FillEmptyFaces(std::vector<std::uint8_t>& filled, std::vector<EdgeMeans>& edges,
-                             const std::int32_t* adjfaces, const std::int8_t* adjedges);
+                             std::span<const PtexFaceInfo> faces);
 
 }  // namespace dispex

@@ -1,4 +1,4 @@
-// The --max-memory admission check: refuse work that will not fit before doing any of it.
+// The max_memory admission check: refuse work that will not fit before doing any of it.
 #include <fmt/format.h>
 
 #include <filesystem>
@@ -25,8 +25,8 @@ std::string Gib(std::uint64_t bytes) {
 
 Status TooBig(std::uint64_t need, std::uint64_t limit, const std::string& what) {
   return Status::Error(fmt::format(
-      "{} needs an estimated {} but the limit is {} (--max-memory); free memory, use a "
-      "machine with more, or raise --max-memory if the estimate is too high",
+      "{} needs an estimated {} but the limit is {} (max_memory); free memory, use a "
+      "machine with more, or raise max_memory if the estimate is too high",
       what, Gib(need), Gib(limit)));
 }
 

@@ -121,16 +121,20 @@ Status PtexFile::Impl::ParseTiles(Block& block, const std::string& where) {
   return Status::Ok();
 }
 
-Status PtexFile::Impl::Parse() {
-  auto fail = [&](const std::string& what) { return Status::Error(name + ": " + what); };
+Status PtexFile::Impl::Fail(const std::string& what) const {
+  return Status::Error(name + ": " + what);
+}
+
+// The header and the extended header, and where the sections lie.
+Status PtexFile::Impl::ParseHeaders(Layout& layout) {
   if (size < kHeaderSize) {
-    return fail("file of " + Num(size) + " bytes is shorter than the 64-byte Ptex header");
+    return Fail("file of " + Num(size) + " bytes is shorter than the 64-byte Ptex header");
   }
   const std::uint8_t* h = data;
-  if (Load<std::uint32_t>(h) != kMagic) return fail("not a Ptex file (no 'Ptex' magic)");
+  if (Load<std::uint32_t>(h) != kMagic) return Fail("not a Ptex file (no 'Ptex' magic)");
   const std::uint32_t version = Load<std::uint32_t>(h + 4);
   if (version != kMajorVersion) {
-    return fail("header: unsupported Ptex major version " + Num(version) + " (expected 1)");
+    return Fail("header: unsupported Ptex major version " + Num(version) + " (expected 1)");
   }
   const std::uint32_t mesh_type = Load<std::uint32_t>(h + 8);
   const std::uint32_t data_type = Load<std::uint32_t>(h + 12);
@@ -147,28 +151,28 @@ Status PtexFile::Impl::Parse() {
   const std::uint32_t meta_zip = Load<std::uint32_t>(h + 56);
   const std::uint32_t meta_mem = Load<std::uint32_t>(h + 60);
 
-  if (mesh_type > 1) return fail("header: mesh type " + Num(mesh_type) + " is not 0 or 1");
-  if (data_type > 3) return fail("header: data type " + Num(data_type) + " is not 0..3");
-  if (nchannels == 0) return fail("header: 0 channels");
+  if (mesh_type > 1) return Fail("header: mesh type " + Num(mesh_type) + " is not 0 or 1");
+  if (data_type > 3) return Fail("header: data type " + Num(data_type) + " is not 0..3");
+  if (nchannels == 0) return Fail("header: 0 channels");
   if (alpha < -1 || alpha >= nchannels) {
-    return fail("header: alpha channel " + std::to_string(alpha) + " is not -1 or below " +
+    return Fail("header: alpha channel " + std::to_string(alpha) + " is not -1 or below " +
                 Num(nchannels) + " channels");
   }
-  if (nfaces == 0) return fail("header: the file has no faces");
+  if (nfaces == 0) return Fail("header: the file has no faces");
   if (nfaces > kMaxFaces)
-    return fail("header: " + Num(nfaces) + " faces exceed the limit of " + Num(kMaxFaces));
+    return Fail("header: " + Num(nfaces) + " faces exceed the limit of " + Num(kMaxFaces));
   if (nlevels == 0 || nlevels > kMaxLevels) {
-    return fail("header: level count " + Num(nlevels) + " is not in 1.." + Num(kMaxLevels));
+    return Fail("header: level count " + Num(nlevels) + " is not in 1.." + Num(kMaxLevels));
   }
   if (level_info_size != kLevelInfoSize * nlevels) {
-    return fail("header: level info size " + Num(level_info_size) + " is not 16 x " + Num(nlevels) +
+    return Fail("header: level info size " + Num(level_info_size) + " is not 16 x " + Num(nlevels) +
                 " levels");
   }
   if (ext_size > kMaxExtHeaderSize) {
-    return fail("header: extended header size " + Num(ext_size) + " is not plausible");
+    return Fail("header: extended header size " + Num(ext_size) + " is not plausible");
   }
   if ((meta_zip == 0) != (meta_mem == 0)) {
-    return fail("header: meta data sizes " + Num(meta_zip) + " (compressed) and " + Num(meta_mem) +
+    return Fail("header: meta data sizes " + Num(meta_zip) + " (compressed) and " + Num(meta_mem) +
                 " (inflated) disagree");
   }
   header.mesh_type = static_cast<PtexMeshType>(mesh_type);
@@ -183,7 +187,7 @@ Status PtexFile::Impl::Parse() {
 
   // Extended header: min(40, ext_size) bytes are read, the rest are zero.
   if (kHeaderSize + std::uint64_t{ext_size} > size) {
-    return fail("extended header of " + Num(ext_size) + " bytes runs past the end of the file");
+    return Fail("extended header of " + Num(ext_size) + " bytes runs past the end of the file");
   }
   std::uint8_t ext[kExtHeaderSize] = {};
   std::memcpy(ext, data + kHeaderSize, std::min<std::size_t>(kExtHeaderSize, ext_size));
@@ -195,13 +199,13 @@ Status PtexFile::Impl::Parse() {
   const std::uint64_t edit_size = Load<std::uint64_t>(ext + 24);
   const std::uint64_t edit_pos = Load<std::uint64_t>(ext + 32);
   if (ubord > 2 || vbord > 2) {
-    return fail("extended header: border modes (" + Num(ubord) + ", " + Num(vbord) +
+    return Fail("extended header: border modes (" + Num(ubord) + ", " + Num(vbord) +
                 ") are not 0..2");
   }
   if (edge_filter > 1)
-    return fail("extended header: edge filter mode " + Num(edge_filter) + " is not 0 or 1");
+    return Fail("extended header: edge filter mode " + Num(edge_filter) + " is not 0 or 1");
   if ((lmd_header_zip == 0) != (lmd_header_mem == 0)) {
-    return fail("extended header: large meta data header sizes disagree");
+    return Fail("extended header: large meta data header sizes disagree");
   }
   header.u_border = static_cast<PtexBorderMode>(ubord);
   header.v_border = static_cast<PtexBorderMode>(vbord);
@@ -214,19 +218,39 @@ Status PtexFile::Impl::Parse() {
   const std::uint64_t level_info_pos = const_pos + const_zip;
   const std::uint64_t level_data_pos = level_info_pos + level_info_size;
   if (level_data_pos > size) {
-    return fail("face info, constant data and level info (" + Num(level_data_pos - face_info_pos) +
+    return Fail("face info, constant data and level info (" + Num(level_data_pos - face_info_pos) +
                 " bytes from offset " + Num(face_info_pos) + ") run past the end of the file (" +
                 Num(size) + " bytes)");
   }
   if (level_data_size > size - level_data_pos) {
-    return fail("header: level data of " + Num(level_data_size) + " bytes at offset " +
+    return Fail("header: level data of " + Num(level_data_size) + " bytes at offset " +
                 Num(level_data_pos) + " runs past the end of the file (" + Num(size) + " bytes)");
   }
   const std::uint64_t meta_pos = level_data_pos + level_data_size;
+  layout.nfaces = nfaces;
+  layout.pixel = pixel;
+  layout.face_info_pos = face_info_pos;
+  layout.face_info_zip = face_info_zip;
+  layout.const_pos = const_pos;
+  layout.const_zip = const_zip;
+  layout.level_info_pos = level_info_pos;
+  layout.level_data_pos = level_data_pos;
+  layout.level_data_size = level_data_size;
+  layout.meta_pos = meta_pos;
+  layout.meta_zip = meta_zip;
+  layout.meta_mem = meta_mem;
+  layout.lmd_header_zip = lmd_header_zip;
+  layout.lmd_header_mem = lmd_header_mem;
+  layout.lmd_data_size = lmd_data_size;
+  layout.edit_size = edit_size;
+  layout.edit_pos = edit_pos;
+  return Status::Ok();
+}
 
-  // Face info.
+Status PtexFile::Impl::ParseFaceInfo(const Layout& layout) {
+  const std::uint32_t nfaces = layout.nfaces;
   std::vector<std::uint8_t> raw;
-  DISPEX_RETURN_IF_ERROR(InflateSection("face info", face_info_pos, face_info_zip,
+  DISPEX_RETURN_IF_ERROR(InflateSection("face info", layout.face_info_pos, layout.face_info_zip,
                                         std::uint64_t{nfaces} * kFaceInfoSize, raw));
   faces.resize(nfaces);
   const bool triangle = header.mesh_type == PtexMeshType::kTriangle;
@@ -234,11 +258,11 @@ Status PtexFile::Impl::Parse() {
     PtexFaceInfo info = DecodeFaceInfo(raw.data() + std::size_t{f} * kFaceInfoSize);
     const std::string where = "face info: face " + Num(f);
     if (info.ulog2 < 0 || info.ulog2 > kMaxLog2 || info.vlog2 < 0 || info.vlog2 > kMaxLog2) {
-      return fail(where + ": resolution log2 (" + std::to_string(info.ulog2) + ", " +
+      return Fail(where + ": resolution log2 (" + std::to_string(info.ulog2) + ", " +
                   std::to_string(info.vlog2) + ") is not in 0.." + std::to_string(kMaxLog2));
     }
     if (triangle && info.ulog2 != info.vlog2) {
-      return fail(where + ": triangle face with non-square resolution log2 (" +
+      return Fail(where + ": triangle face with non-square resolution log2 (" +
                   std::to_string(info.ulog2) + ", " + std::to_string(info.vlog2) + ")");
     }
     if (triangle) {
@@ -247,28 +271,34 @@ Status PtexFile::Impl::Parse() {
     }
     for (int e = 0; e < 4; ++e) {
       if (info.adjfaces[e] < -1 || info.adjfaces[e] >= static_cast<std::int64_t>(nfaces)) {
-        return fail(where + ": neighbour across edge " + std::to_string(e) + " is face " +
+        return Fail(where + ": neighbour across edge " + std::to_string(e) + " is face " +
                     std::to_string(info.adjfaces[e]) + ", not -1 or one of the " + Num(nfaces) +
                     " faces");
       }
       if (triangle && info.adjfaces[e] >= 0 && info.adjedges[e] > 2) {
-        return fail(where + ": triangle neighbour edge id " + std::to_string(info.adjedges[e]));
+        return Fail(where + ": triangle neighbour edge id " + std::to_string(info.adjedges[e]));
       }
     }
     faces[f] = info;
   }
+  return Status::Ok();
+}
 
-  // Constant data.
-  DISPEX_RETURN_IF_ERROR(InflateSection("constant data", const_pos, const_zip,
-                                        std::uint64_t{nfaces} * pixel, const_data));
-
-  // Reduction order from the faces as stored (edits do not change it, as in the reference).
+// Reduction order from the faces as stored (edits do not change it, as in the reference).
+void PtexFile::Impl::ComputeReductionOrder() {
+  const auto nfaces = static_cast<std::uint32_t>(faces.size());
   reduction_order = ReductionOrder(faces);
   rfaceid.assign(nfaces, 0);
   for (std::uint32_t r = 0; r < nfaces; ++r)
     rfaceid[std::size_t(reduction_order[r])] = std::int32_t(r);
+}
 
-  // Levels.
+Status PtexFile::Impl::ParseLevels(const Layout& layout) {
+  const std::uint32_t nfaces = layout.nfaces;
+  const std::uint16_t nlevels = static_cast<std::uint16_t>(header.num_levels);
+  const std::uint64_t pixel = layout.pixel;
+  const std::uint64_t level_data_pos = layout.level_data_pos, level_info_pos = layout.level_info_pos;
+  const std::uint64_t level_data_size = layout.level_data_size;
   levels.resize(nlevels);
   level_blocks.resize(nlevels);
   std::uint64_t level_pos = level_data_pos, level_total = 0;
@@ -280,19 +310,19 @@ Status PtexFile::Impl::Parse() {
     const std::uint32_t entries = Load<std::uint32_t>(li + 12);
     const std::string where = "level " + std::to_string(l);
     if (l == 0 && entries != nfaces) {
-      return fail(where + ": " + Num(entries) + " entries, the file has " + Num(nfaces) + " faces");
+      return Fail(where + ": " + Num(entries) + " entries, the file has " + Num(nfaces) + " faces");
     }
     if (entries > nfaces) {
-      return fail(where + ": " + Num(entries) + " entries exceed the " + Num(nfaces) + " faces");
+      return Fail(where + ": " + Num(entries) + " entries exceed the " + Num(nfaces) + " faces");
     }
     level.num_entries = static_cast<int>(entries);
     if (level.data_size > level_data_size - level_total) {
-      return fail(where + ": " + Num(level.data_size) +
+      return Fail(where + ": " + Num(level.data_size) +
                   " bytes run past the level data size in the header (" + Num(level_data_size) +
                   ")");
     }
     if (level.header_size > level.data_size) {
-      return fail(where + ": header of " + Num(level.header_size) + " bytes exceeds the level's " +
+      return Fail(where + ": header of " + Num(level.header_size) + " bytes exceeds the level's " +
                   Num(level.data_size) + " bytes");
     }
     std::vector<std::uint8_t> fdh_raw;
@@ -311,43 +341,51 @@ Status PtexFile::Impl::Parse() {
       const std::uint32_t bsize = BlockSizeOf(b.fdh), enc = EncodingOf(b.fdh);
       const std::string bwhere = Where(face, l);
       if (bsize > end - offset) {
-        return fail(where + ": block of " + bwhere + " (" + Num(bsize) +
+        return Fail(where + ": block of " + bwhere + " (" + Num(bsize) +
                     " bytes) runs past the end of the level");
       }
       offset += bsize;
       if (info.constant) continue;  // never read: the constant data holds the face
       if (std::min(info.ulog2, info.vlog2) < l) {
-        return fail(where + ": entry " + Num(r) + " is " + bwhere + ", too small for the level (" +
+        return Fail(where + ": entry " + Num(r) + " is " + bwhere + ", too small for the level (" +
                     std::to_string(info.ures()) + "x" + std::to_string(info.vres()) + ")");
       }
       b.ulog2 = static_cast<std::int8_t>(info.ulog2 - l);
       b.vlog2 = static_cast<std::int8_t>(info.vlog2 - l);
       if (enc == kEncConstant && bsize != pixel) {
-        return fail(bwhere + ": constant block of " + Num(bsize) + " bytes, a texel has " +
+        return Fail(bwhere + ": constant block of " + Num(bsize) + " bytes, a texel has " +
                     Num(pixel));
       }
-      if (enc != kEncConstant && bsize == 0) return fail(bwhere + ": empty data block");
+      if (enc != kEncConstant && bsize == 0) return Fail(bwhere + ": empty data block");
       if (enc == kEncTiled) DISPEX_RETURN_IF_ERROR(ParseTiles(b, bwhere));
     }
     if (offset != end) {
-      return fail(where + ": blocks total " + Num(offset - level_pos - level.header_size) +
+      return Fail(where + ": blocks total " + Num(offset - level_pos - level.header_size) +
                   " bytes, the level info says " + Num(level.data_size - level.header_size));
     }
     level_pos = end;
     level_total += level.data_size;
   }
   if (level_total != level_data_size) {
-    return fail("levels total " + Num(level_total) + " bytes, the header says " +
+    return Fail("levels total " + Num(level_total) + " bytes, the header says " +
                 Num(level_data_size));
   }
+  return Status::Ok();
+}
 
-  // Small meta data, the barrier, large meta data.
+// Small meta data, the barrier, large meta data; `end` is where the large meta data ends.
+Status PtexFile::Impl::ParseMetaData(const Layout& layout, std::uint64_t& end) {
+  const std::uint64_t meta_pos = layout.meta_pos;
+  const std::uint32_t meta_zip = layout.meta_zip, meta_mem = layout.meta_mem;
+  const std::uint32_t lmd_header_zip = layout.lmd_header_zip;
+  const std::uint32_t lmd_header_mem = layout.lmd_header_mem;
+  const std::uint64_t lmd_data_size = layout.lmd_data_size;
   if (meta_zip != 0) {
     std::vector<std::uint8_t> block;
     DISPEX_RETURN_IF_ERROR(InflateSection("meta data", meta_pos, meta_zip, meta_mem, block));
     std::vector<ParsedMetaRecord> records;
     std::string why = ParseMetaRecords(block, false, records);
-    if (!why.empty()) return fail("meta data: " + why);
+    if (!why.empty()) return Fail("meta data: " + why);
     for (ParsedMetaRecord& r : records) UpsertMetaItem(meta, std::move(r.item));
   }
   const std::uint64_t lmd_pos = meta_pos + meta_zip + kBarrierSize;
@@ -358,12 +396,12 @@ Status PtexFile::Impl::Parse() {
         InflateSection("large meta data header", lmd_pos, lmd_header_zip, lmd_header_mem, block));
     std::vector<ParsedMetaRecord> records;
     std::string why = ParseMetaRecords(block, true, records);
-    if (!why.empty()) return fail("large meta data header: " + why);
+    if (!why.empty()) return Fail("large meta data header: " + why);
     std::uint64_t value_pos = lmd_pos + lmd_header_zip;
     std::uint64_t total = 0;
     for (ParsedMetaRecord& r : records) {
       if (r.zipsize > lmd_data_size - total) {
-        return fail("large meta data " + QuotedKey(r.item.key) + ": " + Num(r.zipsize) +
+        return Fail("large meta data " + QuotedKey(r.item.key) + ": " + Num(r.zipsize) +
                     " bytes run past the large meta data size (" + Num(lmd_data_size) + ")");
       }
       DISPEX_RETURN_IF_ERROR(InflateSection("large meta data " + QuotedKey(r.item.key), value_pos,
@@ -373,17 +411,23 @@ Status PtexFile::Impl::Parse() {
       UpsertMetaItem(meta, std::move(r.item));
     }
     if (total != lmd_data_size) {
-      return fail("large meta data: values total " + Num(total) + " bytes, the header says " +
+      return Fail("large meta data: values total " + Num(total) + " bytes, the header says " +
                   Num(lmd_data_size));
     }
     lmd_end = value_pos;
   } else if (lmd_data_size != 0) {
-    return fail("extended header: large meta data of " + Num(lmd_data_size) +
+    return Fail("extended header: large meta data of " + Num(lmd_data_size) +
                 " bytes without a header");
   }
+  end = lmd_end;
+  return Status::Ok();
+}
 
-  // Edit blocks (docs/ptex.md, "Edit blocks"): at max(editdatapos, end of large meta data);
-  // editdatapos 0 (files before 1.3) means "scan to the end of the file".
+// Edit blocks (docs/ptex.md, "Edit blocks"): at max(editdatapos, end of large meta data);
+// editdatapos 0 (files before 1.3) means "scan to the end of the file".
+Status PtexFile::Impl::ParseEdits(const Layout& layout, std::uint64_t lmd_end) {
+  const std::uint32_t nfaces = layout.nfaces;
+  const std::uint64_t edit_pos = layout.edit_pos, edit_size = layout.edit_size;
   edit_block.assign(nfaces, -1);
   std::uint64_t edit_start = std::max(edit_pos, lmd_end), edit_end = 0;
   if (edit_pos == 0) {
@@ -391,7 +435,7 @@ Status PtexFile::Impl::Parse() {
     if (edit_start > size) edit_start = size;
   } else if (edit_size != 0) {
     if (edit_start > size || edit_size > size - edit_start) {
-      return fail("edit data of " + Num(edit_size) + " bytes at offset " + Num(edit_start) +
+      return Fail("edit data of " + Num(edit_size) + " bytes at offset " + Num(edit_start) +
                   " runs past the end of the file (" + Num(size) + " bytes)");
     }
     edit_end = edit_start + edit_size;
@@ -402,86 +446,115 @@ Status PtexFile::Impl::Parse() {
   int edit_index = 0;
   while (e < edit_end) {
     const std::string where = "edit block " + std::to_string(edit_index) + " at offset " + Num(e);
-    if (edit_end - e < 5) return fail(where + ": truncated block prefix");
+    if (edit_end - e < 5) return Fail(where + ": truncated block prefix");
     const std::uint8_t type = data[e];
     const std::uint32_t edit_len = Load<std::uint32_t>(data + e + 1);
     if (edit_len == 0) break;  // an empty block ends the edits (the barrier reads so)
     if (edit_len > edit_end - e - 5) {
-      return fail(where + ": " + Num(edit_len) + " bytes run past the edit data");
+      return Fail(where + ": " + Num(edit_len) + " bytes run past the edit data");
     }
     const std::uint64_t body = e + 5;
-    if (type == 0) {  // face data edit
-      if (edit_len < kEditFaceHeaderSize + pixel) {
-        return fail(where + ": face edit of " + Num(edit_len) + " bytes is too short");
-      }
-      const std::uint32_t face = Load<std::uint32_t>(data + body);
-      if (face >= nfaces) return fail(where + ": face id " + Num(face) + " out of range");
-      PtexFaceInfo info = DecodeFaceInfo(data + body + 4);
-      const std::uint32_t fdh = Load<std::uint32_t>(data + body + 24);
-      const std::string fwhere = where + " (face " + Num(face) + ")";
-      if (info.ulog2 < 0 || info.ulog2 > kMaxLog2 || info.vlog2 < 0 || info.vlog2 > kMaxLog2 ||
-          (triangle && info.ulog2 != info.vlog2)) {
-        return fail(fwhere + ": invalid resolution log2 (" + std::to_string(info.ulog2) + ", " +
-                    std::to_string(info.vlog2) + ")");
-      }
-      if (triangle) {
-        info.adjfaces[3] = -1;
-        info.adjedges[3] = 0;
-      }
-      for (int k = 0; k < 4; ++k) {
-        if (info.adjfaces[k] < -1 || info.adjfaces[k] >= static_cast<std::int64_t>(nfaces)) {
-          return fail(fwhere + ": neighbour face " + std::to_string(info.adjfaces[k]) +
-                      " out of range");
-        }
-      }
-      if (kEditFaceHeaderSize + pixel + BlockSizeOf(fdh) != edit_len) {
-        return fail(fwhere + ": block of " + Num(BlockSizeOf(fdh)) +
-                    " bytes does not fill the edit's " + Num(edit_len) + " bytes");
-      }
-      info.has_edits = true;
-      std::memcpy(const_data.data() + face * pixel, data + body + kEditFaceHeaderSize, pixel);
-      faces[face] = info;
-      if (!info.constant) {
-        Block b;
-        b.offset = body + kEditFaceHeaderSize + pixel;
-        b.fdh = fdh;
-        b.ulog2 = info.ulog2;
-        b.vlog2 = info.vlog2;
-        const std::uint32_t enc = EncodingOf(fdh), bsize = BlockSizeOf(fdh);
-        if (enc == kEncConstant && bsize != pixel) {
-          return fail(fwhere + ": constant block of " + Num(bsize) + " bytes");
-        }
-        if (enc != kEncConstant && bsize == 0) return fail(fwhere + ": empty data block");
-        if (enc == kEncTiled) DISPEX_RETURN_IF_ERROR(ParseTiles(b, fwhere));
-        edit_block[face] = static_cast<std::int32_t>(edit_blocks.size());
-        edit_blocks.push_back(b);
-      } else {
-        edit_block[face] = -1;
-      }
-      header.has_edits = true;
-    } else if (type == 1) {  // meta data edit
-      if (edit_len < kEditMetaHeaderSize) return fail(where + ": meta data edit too short");
-      const std::uint32_t zip = Load<std::uint32_t>(data + body);
-      const std::uint32_t mem = Load<std::uint32_t>(data + body + 4);
-      if (std::uint64_t{zip} + kEditMetaHeaderSize != edit_len) {
-        return fail(where + ": meta data edit of " + Num(zip) + " bytes does not fill the " +
-                    Num(edit_len) + "-byte block");
-      }
-      std::vector<std::uint8_t> block;
-      DISPEX_RETURN_IF_ERROR(
-          InflateSection(where + ": meta data", body + kEditMetaHeaderSize, zip, mem, block));
-      std::vector<ParsedMetaRecord> records;
-      std::string why = ParseMetaRecords(block, false, records);
-      if (!why.empty()) return fail(where + ": meta data: " + why);
-      for (ParsedMetaRecord& r : records) UpsertMetaItem(meta, std::move(r.item));
-      header.has_edits = true;
+    if (type == 0) {
+      DISPEX_RETURN_IF_ERROR(ParseFaceEdit(where, body, edit_len, layout));
+    } else if (type == 1) {
+      DISPEX_RETURN_IF_ERROR(ParseMetaEdit(where, body, edit_len));
     }  // other edit types are skipped, as the reference reader does
     e = body + edit_len;
     ++edit_index;
   }
+  return Status::Ok();
+}
 
-  sample_cache = std::make_unique<std::atomic<std::vector<float>*>[]>(nfaces);
-  for (std::uint32_t f = 0; f < nfaces; ++f) sample_cache[f].store(nullptr);
+// A face data edit: the face's info, constant value and block replace those of the levels.
+Status PtexFile::Impl::ParseFaceEdit(const std::string& where, std::uint64_t body,
+                                     std::uint32_t edit_len, const Layout& layout) {
+  const std::uint32_t nfaces = layout.nfaces;
+  const std::uint64_t pixel = layout.pixel;
+  const bool triangle = header.mesh_type == PtexMeshType::kTriangle;
+  if (edit_len < kEditFaceHeaderSize + pixel) {
+    return Fail(where + ": face edit of " + Num(edit_len) + " bytes is too short");
+  }
+  const std::uint32_t face = Load<std::uint32_t>(data + body);
+  if (face >= nfaces) return Fail(where + ": face id " + Num(face) + " out of range");
+  PtexFaceInfo info = DecodeFaceInfo(data + body + 4);
+  const std::uint32_t fdh = Load<std::uint32_t>(data + body + 24);
+  const std::string fwhere = where + " (face " + Num(face) + ")";
+  if (info.ulog2 < 0 || info.ulog2 > kMaxLog2 || info.vlog2 < 0 || info.vlog2 > kMaxLog2 ||
+      (triangle && info.ulog2 != info.vlog2)) {
+    return Fail(fwhere + ": invalid resolution log2 (" + std::to_string(info.ulog2) + ", " +
+                std::to_string(info.vlog2) + ")");
+  }
+  if (triangle) {
+    info.adjfaces[3] = -1;
+    info.adjedges[3] = 0;
+  }
+  for (int k = 0; k < 4; ++k) {
+    if (info.adjfaces[k] < -1 || info.adjfaces[k] >= static_cast<std::int64_t>(nfaces)) {
+      return Fail(fwhere + ": neighbour face " + std::to_string(info.adjfaces[k]) +
+                  " out of range");
+    }
+  }
+  if (kEditFaceHeaderSize + pixel + BlockSizeOf(fdh) != edit_len) {
+    return Fail(fwhere + ": block of " + Num(BlockSizeOf(fdh)) +
+                " bytes does not fill the edit's " + Num(edit_len) + " bytes");
+  }
+  info.has_edits = true;
+  std::memcpy(const_data.data() + face * pixel, data + body + kEditFaceHeaderSize, pixel);
+  faces[face] = info;
+  if (!info.constant) {
+    Block b;
+    b.offset = body + kEditFaceHeaderSize + pixel;
+    b.fdh = fdh;
+    b.ulog2 = info.ulog2;
+    b.vlog2 = info.vlog2;
+    const std::uint32_t enc = EncodingOf(fdh), bsize = BlockSizeOf(fdh);
+    if (enc == kEncConstant && bsize != pixel) {
+      return Fail(fwhere + ": constant block of " + Num(bsize) + " bytes");
+    }
+    if (enc != kEncConstant && bsize == 0) return Fail(fwhere + ": empty data block");
+    if (enc == kEncTiled) DISPEX_RETURN_IF_ERROR(ParseTiles(b, fwhere));
+    edit_block[face] = static_cast<std::int32_t>(edit_blocks.size());
+    edit_blocks.push_back(b);
+  } else {
+    edit_block[face] = -1;
+  }
+  header.has_edits = true;
+  return Status::Ok();
+}
+
+Status PtexFile::Impl::ParseMetaEdit(const std::string& where, std::uint64_t body,
+                                     std::uint32_t edit_len) {
+  if (edit_len < kEditMetaHeaderSize) return Fail(where + ": meta data edit too short");
+  const std::uint32_t zip = Load<std::uint32_t>(data + body);
+  const std::uint32_t mem = Load<std::uint32_t>(data + body + 4);
+  if (std::uint64_t{zip} + kEditMetaHeaderSize != edit_len) {
+    return Fail(where + ": meta data edit of " + Num(zip) + " bytes does not fill the " +
+                Num(edit_len) + "-byte block");
+  }
+  std::vector<std::uint8_t> block;
+  DISPEX_RETURN_IF_ERROR(
+      InflateSection(where + ": meta data", body + kEditMetaHeaderSize, zip, mem, block));
+  std::vector<ParsedMetaRecord> records;
+  std::string why = ParseMetaRecords(block, false, records);
+  if (!why.empty()) return Fail(where + ": meta data: " + why);
+  for (ParsedMetaRecord& r : records) UpsertMetaItem(meta, std::move(r.item));
+  header.has_edits = true;
+  return Status::Ok();
+}
+
+Status PtexFile::Impl::Parse() {
+  Layout layout;
+  DISPEX_RETURN_IF_ERROR(ParseHeaders(layout));
+  DISPEX_RETURN_IF_ERROR(ParseFaceInfo(layout));
+  DISPEX_RETURN_IF_ERROR(InflateSection("constant data", layout.const_pos, layout.const_zip,
+                                        std::uint64_t{layout.nfaces} * layout.pixel, const_data));
+  ComputeReductionOrder();
+  DISPEX_RETURN_IF_ERROR(ParseLevels(layout));
+  std::uint64_t meta_end = 0;
+  DISPEX_RETURN_IF_ERROR(ParseMetaData(layout, meta_end));
+  DISPEX_RETURN_IF_ERROR(ParseEdits(layout, meta_end));
+  sample_cache = std::make_unique<std::atomic<std::vector<float>*>[]>(layout.nfaces);
+  for (std::uint32_t f = 0; f < layout.nfaces; ++f) sample_cache[f].store(nullptr);
   return Status::Ok();
 }
 

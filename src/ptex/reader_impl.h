@@ -57,6 +57,27 @@ struct PtexFile::Impl {
 
   // Builds everything above from `data` / `size`; the message names the section and face.
   Status Parse();
+  // The header fields and section positions the steps of Parse share.
+  struct Layout {
+    std::uint32_t nfaces = 0;
+    std::uint64_t pixel = 0;  // bytes per texel
+    std::uint64_t face_info_pos = 0, const_pos = 0, level_info_pos = 0, level_data_pos = 0,
+                  meta_pos = 0;
+    std::uint32_t face_info_zip = 0, const_zip = 0, meta_zip = 0, meta_mem = 0;
+    std::uint64_t level_data_size = 0;
+    std::uint32_t lmd_header_zip = 0, lmd_header_mem = 0;
+    std::uint64_t lmd_data_size = 0, edit_size = 0, edit_pos = 0;
+  };
+  Status ParseHeaders(Layout& layout);
+  Status ParseFaceInfo(const Layout& layout);
+  void ComputeReductionOrder();
+  Status ParseLevels(const Layout& layout);
+  Status ParseMetaData(const Layout& layout, std::uint64_t& end);
+  Status ParseEdits(const Layout& layout, std::uint64_t lmd_end);
+  Status ParseFaceEdit(const std::string& where, std::uint64_t body, std::uint32_t edit_len,
+                       const Layout& layout);
+  Status ParseMetaEdit(const std::string& where, std::uint64_t body, std::uint32_t edit_len);
+  Status Fail(const std::string& what) const;  // "name: what"
   // Inflates `zipsize` bytes at `offset` into `out`, which must come out `expected` bytes
   // long; the size is checked against the file and the block before `out` is allocated.
   Status InflateSection(const std::string& section, std::uint64_t offset, std::uint64_t zipsize,

@@ -108,19 +108,19 @@ void DrawLegend(Image& image, const AtlasLayout& layout, AtlasMode mode) {
 
 Status ValidateAtlasOptions(const AtlasOptions& o) {
   if (!(o.range >= 0) || !std::isfinite(o.range)) {
-    return Status::Error(fmt::format("--range {}: expected 'auto' or a number > 0", o.range));
+    return Status::Error(fmt::format("range = {}: expected 0 (automatic) or a number > 0", o.range));
   }
-  if (o.channel < 0) return Status::Error(fmt::format("--channel {}: must be >= 0", o.channel));
+  if (o.channel < 0) return Status::Error(fmt::format("channel = {}: must be >= 0", o.channel));
   if (o.min_tile < 2 || o.min_tile > 256) {
-    return Status::Error(fmt::format("--tile {}: must be 2..256", o.min_tile));
+    return Status::Error(fmt::format("min_tile = {}: must be 2..256", o.min_tile));
   }
   if (o.max_tile < 16 || o.max_tile > 4096) {
-    return Status::Error(fmt::format("--max-tile {}: must be 16..4096", o.max_tile));
+    return Status::Error(fmt::format("max_tile = {}: must be 16..4096", o.max_tile));
   }
   if (o.width < 0 || o.width > 16384) {
-    return Status::Error(fmt::format("--width {}: must be 0 (automatic) or up to 16384", o.width));
+    return Status::Error(fmt::format("width = {}: must be 0 (automatic) or up to 16384", o.width));
   }
-  if (o.threads < 0) return Status::Error(fmt::format("--threads {}: must be >= 0", o.threads));
+  if (o.threads < 0) return Status::Error(fmt::format("threads = {}: must be >= 0", o.threads));
   return Status::Ok();
 }
 

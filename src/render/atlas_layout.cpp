@@ -97,7 +97,7 @@ StatusOr<AtlasLayout> LayOutAtlas(const PtexFile& map, const AtlasOptions& optio
   if (std::int64_t(layout.width) * layout.height > kMaxPixels ||
       std::int64_t(tiles_height) * width > kMaxPixels) {
     return Status::Error(
-        fmt::format("{}: the atlas of {} faces would exceed {} pixels; lower --tile or --max-tile",
+        fmt::format("{}: the atlas of {} faces would exceed {} pixels; lower min_tile or max_tile",
                     map.name(), n, kMaxPixels));
   }
   layout.legend = {0, tiles_height, layout.width, legend.height};

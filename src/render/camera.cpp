@@ -86,13 +86,13 @@ StatusOr<Camera> FrameCamera(std::span<const Float3> points, const ViewOptions& 
   PresetAngles(view.preset, azimuth, elevation);
   if (!std::isnan(view.azimuth)) azimuth = view.azimuth;
   if (!std::isnan(view.elevation)) elevation = view.elevation;
-  if (!std::isfinite(azimuth)) return Status::Error("--azimuth: must be a finite angle");
+  if (!std::isfinite(azimuth)) return Status::Error("azimuth: must be a finite angle");
   if (!(elevation >= -90 && elevation <= 90)) {
     return Status::Error(
-        fmt::format("--elevation {}: must be within [-90, 90] degrees", elevation));
+        fmt::format("elevation = {}: must be within [-90, 90] degrees", elevation));
   }
   if (!(view.fov_degrees >= 1 && view.fov_degrees <= 120)) {
-    return Status::Error(fmt::format("--fov {}: must be 1..120 degrees", view.fov_degrees));
+    return Status::Error(fmt::format("fov_degrees = {}: must be 1..120 degrees", view.fov_degrees));
   }
   if (!(view.margin >= 0 && view.margin <= 0.45)) {
     return Status::Error(fmt::format("margin {}: must be 0..0.45", view.margin));

@@ -29,29 +29,29 @@ constexpr render::Rgb kLabel = {235, 235, 235};
 Status ValidateSurfaceRenderOptions(const SurfaceRenderOptions& o) {
   if (o.width < 1 || o.width > 16384 || o.height < 1 || o.height > 16384) {
     return Status::Error(
-        fmt::format("--size {}x{}: width and height must be 1..16384", o.width, o.height));
+        fmt::format("width x height = {}x{}: each must be 1..16384", o.width, o.height));
   }
   if (o.density < 1 || o.density > 256) {
-    return Status::Error(fmt::format("--density {}: must be 1..256", o.density));
+    return Status::Error(fmt::format("density = {}: must be 1..256", o.density));
   }
   if (o.min_density < 1 || o.min_density > 256) {
-    return Status::Error(fmt::format("--min-density {}: must be 1..256", o.min_density));
+    return Status::Error(fmt::format("min_density = {}: must be 1..256", o.min_density));
   }
   if (o.max_density < o.min_density || o.max_density > 256) {
-    return Status::Error(fmt::format("--max-density {}: must be {}..256 (at least --min-density)",
+    return Status::Error(fmt::format("max_density = {}: must be {}..256 (at least min_density)",
                                      o.max_density, o.min_density));
   }
   if (o.supersample < 1 || o.supersample > 4) {
-    return Status::Error(fmt::format("--supersample {}: must be 1..4", o.supersample));
+    return Status::Error(fmt::format("supersample = {}: must be 1..4", o.supersample));
   }
   if (o.ao_samples < 0 || o.ao_samples > 64) {
-    return Status::Error(fmt::format("--ao {}: must be 0..64 rays", o.ao_samples));
+    return Status::Error(fmt::format("ao_samples = {}: must be 0..64 rays", o.ao_samples));
   }
   if (!(o.ao_distance > 0 && o.ao_distance <= 1)) {
-    return Status::Error(fmt::format("--ao-distance {}: must be in (0, 1]", o.ao_distance));
+    return Status::Error(fmt::format("ao_distance = {}: must be in (0, 1]", o.ao_distance));
   }
-  if (o.channel < 0) return Status::Error(fmt::format("--channel {}: must be >= 0", o.channel));
-  if (o.threads < 0) return Status::Error(fmt::format("--threads {}: must be >= 0", o.threads));
+  if (o.channel < 0) return Status::Error(fmt::format("channel = {}: must be >= 0", o.channel));
+  if (o.threads < 0) return Status::Error(fmt::format("threads = {}: must be >= 0", o.threads));
   // The view: framing a unit box checks the angles, field of view and margin.
   BoundingBox unit;
   unit.max = {1, 1, 1};
@@ -161,7 +161,7 @@ StatusOr<Image> RenderComparison(const Mesh& base, const PtexFile& map, const Me
   const int panels = sculpt ? 3 : 2;
   const int panel_width = options.width / panels;
   if (panel_width < 16) {
-    return Status::Error(fmt::format("--size {}x{}: {} panels need at least {} pixels of width",
+    return Status::Error(fmt::format("width x height = {}x{}: {} panels need at least {} pixels of width",
                                      options.width, options.height, panels, 16 * panels));
   }
   // Label size: 2x the font from 240 rows, growing with the image (4x at 720 rows).
@@ -169,7 +169,7 @@ StatusOr<Image> RenderComparison(const Mesh& base, const PtexFile& map, const Me
   const int strip = render::TextHeight(render::FontSize::kSmall, scale) + 6 * scale;
   const int panel_height = options.height - strip;
   if (panel_height < 16) {
-    return Status::Error(fmt::format("--size {}x{}: too low for labelled panels (at least {})",
+    return Status::Error(fmt::format("width x height = {}x{}: too low for labelled panels (at least {})",
                                      options.width, options.height, strip + 16));
   }
   return InArena(options.threads, [&]() -> StatusOr<Image> {

@@ -227,249 +227,301 @@ void VertexNormals(std::size_t num_vertices, std::span<const std::uint32_t> face
   });
 }
 
-}  // namespace
+// TessellateLimitSurface's state, built by its steps in the order Run calls them. Each step
+// fills flat arrays the later ones read.
+class Tessellation {
+ public:
+  Tessellation(const Mesh& cage, const LimitSurface& surface,
+               std::span<const std::array<int, 2>> density, const PtexFile* map, int channel)
+      : cage_(cage), surface_(surface), density_(density), map_(map), channel_(channel),
+        n_(surface.num_ptex_faces()) {}
 
-StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface& surface,
-                                            std::span<const std::array<int, 2>> density,
-                                            const PtexFile* map, int channel) {
-  const int n = surface.num_ptex_faces();
-  DISPEX_CHECK_EQ(density.size(), static_cast<std::size_t>(n));
-  auto active = [&](int f) {
-    return density[static_cast<std::size_t>(f)][0] > 0 && !surface.is_hole(PtexFaceId(f));
-  };
-
-  // 1. Sides of every face, sorted by line.
-  std::vector<SideEntry> entries(4 * static_cast<std::size_t>(n));
-  tbb::parallel_for(0, n, [&](int f) {
-    if (!active(f)) return;
-    const auto& d = density[static_cast<std::size_t>(f)];
-    DISPEX_CHECK(d[0] >= 1 && d[0] <= 1024 && d[1] >= 1 && d[1] <= 1024);
-    FaceSides(cage, surface, f, d[0], d[1], &entries[4 * static_cast<std::size_t>(f)]);
-  });
-  entries.erase(
-      std::remove_if(entries.begin(), entries.end(), [](const SideEntry& e) { return e.face < 0; }),
-      entries.end());
-  tbb::parallel_sort(entries.begin(), entries.end(), [](const SideEntry& x, const SideEntry& y) {
-    if (x.line != y.line) return x.line < y.line;
-    if (x.face != y.face) return x.face < y.face;
-    return x.side < y.side;
-  });
-  const std::size_t num_entries = entries.size();
-  std::vector<std::int64_t> entry_of(4 * static_cast<std::size_t>(n), -1);
-  std::vector<std::int64_t> grid_offset(num_entries + 1, 0);
-  std::vector<std::size_t> line_start;  // entries of line g: [line_start[g], line_start[g + 1])
-  for (std::size_t e = 0; e < num_entries; ++e) {
-    entry_of[4 * static_cast<std::size_t>(entries[e].face) + entries[e].side] =
-        static_cast<std::int64_t>(e);
-    grid_offset[e + 1] = grid_offset[e] + entries[e].segs + 1;
-    if (e == 0 || entries[e].line != entries[e - 1].line) line_start.push_back(e);
-  }
-  line_start.push_back(num_entries);
-  const std::size_t num_lines = line_start.size() - 1;
-
-  // 2. The merged points of each line (at most the sum of its sides' points), and the records
-  // of every face side that covers each point.
-  std::vector<std::int64_t> entry_grid_point(static_cast<std::size_t>(grid_offset[num_entries]));
-  std::vector<Frac> line_point_frac(entry_grid_point.size());
-  std::vector<std::int64_t> line_point_count(num_lines, 0), record_count(num_lines + 1, 0);
-  struct Candidate {
-    Frac t;
-    std::int64_t grid;  // index into entry_grid_point
-  };
-  tbb::enumerable_thread_specific<std::vector<Candidate>> candidates;
-  tbb::parallel_for(std::size_t{0}, num_lines, [&](std::size_t g) {
-    auto& c = candidates.local();
-    c.clear();
-    for (std::size_t e = line_start[g]; e < line_start[g + 1]; ++e) {
-      for (int i = 0; i <= entries[e].segs; ++i) {
-        c.push_back({PointOnSide(entries[e], i), grid_offset[e] + i});
-      }
-    }
-    std::sort(c.begin(), c.end(), [](const Candidate& x, const Candidate& y) {
-      if (FracLess(x.t, y.t)) return true;
-      if (FracLess(y.t, x.t)) return false;
-      return x.grid < y.grid;
-    });
-    const std::int64_t base = grid_offset[line_start[g]];
-    std::int64_t m = -1;
-    for (std::size_t k = 0; k < c.size(); ++k) {
-      if (k == 0 || FracLess(c[k - 1].t, c[k].t)) {
-        line_point_frac[static_cast<std::size_t>(base + ++m)] = c[k].t;
-      }
-      entry_grid_point[static_cast<std::size_t>(c[k].grid)] = base + m;
-    }
-    line_point_count[g] = m + 1;
-    std::int64_t records = 0;
-    for (std::int64_t p = 0; p <= m; ++p) {
-      for (std::size_t e = line_start[g]; e < line_start[g + 1]; ++e) {
-        records += Covers(entries[e], line_point_frac[static_cast<std::size_t>(base + p)]);
-      }
-    }
-    record_count[g + 1] = records;
-  });
-  std::partial_sum(record_count.begin(), record_count.end(), record_count.begin());
-  std::vector<Record> records(static_cast<std::size_t>(record_count[num_lines]));
-  tbb::parallel_for(std::size_t{0}, num_lines, [&](std::size_t g) {
-    const std::int64_t base = grid_offset[line_start[g]];
-    std::size_t r = static_cast<std::size_t>(record_count[g]);
-    const LineKey& line = entries[line_start[g]].line;
-    for (std::int64_t p = 0; p < line_point_count[g]; ++p) {
-      const Frac t = line_point_frac[static_cast<std::size_t>(base + p)];
-      const PointKey key = KeyOf(cage, line, t);
-      for (std::size_t e = line_start[g]; e < line_start[g + 1]; ++e) {
-        if (!Covers(entries[e], t)) continue;
-        Record& rec = records[r++];
-        rec.key = key;
-        rec.face = entries[e].face;
-        rec.line_point = base + p;
-        SideUv(entries[e].side, SigmaOf(entries[e], t), rec.u, rec.v);
-      }
-    }
-  });
-
-  // 3. One vertex per distinct point.
-  tbb::parallel_sort(records.begin(), records.end(), RecordLess);
-  std::vector<std::int32_t> line_point_vertex(line_point_frac.size(), -1);
-  std::vector<std::size_t> vertex_records;  // records of vertex i: [vertex_records[i], [i + 1])
-  for (std::size_t r = 0; r < records.size(); ++r) {
-    if (r == 0 || records[r].key != records[r - 1].key) vertex_records.push_back(r);
-    line_point_vertex[static_cast<std::size_t>(records[r].line_point)] =
-        static_cast<std::int32_t>(vertex_records.size() - 1);
-  }
-  vertex_records.push_back(records.size());
-  const std::size_t num_shared = vertex_records.size() - 1;
-
-  // 4. Per face: interior grid points and the centres of stitched cells.
-  auto grid_point = [&](int f, int side, int i) {
-    const std::int64_t e = entry_of[4 * static_cast<std::size_t>(f) + side];
-    return entry_grid_point[static_cast<std::size_t>(grid_offset[static_cast<std::size_t>(e)] + i)];
-  };
-  auto extra_points = [&](int f, int side, int i) {  // between grid points i and i + 1
-    const std::int64_t a = grid_point(f, side, i), b = grid_point(f, side, i + 1);
-    return static_cast<int>(std::abs(b - a) - 1);
-  };
-  auto cell_extras = [&](int f, int kx, int ky, int i, int j) {
-    int extra = 0;
-    if (j == 0) extra += extra_points(f, 0, i);
-    if (i == kx - 1) extra += extra_points(f, 1, j);
-    if (j == ky - 1) extra += extra_points(f, 2, kx - 1 - i);
-    if (i == 0) extra += extra_points(f, 3, ky - 1 - j);
-    return extra;
-  };
-  std::vector<std::int64_t> vertex_start(static_cast<std::size_t>(n) + 1, 0);
-  std::vector<std::int64_t> triangle_start(static_cast<std::size_t>(n) + 1, 0);
-  tbb::parallel_for(0, n, [&](int f) {
-    if (!active(f)) return;
-    const int kx = density[static_cast<std::size_t>(f)][0];
-    const int ky = density[static_cast<std::size_t>(f)][1];
-    std::int64_t vertices = std::int64_t(kx - 1) * (ky - 1), triangles = 0;
-    for (int j = 0; j < ky; ++j) {
-      for (int i = 0; i < kx; ++i) {
-        const bool border = i == 0 || j == 0 || i == kx - 1 || j == ky - 1;
-        const int extra = border ? cell_extras(f, kx, ky, i, j) : 0;
-        if (extra == 0) {
-          triangles += 2;
-        } else {
-          vertices += 1;
-          triangles += 4 + extra;
-        }
-      }
-    }
-    vertex_start[static_cast<std::size_t>(f) + 1] = vertices;
-    triangle_start[static_cast<std::size_t>(f) + 1] = triangles;
-  });
-  vertex_start[0] = static_cast<std::int64_t>(num_shared);
-  std::partial_sum(vertex_start.begin(), vertex_start.end(), vertex_start.begin());
-  std::partial_sum(triangle_start.begin(), triangle_start.end(), triangle_start.begin());
-  const std::int64_t num_vertices = vertex_start[static_cast<std::size_t>(n)];
-  const std::int64_t num_triangles = triangle_start[static_cast<std::size_t>(n)];
-  if (num_vertices >= std::numeric_limits<std::int32_t>::max() ||
-      3 * num_triangles >= std::numeric_limits<std::int32_t>::max()) {
-    return Status::Error(fmt::format(
-        "{}: the tessellation would have {} triangles, more than 32-bit indices hold; lower the "
-        "density",
-        surface.source(), num_triangles));
+  StatusOr<ShadedMesh> Run() {
+    DISPEX_CHECK_EQ(density_.size(), static_cast<std::size_t>(n_));
+    CollectSides();
+    MergeLinePoints();
+    NumberSharedVertices();
+    CountFaceElements();
+    DISPEX_RETURN_IF_ERROR(AllocateMesh());
+    DISPEX_RETURN_IF_ERROR(PlaceSharedVertices());
+    DISPEX_RETURN_IF_ERROR(FillFaces());
+    SmoothNormals();
+    return std::move(out_);
   }
 
-  ShadedMesh out;
-  Mesh& mesh = out.mesh;
-  mesh.source = surface.source() + (map ? " displaced by " + map->name() : " (limit surface)");
-  mesh.positions.reserve(static_cast<std::size_t>(num_vertices) + 1);
-  mesh.positions.resize(static_cast<std::size_t>(num_vertices));
-  std::vector<Float3> limit_normals(static_cast<std::size_t>(num_vertices));
-  mesh.face_indices.resize(3 * static_cast<std::size_t>(num_triangles));
-  mesh.face_offsets.resize(static_cast<std::size_t>(num_triangles) + 1);
-  tbb::parallel_for(std::size_t{0}, mesh.face_offsets.size(), [&](std::size_t t) {
-    mesh.face_offsets[t] = static_cast<std::uint32_t>(3 * t);
-  });
-
+ private:
   struct Scratch {
     std::vector<float> uv, p, nrm;
     std::vector<std::int32_t> polygon;
   };
-  tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
-  tbb::enumerable_thread_specific<Scratch> scratch;
-  FirstError error;
-  auto evaluator_for_thread = [&]() -> LimitEvaluator& {
-    auto& e = evaluators.local();
-    if (!e) e.emplace(surface);
+
+  bool Active(int f) const {
+    return density_[static_cast<std::size_t>(f)][0] > 0 && !surface_.is_hole(PtexFaceId(f));
+  }
+  int Kx(int f) const { return density_[static_cast<std::size_t>(f)][0]; }
+  int Ky(int f) const { return density_[static_cast<std::size_t>(f)][1]; }
+
+  LimitEvaluator& EvaluatorForThread() {
+    auto& e = evaluators_.local();
+    if (!e) e.emplace(surface_);
     return *e;
-  };
+  }
+
+  // The merged line point of grid point i along side `side` of face f.
+  std::int64_t GridPoint(int f, int side, int i) const {
+    const std::int64_t e = entry_of_[4 * static_cast<std::size_t>(f) + side];
+    return entry_grid_point_[static_cast<std::size_t>(grid_offset_[static_cast<std::size_t>(e)] + i)];
+  }
+  // Points a neighbour added between grid points i and i + 1 of a side.
+  int ExtraPoints(int f, int side, int i) const {
+    const std::int64_t a = GridPoint(f, side, i), b = GridPoint(f, side, i + 1);
+    return static_cast<int>(std::abs(b - a) - 1);
+  }
+  int CellExtras(int f, int i, int j) const {
+    const int kx = Kx(f), ky = Ky(f);
+    int extra = 0;
+    if (j == 0) extra += ExtraPoints(f, 0, i);
+    if (i == kx - 1) extra += ExtraPoints(f, 1, j);
+    if (j == ky - 1) extra += ExtraPoints(f, 2, kx - 1 - i);
+    if (i == 0) extra += ExtraPoints(f, 3, ky - 1 - j);
+    return extra;
+  }
+  // A border cell with extra points becomes a fan around its centre.
+  bool Stitched(int f, int i, int j) const {
+    const bool border = i == 0 || j == 0 || i == Kx(f) - 1 || j == Ky(f) - 1;
+    return border && CellExtras(f, i, j) > 0;
+  }
+
+  // 1. Sides of every face, sorted by line.
+  void CollectSides() {
+    entries_.resize(4 * static_cast<std::size_t>(n_));
+    tbb::parallel_for(0, n_, [&](int f) {
+      if (!Active(f)) return;
+      const auto& d = density_[static_cast<std::size_t>(f)];
+      DISPEX_CHECK(d[0] >= 1 && d[0] <= 1024 && d[1] >= 1 && d[1] <= 1024);
+      FaceSides(cage_, surface_, f, d[0], d[1], &entries_[4 * static_cast<std::size_t>(f)]);
+    });
+    entries_.erase(std::remove_if(entries_.begin(), entries_.end(),
+                                  [](const SideEntry& e) { return e.face < 0; }),
+                   entries_.end());
+    tbb::parallel_sort(entries_.begin(), entries_.end(), [](const SideEntry& x, const SideEntry& y) {
+      if (x.line != y.line) return x.line < y.line;
+      if (x.face != y.face) return x.face < y.face;
+      return x.side < y.side;
+    });
+    const std::size_t num_entries = entries_.size();
+    entry_of_.assign(4 * static_cast<std::size_t>(n_), -1);
+    grid_offset_.assign(num_entries + 1, 0);
+    for (std::size_t e = 0; e < num_entries; ++e) {
+      entry_of_[4 * static_cast<std::size_t>(entries_[e].face) + entries_[e].side] =
+          static_cast<std::int64_t>(e);
+      grid_offset_[e + 1] = grid_offset_[e] + entries_[e].segs + 1;
+      if (e == 0 || entries_[e].line != entries_[e - 1].line) line_start_.push_back(e);
+    }
+    line_start_.push_back(num_entries);
+    num_lines_ = line_start_.size() - 1;
+  }
+
+  // 2. The merged points of each line (at most the sum of its sides' points), and the records
+  // of every face side that covers each point.
+  void MergeLinePoints() {
+    const std::size_t num_entries = entries_.size();
+    entry_grid_point_.resize(static_cast<std::size_t>(grid_offset_[num_entries]));
+    line_point_frac_.resize(entry_grid_point_.size());
+    line_point_count_.assign(num_lines_, 0);
+    std::vector<std::int64_t> record_count(num_lines_ + 1, 0);
+    struct Candidate {
+      Frac t;
+      std::int64_t grid;  // index into entry_grid_point_
+    };
+    tbb::enumerable_thread_specific<std::vector<Candidate>> candidates;
+    tbb::parallel_for(std::size_t{0}, num_lines_, [&](std::size_t g) {
+      auto& c = candidates.local();
+      c.clear();
+      for (std::size_t e = line_start_[g]; e < line_start_[g + 1]; ++e) {
+        for (int i = 0; i <= entries_[e].segs; ++i) {
+          c.push_back({PointOnSide(entries_[e], i), grid_offset_[e] + i});
+        }
+      }
+      std::sort(c.begin(), c.end(), [](const Candidate& x, const Candidate& y) {
+        if (FracLess(x.t, y.t)) return true;
+        if (FracLess(y.t, x.t)) return false;
+        return x.grid < y.grid;
+      });
+      const std::int64_t base = grid_offset_[line_start_[g]];
+      std::int64_t m = -1;
+      for (std::size_t k = 0; k < c.size(); ++k) {
+        if (k == 0 || FracLess(c[k - 1].t, c[k].t)) {
+          line_point_frac_[static_cast<std::size_t>(base + ++m)] = c[k].t;
+        }
+        entry_grid_point_[static_cast<std::size_t>(c[k].grid)] = base + m;
+      }
+      line_point_count_[g] = m + 1;
+      std::int64_t records = 0;
+      for (std::int64_t p = 0; p <= m; ++p) {
+        for (std::size_t e = line_start_[g]; e < line_start_[g + 1]; ++e) {
+          records += Covers(entries_[e], line_point_frac_[static_cast<std::size_t>(base + p)]);
+        }
+      }
+      record_count[g + 1] = records;
+    });
+    std::partial_sum(record_count.begin(), record_count.end(), record_count.begin());
+    records_.resize(static_cast<std::size_t>(record_count[num_lines_]));
+    tbb::parallel_for(std::size_t{0}, num_lines_, [&](std::size_t g) {
+      const std::int64_t base = grid_offset_[line_start_[g]];
+      std::size_t r = static_cast<std::size_t>(record_count[g]);
+      const LineKey& line = entries_[line_start_[g]].line;
+      for (std::int64_t p = 0; p < line_point_count_[g]; ++p) {
+        const Frac t = line_point_frac_[static_cast<std::size_t>(base + p)];
+        const PointKey key = KeyOf(cage_, line, t);
+        for (std::size_t e = line_start_[g]; e < line_start_[g + 1]; ++e) {
+          if (!Covers(entries_[e], t)) continue;
+          Record& rec = records_[r++];
+          rec.key = key;
+          rec.face = entries_[e].face;
+          rec.line_point = base + p;
+          SideUv(entries_[e].side, SigmaOf(entries_[e], t), rec.u, rec.v);
+        }
+      }
+    });
+  }
+
+  // 3. One vertex per distinct point.
+  void NumberSharedVertices() {
+    tbb::parallel_sort(records_.begin(), records_.end(), RecordLess);
+    line_point_vertex_.assign(line_point_frac_.size(), -1);
+    for (std::size_t r = 0; r < records_.size(); ++r) {
+      if (r == 0 || records_[r].key != records_[r - 1].key) vertex_records_.push_back(r);
+      line_point_vertex_[static_cast<std::size_t>(records_[r].line_point)] =
+          static_cast<std::int32_t>(vertex_records_.size() - 1);
+    }
+    vertex_records_.push_back(records_.size());
+    num_shared_ = vertex_records_.size() - 1;
+  }
+
+  // 4. Per face: interior grid points and the centres of stitched cells, and its triangles.
+  void CountFaceElements() {
+    vertex_start_.assign(static_cast<std::size_t>(n_) + 1, 0);
+    triangle_start_.assign(static_cast<std::size_t>(n_) + 1, 0);
+    tbb::parallel_for(0, n_, [&](int f) {
+      if (!Active(f)) return;
+      const int kx = Kx(f), ky = Ky(f);
+      std::int64_t vertices = std::int64_t(kx - 1) * (ky - 1), triangles = 0;
+      for (int j = 0; j < ky; ++j) {
+        for (int i = 0; i < kx; ++i) {
+          const bool border = i == 0 || j == 0 || i == kx - 1 || j == ky - 1;
+          const int extra = border ? CellExtras(f, i, j) : 0;
+          if (extra == 0) {
+            triangles += 2;
+          } else {
+            vertices += 1;
+            triangles += 4 + extra;
+          }
+        }
+      }
+      vertex_start_[static_cast<std::size_t>(f) + 1] = vertices;
+      triangle_start_[static_cast<std::size_t>(f) + 1] = triangles;
+    });
+    vertex_start_[0] = static_cast<std::int64_t>(num_shared_);
+    std::partial_sum(vertex_start_.begin(), vertex_start_.end(), vertex_start_.begin());
+    std::partial_sum(triangle_start_.begin(), triangle_start_.end(), triangle_start_.begin());
+  }
+
+  Status AllocateMesh() {
+    const std::int64_t num_vertices = vertex_start_[static_cast<std::size_t>(n_)];
+    const std::int64_t num_triangles = triangle_start_[static_cast<std::size_t>(n_)];
+    if (num_vertices >= std::numeric_limits<std::int32_t>::max() ||
+        3 * num_triangles >= std::numeric_limits<std::int32_t>::max()) {
+      return Status::Error(fmt::format(
+          "{}: the tessellation would have {} triangles, more than 32-bit indices hold; lower "
+          "the density",
+          surface_.source(), num_triangles));
+    }
+    Mesh& mesh = out_.mesh;
+    mesh.source =
+        surface_.source() + (map_ ? " displaced by " + map_->name() : " (limit surface)");
+    mesh.positions.reserve(static_cast<std::size_t>(num_vertices) + 1);
+    mesh.positions.resize(static_cast<std::size_t>(num_vertices));
+    limit_normals_.resize(static_cast<std::size_t>(num_vertices));
+    mesh.face_indices.resize(3 * static_cast<std::size_t>(num_triangles));
+    mesh.face_offsets.resize(static_cast<std::size_t>(num_triangles) + 1);
+    tbb::parallel_for(std::size_t{0}, mesh.face_offsets.size(), [&](std::size_t t) {
+      mesh.face_offsets[t] = static_cast<std::uint32_t>(3 * t);
+    });
+    return Status::Ok();
+  }
+
+  // Vertex `v` at limit point p(i) moved by h along the limit normal nrm(i) (xyz at 3i).
+  void Place(std::size_t v, const Scratch& s, std::size_t k, float h) {
+    const std::size_t i = 3 * k;
+    limit_normals_[v] = {s.nrm[i], s.nrm[i + 1], s.nrm[i + 2]};
+    out_.mesh.positions[v] = {s.p[i] + h * s.nrm[i], s.p[i + 1] + h * s.nrm[i + 1],
+                              s.p[i + 2] + h * s.nrm[i + 2]};
+  }
 
   // 5. Shared vertices: evaluated on their first face, displaced by the mean of all faces.
-  std::vector<std::pair<std::int32_t, std::int32_t>> owners(num_shared);  // (face, vertex)
-  for (std::size_t v = 0; v < num_shared; ++v) {
-    owners[v] = {records[vertex_records[v]].face, static_cast<std::int32_t>(v)};
-  }
-  std::sort(owners.begin(), owners.end());
-  std::vector<std::size_t> owner_start;
-  for (std::size_t k = 0; k < owners.size(); ++k) {
-    if (k == 0 || owners[k].first != owners[k - 1].first) owner_start.push_back(k);
-  }
-  owner_start.push_back(owners.size());
-  tbb::parallel_for(std::size_t{0}, owner_start.size() - 1, [&](std::size_t g) {
-    const std::size_t begin = owner_start[g], end = owner_start[g + 1];
-    const int f = owners[begin].first;
-    Scratch& s = scratch.local();
-    s.uv.resize(2 * (end - begin));
-    s.p.resize(3 * (end - begin));
-    s.nrm.resize(3 * (end - begin));
-    for (std::size_t k = begin; k < end; ++k) {
-      const Record& r = records[vertex_records[static_cast<std::size_t>(owners[k].second)]];
-      s.uv[2 * (k - begin)] = r.u;
-      s.uv[2 * (k - begin) + 1] = r.v;
+  Status PlaceSharedVertices() {
+    std::vector<std::pair<std::int32_t, std::int32_t>> owners(num_shared_);  // (face, vertex)
+    for (std::size_t v = 0; v < num_shared_; ++v) {
+      owners[v] = {records_[vertex_records_[v]].face, static_cast<std::int32_t>(v)};
     }
-    Status st = evaluator_for_thread().EvaluatePoints(PtexFaceId(f), s.uv, s.p, s.nrm);
-    if (!st.ok()) return error.Record(f, st);
-    for (std::size_t k = begin; k < end; ++k) {
-      const auto v = static_cast<std::size_t>(owners[k].second);
-      float h = 0;
-      if (map) {
-        double sum = 0;
-        for (std::size_t r = vertex_records[v]; r < vertex_records[v + 1]; ++r) {
-          const float value =
-              map->Sample(PtexFaceId(records[r].face), records[r].u, records[r].v, channel);
-          if (!std::isfinite(value))
-            return error.Record(records[r].face, MapValueError(*map, records[r].face));
-          sum += value;
-        }
-        h = static_cast<float>(sum / double(vertex_records[v + 1] - vertex_records[v]));
+    std::sort(owners.begin(), owners.end());
+    std::vector<std::size_t> owner_start;
+    for (std::size_t k = 0; k < owners.size(); ++k) {
+      if (k == 0 || owners[k].first != owners[k - 1].first) owner_start.push_back(k);
+    }
+    owner_start.push_back(owners.size());
+    tbb::parallel_for(std::size_t{0}, owner_start.size() - 1, [&](std::size_t g) {
+      const std::size_t begin = owner_start[g], end = owner_start[g + 1];
+      const int f = owners[begin].first;
+      Scratch& s = scratch_.local();
+      s.uv.resize(2 * (end - begin));
+      s.p.resize(3 * (end - begin));
+      s.nrm.resize(3 * (end - begin));
+      for (std::size_t k = begin; k < end; ++k) {
+        const Record& r = records_[vertex_records_[static_cast<std::size_t>(owners[k].second)]];
+        s.uv[2 * (k - begin)] = r.u;
+        s.uv[2 * (k - begin) + 1] = r.v;
       }
-      const std::size_t i = 3 * (k - begin);
-      limit_normals[v] = {s.nrm[i], s.nrm[i + 1], s.nrm[i + 2]};
-      mesh.positions[v] = {s.p[i] + h * s.nrm[i], s.p[i + 1] + h * s.nrm[i + 1],
-                           s.p[i + 2] + h * s.nrm[i + 2]};
-    }
-  });
-  if (error.failed()) return error.status();
+      Status st = EvaluatorForThread().EvaluatePoints(PtexFaceId(f), s.uv, s.p, s.nrm);
+      if (!st.ok()) return error_.Record(f, st);
+      for (std::size_t k = begin; k < end; ++k) {
+        const auto v = static_cast<std::size_t>(owners[k].second);
+        float h = 0;
+        if (map_) {
+          double sum = 0;
+          for (std::size_t r = vertex_records_[v]; r < vertex_records_[v + 1]; ++r) {
+            const float value =
+                map_->Sample(PtexFaceId(records_[r].face), records_[r].u, records_[r].v, channel_);
+            if (!std::isfinite(value))
+              return error_.Record(records_[r].face, MapValueError(*map_, records_[r].face));
+            sum += value;
+          }
+          h = static_cast<float>(sum / double(vertex_records_[v + 1] - vertex_records_[v]));
+        }
+        Place(v, s, k - begin, h);
+      }
+    });
+    if (error_.failed()) return error_.status();
+    return Status::Ok();
+  }
 
   // 6. Interior points and triangles, face by face.
-  tbb::parallel_for(0, n, [&](int f) {
-    if (!active(f)) return;
-    const int kx = density[static_cast<std::size_t>(f)][0];
-    const int ky = density[static_cast<std::size_t>(f)][1];
-    Scratch& s = scratch.local();
-    // Points to evaluate: interior grid points, then the centres of stitched cells.
+  Status FillFaces() {
+    tbb::parallel_for(0, n_, [&](int f) {
+      if (!Active(f)) return;
+      Scratch& s = scratch_.local();
+      Status st = PlaceInteriorVertices(f, s);
+      if (!st.ok()) return error_.Record(f, st);
+      EmitTriangles(f, s);
+    });
+    if (error_.failed()) return error_.status();
+    return Status::Ok();
+  }
+
+  // Interior grid points, then the centres of stitched cells.
+  Status PlaceInteriorVertices(int f, Scratch& s) {
+    const int kx = Kx(f), ky = Ky(f);
     s.uv.clear();
     for (int j = 1; j < ky; ++j) {
       for (int i = 1; i < kx; ++i) {
@@ -479,37 +531,39 @@ StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface
     }
     for (int j = 0; j < ky; ++j) {
       for (int i = 0; i < kx; ++i) {
-        const bool border = i == 0 || j == 0 || i == kx - 1 || j == ky - 1;
-        if (border && cell_extras(f, kx, ky, i, j) > 0) {
+        if (Stitched(f, i, j)) {
           s.uv.push_back((float(i) + 0.5f) / float(kx));
           s.uv.push_back((float(j) + 0.5f) / float(ky));
         }
       }
     }
     const std::size_t count = s.uv.size() / 2;
-    const auto first = static_cast<std::size_t>(vertex_start[static_cast<std::size_t>(f)]);
+    const auto first = static_cast<std::size_t>(vertex_start_[static_cast<std::size_t>(f)]);
     DISPEX_CHECK_EQ(first + count,
-                    static_cast<std::size_t>(vertex_start[static_cast<std::size_t>(f) + 1]));
-    if (count > 0) {
-      s.p.resize(3 * count);
-      s.nrm.resize(3 * count);
-      Status st = evaluator_for_thread().EvaluatePoints(PtexFaceId(f), s.uv, s.p, s.nrm);
-      if (!st.ok()) return error.Record(f, st);
-      for (std::size_t k = 0; k < count; ++k) {
-        float h = 0;
-        if (map) {
-          h = map->Sample(PtexFaceId(f), s.uv[2 * k], s.uv[2 * k + 1], channel);
-          if (!std::isfinite(h)) return error.Record(f, MapValueError(*map, f));
-        }
-        const std::size_t i = 3 * k;
-        limit_normals[first + k] = {s.nrm[i], s.nrm[i + 1], s.nrm[i + 2]};
-        mesh.positions[first + k] = {s.p[i] + h * s.nrm[i], s.p[i + 1] + h * s.nrm[i + 1],
-                                     s.p[i + 2] + h * s.nrm[i + 2]};
+                    static_cast<std::size_t>(vertex_start_[static_cast<std::size_t>(f) + 1]));
+    if (count == 0) return Status::Ok();
+    s.p.resize(3 * count);
+    s.nrm.resize(3 * count);
+    DISPEX_RETURN_IF_ERROR(EvaluatorForThread().EvaluatePoints(PtexFaceId(f), s.uv, s.p, s.nrm));
+    for (std::size_t k = 0; k < count; ++k) {
+      float h = 0;
+      if (map_) {
+        h = map_->Sample(PtexFaceId(f), s.uv[2 * k], s.uv[2 * k + 1], channel_);
+        if (!std::isfinite(h)) return MapValueError(*map_, f);
       }
+      Place(first + k, s, k, h);
     }
+    return Status::Ok();
+  }
 
+  // Two triangles per plain cell (split along the shorter diagonal), a fan around the centre
+  // for a stitched one.
+  void EmitTriangles(int f, Scratch& s) {
+    const int kx = Kx(f), ky = Ky(f);
+    const auto first = static_cast<std::size_t>(vertex_start_[static_cast<std::size_t>(f)]);
+    Mesh& mesh = out_.mesh;
     auto shared = [&](int side, int i) {
-      return line_point_vertex[static_cast<std::size_t>(grid_point(f, side, i))];
+      return line_point_vertex_[static_cast<std::size_t>(GridPoint(f, side, i))];
     };
     auto grid_vertex = [&](int i, int j) -> std::int32_t {
       if (j == 0) return shared(0, i);
@@ -520,13 +574,13 @@ StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface
     };
     // Appends the points strictly between grid points i and i + 1 of a side.
     auto append_between = [&](int side, int i) {
-      const std::int64_t a = grid_point(f, side, i), b = grid_point(f, side, i + 1);
+      const std::int64_t a = GridPoint(f, side, i), b = GridPoint(f, side, i + 1);
       const std::int64_t step = b > a ? 1 : -1;
       for (std::int64_t p = a + step; p != b; p += step) {
-        s.polygon.push_back(line_point_vertex[static_cast<std::size_t>(p)]);
+        s.polygon.push_back(line_point_vertex_[static_cast<std::size_t>(p)]);
       }
     };
-    std::int32_t* tri = mesh.face_indices.data() + 3 * triangle_start[static_cast<std::size_t>(f)];
+    std::int32_t* tri = mesh.face_indices.data() + 3 * triangle_start_[static_cast<std::size_t>(f)];
     auto emit = [&](std::int32_t a, std::int32_t b, std::int32_t c) {
       *tri++ = a;
       *tri++ = b;
@@ -537,8 +591,7 @@ StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface
       for (int i = 0; i < kx; ++i) {
         const std::int32_t a = grid_vertex(i, j), b = grid_vertex(i + 1, j);
         const std::int32_t c = grid_vertex(i + 1, j + 1), d = grid_vertex(i, j + 1);
-        const bool border = i == 0 || j == 0 || i == kx - 1 || j == ky - 1;
-        if (!border || cell_extras(f, kx, ky, i, j) == 0) {
+        if (!Stitched(f, i, j)) {
           const auto& P = mesh.positions;
           if (Length2(Sub(P[static_cast<std::size_t>(a)], P[static_cast<std::size_t>(c)])) <=
               Length2(Sub(P[static_cast<std::size_t>(b)], P[static_cast<std::size_t>(d)]))) {
@@ -566,23 +619,59 @@ StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface
       }
     }
     DISPEX_CHECK(tri ==
-                 mesh.face_indices.data() + 3 * triangle_start[static_cast<std::size_t>(f) + 1]);
-  });
-  if (error.failed()) return error.status();
+                 mesh.face_indices.data() + 3 * triangle_start_[static_cast<std::size_t>(f) + 1]);
+  }
 
   // 7. Smooth normals.
-  std::vector<Float3> triangle_normals(static_cast<std::size_t>(num_triangles));
-  tbb::parallel_for(std::size_t{0}, triangle_normals.size(), [&](std::size_t t) {
-    const Float3& a = mesh.positions[static_cast<std::size_t>(mesh.face_indices[3 * t])];
-    const Float3& b = mesh.positions[static_cast<std::size_t>(mesh.face_indices[3 * t + 1])];
-    const Float3& c = mesh.positions[static_cast<std::size_t>(mesh.face_indices[3 * t + 2])];
-    const Float3 e1 = Sub(b, a), e2 = Sub(c, a);
-    triangle_normals[t] = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z,
-                           e1.x * e2.y - e1.y * e2.x};
-  });
-  VertexNormals(mesh.positions.size(), mesh.face_offsets, mesh.face_indices, triangle_normals,
-                limit_normals, out.normals);
-  return out;
+  void SmoothNormals() {
+    const Mesh& mesh = out_.mesh;
+    std::vector<Float3> triangle_normals(mesh.face_indices.size() / 3);
+    tbb::parallel_for(std::size_t{0}, triangle_normals.size(), [&](std::size_t t) {
+      const Float3& a = mesh.positions[static_cast<std::size_t>(mesh.face_indices[3 * t])];
+      const Float3& b = mesh.positions[static_cast<std::size_t>(mesh.face_indices[3 * t + 1])];
+      const Float3& c = mesh.positions[static_cast<std::size_t>(mesh.face_indices[3 * t + 2])];
+      const Float3 e1 = Sub(b, a), e2 = Sub(c, a);
+      triangle_normals[t] = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z,
+                             e1.x * e2.y - e1.y * e2.x};
+    });
+    VertexNormals(mesh.positions.size(), mesh.face_offsets, mesh.face_indices, triangle_normals,
+                  limit_normals_, out_.normals);
+  }
+
+  const Mesh& cage_;
+  const LimitSurface& surface_;
+  std::span<const std::array<int, 2>> density_;
+  const PtexFile* map_;
+  int channel_;
+  int n_;  // Ptex faces
+
+  std::vector<SideEntry> entries_;        // face sides, by line
+  std::vector<std::int64_t> entry_of_;    // 4 f + side -> its entry, or -1
+  std::vector<std::int64_t> grid_offset_; // entry -> its first grid point
+  std::vector<std::size_t> line_start_;   // entries of line g: [line_start_[g], [g + 1])
+  std::size_t num_lines_ = 0;
+  std::vector<std::int64_t> entry_grid_point_;  // grid point -> merged line point
+  std::vector<Frac> line_point_frac_;
+  std::vector<std::int64_t> line_point_count_;
+  std::vector<Record> records_;
+  std::vector<std::int32_t> line_point_vertex_;
+  std::vector<std::size_t> vertex_records_;  // records of vertex i: [vertex_records_[i], [i + 1])
+  std::size_t num_shared_ = 0;
+  std::vector<std::int64_t> vertex_start_, triangle_start_;  // per face, prefix sums
+
+  ShadedMesh out_;
+  std::vector<Float3> limit_normals_;
+  tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators_;
+  tbb::enumerable_thread_specific<Scratch> scratch_;
+  FirstError error_;
+};
+
+}  // namespace
+
+StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface& surface,
+                                            std::span<const std::array<int, 2>> density,
+                                            const PtexFile* map, int channel) {
+  return Tessellation(cage, surface, density, map, channel).Run();
 }
 
 ShadedMesh ShadePolygonMesh(const Mesh& mesh) {

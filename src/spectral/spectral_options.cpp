@@ -36,30 +36,30 @@ Status ValidateSpectralOptions(const SpectralOptions& options) {
     case ResolutionRule::kFixed:
       break;
     default:
-      return Status::Error(fmt::format("resolution rule {} is not one of bound, nonzero, fixed",
+      return Status::Error(fmt::format("rule = {}: not one of bound, nonzero, fixed",
                                        static_cast<int>(options.rule)));
   }
   if (!std::isfinite(options.tolerance) || options.tolerance < 0) {
     return Status::Error(
-        fmt::format("tolerance {} must be finite and >= 0 (object units)", options.tolerance));
+        fmt::format("tolerance = {}: must be finite and >= 0 (object units)", options.tolerance));
   }
   if (!std::isfinite(options.edge_tolerance) || options.edge_tolerance < 0) {
-    return Status::Error(fmt::format("edge tolerance {} must be finite and >= 0 (object units)",
+    return Status::Error(fmt::format("edge_tolerance = {}: must be finite and >= 0 (object units)",
                                      options.edge_tolerance));
   }
   if (!std::isfinite(options.nonzero_threshold) || options.nonzero_threshold < 0) {
     return Status::Error(
-        fmt::format("nonzero threshold {} must be finite and >= 0", options.nonzero_threshold));
+        fmt::format("nonzero_threshold = {}: must be finite and >= 0", options.nonzero_threshold));
   }
   for (int l : {options.min_ulog2, options.min_vlog2}) {
     if (l < 0 || l > kMaxSpectralLog2) {
-      return Status::Error(fmt::format("least resolution log2 {} x {}: {} is outside 0..{}",
+      return Status::Error(fmt::format("min_ulog2 x min_vlog2 = {} x {}: {} is outside 0..{}",
                                        options.min_ulog2, options.min_vlog2, l, kMaxSpectralLog2));
     }
   }
   for (int l : {options.fixed_ulog2, options.fixed_vlog2}) {
     if (l < 0 || l > kMaxSpectralLog2) {
-      return Status::Error(fmt::format("fixed resolution log2 {} x {}: {} is outside 0..{}",
+      return Status::Error(fmt::format("fixed_ulog2 x fixed_vlog2 = {} x {}: {} is outside 0..{}",
                                        options.fixed_ulog2, options.fixed_vlog2, l,
                                        kMaxSpectralLog2));
     }

@@ -296,11 +296,204 @@ void AtomicMin(std::int32_t& slot, std::int32_t value) {
   }
 }
 
-}  // namespace
+// RefineUniform's state, built by its steps in the order RefineUniform calls them.
+struct Refinement {
+  Refinement(const LimitSurface::Impl& surface, int levels_, const RefineOptions& options_)
+      : s(surface), levels(levels_), options(options_),
+        arena(options_.threads > 0 ? options_.threads : tbb::task_arena::automatic) {}
 
-StatusOr<RefinedMesh> RefineUniform(const LimitSurface& surface, int levels,
-                                    const RefineOptions& options) {
-  const LimitSurface::Impl& s = surface.impl();
+  const LimitSurface::Impl& s;
+  const int levels;
+  const RefineOptions& options;
+  tbb::task_arena arena;
+  tbb::enumerable_thread_specific<std::unique_ptr<Worker>> workers;
+
+  std::unique_ptr<Far::TopologyRefiner> refiner;
+  std::unique_ptr<LastSplit> split;
+  int num_vertices = 0, num_faces = 0;  // at the output level, holes included
+  std::vector<std::int32_t> owner;      // per vertex: the lowest kept leaf face using it
+  std::vector<std::uint8_t> keep;       // per leaf face: not part of a hole
+  std::vector<std::uint32_t> leaf_offsets;  // only for levels == 0 (faces of any size)
+  // Face-vertex lists of all leaves in OpenSubdiv's order (holes included, dropped at the end).
+  std::vector<std::int32_t> leaf_vertices;
+  std::vector<std::int32_t> new_vertex, new_face;  // compacted ids, -1 for dropped ones
+  std::int32_t kept_vertices = 0, kept_faces = 0;
+  RefinedMesh out;
+
+  Worker& WorkerForThread() {
+    auto& w = workers.local();
+    if (!w) w = std::make_unique<Worker>(*refiner, split.get(), s, levels);
+    return *w;
+  }
+  bool HasSurface(int base_face) const { return s.ptex_hole[s.first_ptex[base_face]] == 0; }
+  std::size_t LeafOffset(int face) const {
+    return levels == 0 ? leaf_offsets[face] : 4 * static_cast<std::size_t>(face);
+  }
+
+  // OpenSubdiv refines to the level above the output (full topology: the last split needs
+  // its edges).
+  Status BuildTopology(std::uint64_t expected_faces) {
+    using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
+    refiner.reset(Factory::Create(*s.refiner));
+    if (levels > 1) {
+      subdiv::OsdMessageCapture capture;
+      Far::TopologyRefiner::UniformOptions uniform(levels - 1);
+      uniform.fullTopologyInLastLevel = true;
+      refiner->RefineUniform(uniform);
+      if (!capture.empty()) {
+        return Status::Error(s.source +
+                             ": OpenSubdiv uniform refinement failed: " + capture.messages());
+      }
+    }
+    if (levels == 0) {
+      num_vertices = refiner->GetLevel(0).GetNumVertices();
+      num_faces = refiner->GetLevel(0).GetNumFaces();
+    } else {
+      split = std::make_unique<LastSplit>(refiner->GetLevel(levels - 1), levels > 1);
+      DISPEX_CHECK_EQ(static_cast<std::uint64_t>(split->num_child_faces()), expected_faces);
+      num_vertices = static_cast<int>(split->num_child_vertices());
+      num_faces = static_cast<int>(split->num_child_faces());
+    }
+    out.levels = levels;
+    out.refined_vertices = static_cast<std::size_t>(num_vertices);
+    out.refined_faces = static_cast<std::size_t>(num_faces);
+    out.mesh.source = fmt::format("{} (level {})", s.source, levels);
+    return Status::Ok();
+  }
+
+  // Pass 1: each vertex's owner is the first (lowest-numbered) kept leaf face using it; the
+  // leaf faces' vertex lists are kept for the output.
+  void FindOwners() {
+    owner.assign(num_vertices, kNoOwner);
+    keep.assign(num_faces, 0);
+    if (levels == 0) {
+      leaf_offsets.resize(static_cast<std::size_t>(num_faces) + 1);
+      for (int f = 0; f < num_faces; ++f) {
+        leaf_offsets[f + 1] = leaf_offsets[f] + static_cast<std::uint32_t>(
+                                                    refiner->GetLevel(0).GetFaceVertices(f).size());
+      }
+    }
+    leaf_vertices.resize(levels == 0 ? leaf_offsets.back() : 4 * static_cast<std::size_t>(num_faces));
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<int>(0, s.num_base_faces()),
+                        [&](const tbb::blocked_range<int>& r) {
+        LeafWalker& walker = WorkerForThread().walker;
+        for (int f = r.begin(); f != r.end(); ++f) {
+          if (!HasSurface(f)) continue;
+          walker.Walk(f, [&](int face, int corners, const int* vertices, const int*, const float*) {
+            keep[face] = 1;
+            std::int32_t* dst = &leaf_vertices[LeafOffset(face)];
+            for (int m = 0; m < corners; ++m) {
+              dst[m] = vertices[m];
+              AtomicMin(owner[vertices[m]], face);
+            }
+          });
+        }
+      });
+    });
+  }
+
+  // Compaction: vertices and faces of holes go, the rest keep OpenSubdiv's order.
+  void Compact() {
+    new_vertex.assign(num_vertices, -1);
+    for (int v = 0; v < num_vertices; ++v) {
+      if (owner[v] != kNoOwner) new_vertex[v] = kept_vertices++;
+    }
+    if (options.face_charts) new_face.assign(num_faces, -1);
+    for (int f = 0; f < num_faces; ++f) {
+      if (!keep[f]) continue;
+      if (options.face_charts) new_face[f] = kept_faces;
+      ++kept_faces;
+    }
+    out.mesh.positions.resize(kept_vertices);
+    out.normals.resize(3 * static_cast<std::size_t>(kept_vertices));
+    out.ptex_faces.resize(kept_vertices);
+    out.uvs.resize(2 * static_cast<std::size_t>(kept_vertices));
+    if (options.face_charts) {
+      out.face_ptex.resize(kept_faces);
+      out.face_uvs.resize(8 * static_cast<std::size_t>(kept_faces));
+    }
+  }
+
+  // Pass 2: locate and evaluate every vertex from its owner face. A face OpenSubdiv fails
+  // on stops the work; the lowest such base face is reported, whatever the scheduling.
+  Status EvaluateVertices() {
+    std::atomic<int> failed_face{std::numeric_limits<int>::max()};
+    std::mutex failure_mutex;
+    std::string failure;
+    Mesh& mesh = out.mesh;
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<int>(0, s.num_base_faces()),
+                        [&](const tbb::blocked_range<int>& r) {
+        Worker& w = WorkerForThread();
+        for (int f = r.begin(); f != r.end(); ++f) {
+          if (!HasSurface(f) || f > failed_face.load(std::memory_order_relaxed)) continue;
+          bool ok = true;
+          w.walker.Walk(
+              f, [&](int face, int corners, const int* vertices, const int* ptex, const float* uv) {
+                for (int m = 0; m < corners && ok; ++m) {
+                  if (owner[vertices[m]] != face) continue;
+                  const std::int32_t v = new_vertex[vertices[m]];
+                  if (w.sampler.Bind(ptex[m]) != subdiv::FaceSampler::BindResult::kOk) {
+                    ok = false;
+                    std::lock_guard<std::mutex> lock(failure_mutex);
+                    if (f < failed_face.load()) {
+                      failed_face = f;
+                      failure = w.sampler.error();
+                    }
+                    break;
+                  }
+                  float p[3];
+                  w.sampler.Point(uv[2 * m], uv[2 * m + 1], p,
+                                  &out.normals[3 * static_cast<std::size_t>(v)]);
+                  mesh.positions[v] = Float3{p[0], p[1], p[2]};
+                  out.ptex_faces[v] = PtexFaceId(ptex[m]);
+                  out.uvs[2 * static_cast<std::size_t>(v)] = uv[2 * m];
+                  out.uvs[2 * static_cast<std::size_t>(v) + 1] = uv[2 * m + 1];
+                }
+                if (options.face_charts) {
+                  const std::size_t nf = static_cast<std::size_t>(new_face[face]);
+                  out.face_ptex[nf] = PtexFaceId(ptex[0]);
+                  for (int k = 0; k < 8; ++k) out.face_uvs[8 * nf + k] = uv[k];
+                }
+              });
+        }
+      });
+    });
+    if (failed_face.load() != std::numeric_limits<int>::max()) {
+      return Status::Error(
+          fmt::format("{}: OpenSubdiv could not build the limit surface of base face {}: {}",
+                      s.source, failed_face.load(), failure));
+    }
+    return Status::Ok();
+  }
+
+  // Faces, in OpenSubdiv's order, compacted in place.
+  void WriteFaces() {
+    owner = {};
+    workers.clear();  // the walkers read the topology released next
+    refiner.reset();  // the topology is all in leaf_vertices now
+    split.reset();
+    Mesh& mesh = out.mesh;
+    std::size_t write = 0;
+    mesh.face_offsets.reserve(static_cast<std::size_t>(kept_faces) + 1);
+    mesh.face_offsets.push_back(0);
+    for (int f = 0; f < num_faces; ++f) {
+      if (!keep[f]) continue;
+      const std::size_t begin = LeafOffset(f);
+      const std::size_t end = levels == 0 ? leaf_offsets[f + 1] : begin + 4;
+      for (std::size_t i = begin; i < end; ++i) leaf_vertices[write++] = new_vertex[leaf_vertices[i]];
+      mesh.face_offsets.push_back(static_cast<std::uint32_t>(write));
+    }
+    leaf_vertices.resize(write);
+    leaf_vertices.shrink_to_fit();
+    mesh.face_indices = std::move(leaf_vertices);
+  }
+};
+
+// Checks the arguments; returns the number of faces at the output level, holes included.
+StatusOr<std::uint64_t> CountRefinedFaces(const LimitSurface::Impl& s, int levels,
+                                          const RefineOptions& options) {
   if (levels < 0 || levels > kMaxLevels) {
     return Status::Error(
         fmt::format("{}: refinement level {} outside 0..{}", s.source, levels, kMaxLevels));
@@ -311,9 +504,8 @@ StatusOr<RefinedMesh> RefineUniform(const LimitSurface& surface, int levels,
   if (options.face_charts && levels == 0) {
     return Status::Error(s.source + ": face charts need at least one refinement level");
   }
-  const int num_base = s.num_base_faces();
   std::uint64_t expected_faces = 0;
-  for (int f = 0; f < num_base; ++f) {
+  for (int f = 0; f < s.num_base_faces(); ++f) {
     const std::uint64_t n = s.face_size(f);
     expected_faces += (levels == 0) ? 1 : ((n == 4 ? 4 : n) << (2 * (levels - 1)));
   }
@@ -322,175 +514,22 @@ StatusOr<RefinedMesh> RefineUniform(const LimitSurface& surface, int levels,
         fmt::format("{}: {} refinement levels make {} faces, more than 32-bit indices allow",
                     s.source, levels, expected_faces));
   }
+  return expected_faces;
+}
 
-  // OpenSubdiv refines to the level above the output (full topology: the last split needs
-  // its edges).
-  using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-  std::unique_ptr<Far::TopologyRefiner> refiner(Factory::Create(*s.refiner));
-  if (levels > 1) {
-    subdiv::OsdMessageCapture capture;
-    Far::TopologyRefiner::UniformOptions uniform(levels - 1);
-    uniform.fullTopologyInLastLevel = true;
-    refiner->RefineUniform(uniform);
-    if (!capture.empty()) {
-      return Status::Error(s.source +
-                           ": OpenSubdiv uniform refinement failed: " + capture.messages());
-    }
-  }
-  std::unique_ptr<LastSplit> split;
-  int num_vertices = 0, num_faces = 0;
-  if (levels == 0) {
-    num_vertices = refiner->GetLevel(0).GetNumVertices();
-    num_faces = refiner->GetLevel(0).GetNumFaces();
-  } else {
-    split = std::make_unique<LastSplit>(refiner->GetLevel(levels - 1), levels > 1);
-    DISPEX_CHECK_EQ(static_cast<std::uint64_t>(split->num_child_faces()), expected_faces);
-    num_vertices = static_cast<int>(split->num_child_vertices());
-    num_faces = static_cast<int>(split->num_child_faces());
-  }
+}  // namespace
 
-  RefinedMesh out;
-  out.levels = levels;
-  out.refined_vertices = static_cast<std::size_t>(num_vertices);
-  out.refined_faces = static_cast<std::size_t>(num_faces);
-
-  auto has_surface = [&](int base_face) { return s.ptex_hole[s.first_ptex[base_face]] == 0; };
-
-  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
-  tbb::enumerable_thread_specific<std::unique_ptr<Worker>> workers;
-  auto worker = [&]() -> Worker& {
-    auto& w = workers.local();
-    if (!w) w = std::make_unique<Worker>(*refiner, split.get(), s, levels);
-    return *w;
-  };
-
-  // Pass 1: each vertex's owner is the first (lowest-numbered) kept leaf face using it; the
-  // leaf faces' vertex lists are kept for the output.
-  std::vector<std::int32_t> owner(num_vertices, kNoOwner);
-  std::vector<std::uint8_t> keep(num_faces, 0);
-  std::vector<std::uint32_t> leaf_offsets;  // only for levels == 0 (faces of any size)
-  Mesh& mesh = out.mesh;
-  mesh.source = fmt::format("{} (level {})", s.source, levels);
-  if (levels == 0) {
-    leaf_offsets.resize(static_cast<std::size_t>(num_faces) + 1);
-    for (int f = 0; f < num_faces; ++f) {
-      leaf_offsets[f + 1] = leaf_offsets[f] + static_cast<std::uint32_t>(
-                                                  refiner->GetLevel(0).GetFaceVertices(f).size());
-    }
-  }
-  auto leaf_offset = [&](int face) -> std::size_t {
-    return levels == 0 ? leaf_offsets[face] : 4 * static_cast<std::size_t>(face);
-  };
-  // Face-vertex lists of all leaves in OpenSubdiv's order (holes included, dropped below).
-  std::vector<std::int32_t> leaf_vertices(levels == 0 ? leaf_offsets.back()
-                                                      : 4 * static_cast<std::size_t>(num_faces));
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, num_base), [&](const tbb::blocked_range<int>& r) {
-      LeafWalker& walker = worker().walker;
-      for (int f = r.begin(); f != r.end(); ++f) {
-        if (!has_surface(f)) continue;
-        walker.Walk(f, [&](int face, int corners, const int* vertices, const int*, const float*) {
-          keep[face] = 1;
-          std::int32_t* dst = &leaf_vertices[leaf_offset(face)];
-          for (int m = 0; m < corners; ++m) {
-            dst[m] = vertices[m];
-            AtomicMin(owner[vertices[m]], face);
-          }
-        });
-      }
-    });
-  });
-
-  // Compaction: vertices and faces of holes go, the rest keep OpenSubdiv's order.
-  std::vector<std::int32_t> new_vertex(num_vertices, -1);
-  std::int32_t kept_vertices = 0;
-  for (int v = 0; v < num_vertices; ++v) {
-    if (owner[v] != kNoOwner) new_vertex[v] = kept_vertices++;
-  }
-  std::vector<std::int32_t> new_face;
-  std::int32_t kept_faces = 0;
-  if (options.face_charts) new_face.assign(num_faces, -1);
-  for (int f = 0; f < num_faces; ++f) {
-    if (!keep[f]) continue;
-    if (options.face_charts) new_face[f] = kept_faces;
-    ++kept_faces;
-  }
-
-  mesh.positions.resize(kept_vertices);
-  out.normals.resize(3 * static_cast<std::size_t>(kept_vertices));
-  out.ptex_faces.resize(kept_vertices);
-  out.uvs.resize(2 * static_cast<std::size_t>(kept_vertices));
-  if (options.face_charts) {
-    out.face_ptex.resize(kept_faces);
-    out.face_uvs.resize(8 * static_cast<std::size_t>(kept_faces));
-  }
-
-  // Pass 2: locate and evaluate every vertex from its owner face. A face OpenSubdiv fails
-  // on stops the work; the lowest such base face is reported, whatever the scheduling.
-  std::atomic<int> failed_face{std::numeric_limits<int>::max()};
-  std::mutex failure_mutex;
-  std::string failure;
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, num_base), [&](const tbb::blocked_range<int>& r) {
-      Worker& w = worker();
-      for (int f = r.begin(); f != r.end(); ++f) {
-        if (!has_surface(f) || f > failed_face.load(std::memory_order_relaxed)) continue;
-        bool ok = true;
-        w.walker.Walk(
-            f, [&](int face, int corners, const int* vertices, const int* ptex, const float* uv) {
-              for (int m = 0; m < corners && ok; ++m) {
-                if (owner[vertices[m]] != face) continue;
-                const std::int32_t v = new_vertex[vertices[m]];
-                if (w.sampler.Bind(ptex[m]) != subdiv::FaceSampler::BindResult::kOk) {
-                  ok = false;
-                  std::lock_guard<std::mutex> lock(failure_mutex);
-                  if (f < failed_face.load()) {
-                    failed_face = f;
-                    failure = w.sampler.error();
-                  }
-                  break;
-                }
-                float p[3];
-                w.sampler.Point(uv[2 * m], uv[2 * m + 1], p,
-                                &out.normals[3 * static_cast<std::size_t>(v)]);
-                mesh.positions[v] = Float3{p[0], p[1], p[2]};
-                out.ptex_faces[v] = PtexFaceId(ptex[m]);
-                out.uvs[2 * static_cast<std::size_t>(v)] = uv[2 * m];
-                out.uvs[2 * static_cast<std::size_t>(v) + 1] = uv[2 * m + 1];
-              }
-              if (options.face_charts) {
-                const std::size_t nf = static_cast<std::size_t>(new_face[face]);
-                out.face_ptex[nf] = PtexFaceId(ptex[0]);
-                for (int k = 0; k < 8; ++k) out.face_uvs[8 * nf + k] = uv[k];
-              }
-            });
-      }
-    });
-  });
-  if (failed_face.load() != std::numeric_limits<int>::max()) {
-    return Status::Error(
-        fmt::format("{}: OpenSubdiv could not build the limit surface of base face {}: {}",
-                    s.source, failed_face.load(), failure));
-  }
-  owner = {};
-  refiner.reset();  // the topology is all in leaf_vertices now
-  split.reset();
-
-  // Faces, in OpenSubdiv's order, compacted in place.
-  std::size_t write = 0;
-  mesh.face_offsets.reserve(static_cast<std::size_t>(kept_faces) + 1);
-  mesh.face_offsets.push_back(0);
-  for (int f = 0; f < num_faces; ++f) {
-    if (!keep[f]) continue;
-    const std::size_t begin = leaf_offset(f);
-    const std::size_t end = levels == 0 ? leaf_offsets[f + 1] : begin + 4;
-    for (std::size_t i = begin; i < end; ++i) leaf_vertices[write++] = new_vertex[leaf_vertices[i]];
-    mesh.face_offsets.push_back(static_cast<std::uint32_t>(write));
-  }
-  leaf_vertices.resize(write);
-  leaf_vertices.shrink_to_fit();
-  mesh.face_indices = std::move(leaf_vertices);
-  return out;
+StatusOr<RefinedMesh> RefineUniform(const LimitSurface& surface, int levels,
+                                    const RefineOptions& options) {
+  DISPEX_ASSIGN_OR_RETURN(const std::uint64_t expected_faces,
+                          CountRefinedFaces(surface.impl(), levels, options));
+  Refinement refinement(surface.impl(), levels, options);
+  DISPEX_RETURN_IF_ERROR(refinement.BuildTopology(expected_faces));
+  refinement.FindOwners();
+  refinement.Compact();
+  DISPEX_RETURN_IF_ERROR(refinement.EvaluateVertices());
+  refinement.WriteFaces();
+  return std::move(refinement.out);
 }
 
 }  // namespace dispex

@@ -410,7 +410,7 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   Stopwatch clock;
   const bool jittered = options.layout == SculptLayout::kJittered;
   if (!jittered && (options.levels < 1 || options.levels > 8)) {
-    return Status::Error(fmt::format("--levels {}: must be 1..8", options.levels));
+    return Status::Error(fmt::format("levels = {}: must be 1..8", options.levels));
   }
   if (jittered && (options.density < 2 || options.density > 256)) {
     return Status::Error(
@@ -423,9 +423,9 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
         fmt::format("density {}: only the jittered layout has a density", options.density));
   }
   if (!(std::isfinite(options.amplitude) && options.amplitude >= 0)) {
-    return Status::Error(fmt::format("--amplitude {}: must be >= 0", options.amplitude));
+    return Status::Error(fmt::format("amplitude = {}: must be >= 0", options.amplitude));
   }
-  if (options.output_path.empty()) return Status::Error("no output file given (-o SCULPT.obj)");
+  if (options.output_path.empty()) return Status::Error("no output file given (output_path)");
   if (options.output_path == options.cage_path) {
     return Status::Error("the output must differ from the cage");
   }

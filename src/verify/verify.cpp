@@ -173,16 +173,14 @@ void Threshold(VerifyReport& r, const char* what, const ErrorStats& s, double li
                const char* option) {
   if (!r.passed || limit <= 0 || s.max <= limit) return;
   r.passed = false;
-  r.failure = fmt::format("{} max error {:.6g} exceeds {} {:.6g}", what, s.max, option, limit);
+  r.failure = fmt::format("{} max error {:.6g} exceeds {} = {:.6g}", what, s.max, option, limit);
 }
 
 void RmsThreshold(VerifyReport& r, const char* what, const ErrorStats& s, double limit) {
   if (!r.passed || limit <= 0 || s.rms <= limit) return;
   r.passed = false;
-  r.failure = fmt::format("{} RMS error {:.6g} exceeds --max-rms {:.6g}", what, s.rms, limit);
+  r.failure = fmt::format("{} RMS error {:.6g} exceeds max_rms = {:.6g}", what, s.rms, limit);
 }
-
-}  // namespace
 
 // The map's face table for the sampler: resolutions from the map, adjacency and sub-face
 // flags from the base's limit surface (the map's own adjacency is not trusted).
@@ -291,10 +289,12 @@ void EdgeThresholds(VerifyReport& r, const VerifyOptions& options) {
   }
 }
 
+}  // namespace
+
 StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   Stopwatch clock;
   if (options.samples_per_face < 0 || options.samples_per_face > 512) {
-    return Status::Error(fmt::format("--samples {}: must be 0..512", options.samples_per_face));
+    return Status::Error(fmt::format("samples_per_face = {}: must be 0..512", options.samples_per_face));
   }
   std::optional<tbb::global_control> limit;
   if (options.threads > 0) {
@@ -430,7 +430,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     double rel = options.max_error_rel * r.diagonal;
     limit_abs = limit_abs > 0 ? std::min(limit_abs, rel) : rel;
   }
-  const char* option = options.max_error_rel > 0 ? "--max-error-rel" : "--max-error";
+  const char* option = options.max_error_rel > 0 ? "max_error_rel" : "max_error";
   if (r.measured_truth && r.truth_over_bound > 0) {
     const auto& w = r.truth_worst;
     r.passed = false;

@@ -11,6 +11,7 @@
 #include "dispex/extract.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
+#include "subdiv_ptex_faces.h"
 #include "dispex/verify.h"
 #include "e2e_support.h"
 
@@ -56,7 +57,7 @@ TEST_P(ExtractRealCages, MapMatchesTheKnownDisplacementAndTheReportAddsUp) {
   auto report = Extract(options);
   ASSERT_TRUE(report.ok()) << report.status().message();
 
-  // The file: one face per Ptex face, with OpenSubdiv's adjacency.
+  // The file: one face per Ptex face, with OpenSubdiv's adjacency (checked against the oracle).
   auto map = PtexFile::Open(options.output_path);
   ASSERT_TRUE(map.ok()) << map.status().message();
   auto faces = ComputeSubdivPtexFaces(*base);
@@ -68,6 +69,7 @@ TEST_P(ExtractRealCages, MapMatchesTheKnownDisplacementAndTheReportAddsUp) {
   for (int f = 0; f < map->num_faces(); ++f) {
     const PtexFaceInfo& info = map->face_info(PtexFaceId(f));
     EXPECT_EQ(info.adjfaces, faces->faces[f].adjfaces) << "face " << f;
+    EXPECT_EQ(info.adjedges, faces->faces[f].adjedges) << "face " << f;
     EXPECT_EQ(info.subface, faces->faces[f].subface) << "face " << f;
     texels += info.constant ? 1 : static_cast<std::int64_t>(info.num_texels());
   }
@@ -294,7 +296,7 @@ TEST_F(ExtractTest, HolesFailMakesAnyMissAnError) {
   o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 1e-5};
   auto report = Extract(o);
   ASSERT_FALSE(report.ok());
-  EXPECT_NE(report.status().message().find("--holes fail"), std::string::npos)
+  EXPECT_NE(report.status().message().find("holes = fail"), std::string::npos)
       << report.status().message();
   EXPECT_FALSE(testing::fs::exists(o.output_path));
 }

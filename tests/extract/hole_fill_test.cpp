@@ -99,7 +99,12 @@ TEST(FillEmptyFaces, FillsChainsInRoundsAndReportsIslands) {
   std::vector<EdgeMeans> means(5);
   means[0].mean[1] = 2.0f;  // face 0's right edge
   means[3].mean[3] = 4.0f;  // face 3's left edge
-  CrossFaceFill fill = FillEmptyFaces(filled, means, adj.data(), edges.data());
+  std::vector<PtexFaceInfo> faces(5);
+  for (std::size_t i = 0; i < adj.size(); ++i) {
+    faces[i / 4].adjfaces[i % 4] = adj[i];
+    faces[i / 4].adjedges[i % 4] = static_cast<std::uint8_t>(edges[i]);
+  }
+  CrossFaceFill fill = FillEmptyFaces(filled, means, faces);
   ASSERT_EQ(fill.faces.size(), 2u);
   EXPECT_EQ(fill.faces[0], 1);
   EXPECT_FLOAT_EQ(fill.values[0], 2.0f);

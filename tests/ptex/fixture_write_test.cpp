@@ -16,6 +16,7 @@
 #include "dispex/ptex.h"
 #include "ptex/zlib_block.h"
 #include "ptex_test_util.h"
+#include "subdiv_ptex_faces.h"
 
 namespace dispex {
 namespace {

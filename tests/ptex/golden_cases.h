@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "dispex/ptex.h"
+#include "subdiv_ptex_faces.h"
 
 namespace dispex::ptex_test {
 

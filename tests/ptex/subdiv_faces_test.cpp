@@ -17,6 +17,7 @@
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
 #include "ptex_test_util.h"
+#include "subdiv_ptex_faces.h"
 
 namespace dispex {
 namespace {

@@ -408,7 +408,7 @@ TEST(Atlas, TooLargeAnAtlasIsAnErrorBeforeAnyTexelIsRead) {
   auto image = RenderAtlas(*map, options);
   ASSERT_FALSE(image.ok());
   EXPECT_NE(image.status().message().find("huge.ptx"), std::string::npos);
-  EXPECT_NE(image.status().message().find("--max-tile"), std::string::npos);
+  EXPECT_NE(image.status().message().find("max_tile"), std::string::npos);
   // At the default largest tile the same map is fine.
   AtlasLayout layout;
   image = RenderAtlas(*map, AtlasOptions{}, &layout);

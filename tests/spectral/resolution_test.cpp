@@ -364,7 +364,7 @@ TEST(ResolutionTest, RejectsBadInput) {
   SpectralOptions o;
   o.tolerance = -1;
   EXPECT_EQ(analyzer.Analyze(block, 8, 8, o).status().message(),
-            "tolerance -1 must be finite and >= 0 (object units)");
+            "tolerance = -1: must be finite and >= 0 (object units)");
   // The analyzer still works after errors.
   EXPECT_TRUE(analyzer.Analyze(block, 8, 8, {}).ok());
 }

@@ -287,7 +287,7 @@ TEST_F(WrongMaps, GoodMapPassesAndShiftedScaledReversedMapsFail) {
   VerifyReport shifted =
       Check(Rewrite("shifted.ptx", same, [&](float v) { return v + 1.5f * shift; }), max_rms);
   EXPECT_FALSE(shifted.passed);
-  EXPECT_NE(shifted.failure.find("exceeds --max-error"), std::string::npos) << shifted.failure;
+  EXPECT_NE(shifted.failure.find("exceeds max_error"), std::string::npos) << shifted.failure;
   VerifyReport scaled = Check(Rewrite("scaled.ptx", same, [](float v) { return 3 * v; }), max_rms);
   EXPECT_FALSE(scaled.passed);
   VerifyReport swapped =

@@ -3,8 +3,8 @@
 // Follows OpenSubdiv 3.5: Far::PtexIndices (numbering: a quad is one Ptex face, an n-gon n
 // sub-faces) and Far::PtexIndices::GetAdjacency (docs/ptex.md, "OpenSubdiv Ptex adjacency"), with
 // edges identified as Vtr does (Vtr::Level::completeTopologyFromFaceVertices, see BuildEdges), and
-// an edge has a neighbour only when exactly two face corners use it. tests/ptex compares the result
-// with OpenSubdiv itself on every cage in tests/data/meshes.
+// an edge has a neighbour only when exactly two face corners use it. subdiv_faces_test compares
+// the result with OpenSubdiv itself on every cage in tests/data/meshes.
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "dispex/ptex.h"
+#include "subdiv_ptex_faces.h"
 
 namespace dispex {
 
@@ -189,28 +189,6 @@ StatusOr<SubdivPtexFaces> ComputeSubdivPtexFaces(const Mesh& mesh) {
     }
   }
   return out;
-}
-
-Status AddMeshMetaData(PtexWriter& writer, const Mesh& mesh) {
-  const std::size_t nfaces = mesh.num_faces();
-  std::vector<std::int32_t> counts(nfaces);
-  for (std::size_t f = 0; f < nfaces; ++f) counts[f] = mesh.face_size(f);
-  std::vector<float> positions;
-  positions.reserve(mesh.num_vertices() * 3);
-  for (const Float3& p : mesh.positions) {
-    positions.push_back(p.x);
-    positions.push_back(p.y);
-    positions.push_back(p.z);
-  }
-  if (nfaces == 0 || positions.empty()) {
-    return Status::Error((mesh.source.empty() ? std::string("mesh") : mesh.source) +
-                         ": no faces or vertices to store as Ptex mesh meta data");
-  }
-  DISPEX_RETURN_IF_ERROR(
-      writer.AddMetaData("PtexFaceVertCounts", std::span<const std::int32_t>(counts)));
-  DISPEX_RETURN_IF_ERROR(
-      writer.AddMetaData("PtexFaceVertIndices", std::span<const std::int32_t>(mesh.face_indices)));
-  return writer.AddMetaData("PtexVertPositions", std::span<const float>(positions));
 }
 
 }  // namespace dispex

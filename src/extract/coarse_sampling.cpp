@@ -1,0 +1,62 @@
+#include "extract/coarse_sampling.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <span>
+
+#include "extract/parallel_errors.h"
+
+namespace dispex {
+
+StatusOr<CoarseSampling> SampleCoarsely(const LimitSurface& surface) {
+  const int n = surface.num_ptex_faces();
+  constexpr int kGrid = 4;
+  CoarseSampling out;
+  out.face_areas.assign(static_cast<std::size_t>(n), 0.0);
+  std::vector<float> pos(static_cast<std::size_t>(n) * kGrid * kGrid * 3, 0.0f);
+  std::vector<float> nrm(pos.size(), 0.0f);
+  std::vector<std::uint8_t> ok(static_cast<std::size_t>(n), 0);
+  tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
+  FirstError error;
+  tbb::parallel_for(0, n, [&](int f) {
+    PtexFaceId face(f);
+    if (surface.is_hole(face) || error.failed()) return;
+    auto& evaluator = evaluators.local();
+    if (!evaluator) evaluator.emplace(surface);
+    std::span<float> p(pos.data() + static_cast<std::size_t>(f) * kGrid * kGrid * 3, kGrid * kGrid * 3);
+    std::span<float> q(nrm.data() + static_cast<std::size_t>(f) * kGrid * kGrid * 3, kGrid * kGrid * 3);
+    Status s = evaluator->EvaluateGrid(face, kGrid, kGrid, p, q);
+    if (!s.ok()) return error.Record(f, s);
+    // The 3x3 cells between sample centres cover (3/4)^2 of the face's parameter square.
+    double area = 0;
+    for (int j = 0; j + 1 < kGrid; ++j) {
+      for (int i = 0; i + 1 < kGrid; ++i) {
+        auto at = [&](int ii, int jj, int c) { return double(p[3 * (jj * kGrid + ii) + c]); };
+        double ax = at(i + 1, j + 1, 0) - at(i, j, 0), ay = at(i + 1, j + 1, 1) - at(i, j, 1),
+               az = at(i + 1, j + 1, 2) - at(i, j, 2);
+        double bx = at(i, j + 1, 0) - at(i + 1, j, 0), by = at(i, j + 1, 1) - at(i + 1, j, 1),
+               bz = at(i, j + 1, 2) - at(i + 1, j, 2);
+        double cx = ay * bz - az * by, cy = az * bx - ax * bz, cz = ax * by - ay * bx;
+        area += 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
+      }
+    }
+    out.face_areas[static_cast<std::size_t>(f)] = area / (0.75 * 0.75);
+    ok[static_cast<std::size_t>(f)] = 1;
+  });
+  if (error.failed()) return error.status();
+  // At most ~64K points for the search-distance estimate, spread over all faces.
+  std::size_t total = static_cast<std::size_t>(n) * kGrid * kGrid;
+  std::size_t stride = std::max<std::size_t>(1, total / 65536);
+  for (std::size_t i = 0; i < total; i += stride) {
+    if (!ok[i / (kGrid * kGrid)]) continue;
+    out.points.push_back({pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]});
+    out.normals.push_back({nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]});
+  }
+  return out;
+}
+
+}  // namespace dispex

@@ -1,0 +1,115 @@
+#include "extract/extract_inputs.h"
+
+#include <fmt/format.h>
+#include <tbb/task_group.h>
+
+#include <algorithm>
+#include <optional>
+
+#include "core/cancel.h"
+#include "core/content_hash.h"
+#include "core/system.h"
+#include "extract/parallel_errors.h"
+#include "extract/ptex_face_table.h"
+
+namespace dispex {
+
+namespace {
+
+struct MeshesRead {
+  Mesh base;
+  Mesh sculpt;
+  LimitSurface surface;
+};
+
+// The sculpt is read while the base's topology is built.
+StatusOr<MeshesRead> ReadMeshes(const ExtractOptions& options, ExtractReport& report) {
+  ReadOptions read_options;
+  read_options.threads = options.threads;
+  std::optional<StatusOr<Mesh>> sculpt_read;
+  StatusOr<std::string> sculpt_fingerprint = Status::Error("not computed");
+  std::optional<StatusOr<Mesh>> base_read;
+  std::optional<StatusOr<LimitSurface>> surface_built;
+  {
+    tbb::task_group group;
+    group.run([&] {
+      Stopwatch clock;
+      sculpt_read.emplace(ReadMesh(options.sculpt_path, read_options));
+      report.t_read_sculpt = clock.seconds();
+      if (sculpt_read->ok()) sculpt_fingerprint = FileFingerprint(options.sculpt_path);
+    });
+    Stopwatch clock;
+    base_read.emplace(ReadMesh(options.base_path, read_options));
+    report.t_read_base = clock.seconds();
+    if (base_read->ok()) {
+      clock.Reset();
+      surface_built.emplace(LimitSurface::Build(base_read->value()));
+      report.t_topology = clock.seconds();
+    }
+    group.wait();
+  }
+  if (!base_read->ok()) return base_read->status();
+  if (!surface_built->ok()) return surface_built->status();
+  if (!sculpt_read->ok()) return sculpt_read->status();
+  if (CancelRequested()) return Cancelled();
+  DISPEX_ASSIGN_OR_RETURN(report.base_fingerprint, FileFingerprint(options.base_path));
+  DISPEX_ASSIGN_OR_RETURN(report.sculpt_fingerprint, std::move(sculpt_fingerprint));
+  return MeshesRead{std::move(*base_read).value(), std::move(*sculpt_read).value(),
+                    std::move(*surface_built).value()};
+}
+
+void ReportMeshes(const ExtractOptions& options, const MeshesRead& meshes, ExtractReport& report) {
+  const LimitSurfaceStats surface_stats = meshes.surface.stats();
+  report.base_vertices = meshes.base.num_vertices();
+  report.base_faces = meshes.base.num_faces();
+  report.ptex_faces = static_cast<std::size_t>(meshes.surface.num_ptex_faces());
+  report.hole_faces = static_cast<std::size_t>(surface_stats.hole_ptex_faces);
+  report.inf_sharp_edges = surface_stats.inf_sharp_edges;
+  report.sculpt_vertices = meshes.sculpt.num_vertices();
+  report.sculpt_faces = meshes.sculpt.num_faces();
+  for (std::string& w : IgnoredTagWarnings(meshes.base)) report.warnings.push_back(std::move(w));
+  if (surface_stats.inf_sharp_edges > 0) {
+    report.warnings.push_back(fmt::format(
+        "{}: {} infinitely sharp edges: the limit normal has two values there, so the map "
+        "opens a gap or an overlap along them", options.base_path, surface_stats.inf_sharp_edges));
+  }
+  report.base_diagonal = ComputeBounds(meshes.base).diagonal();
+}
+
+Status CheckMemoryForInputs(const ExtractOptions& options, const MeshesRead& meshes,
+                            std::uint64_t memory_limit) {
+  // Texels the output can hold at most: every face at the largest oversampling.
+  const std::uint64_t max_texels = static_cast<std::uint64_t>(meshes.surface.num_ptex_faces()) *
+                                   static_cast<std::uint64_t>(options.max_oversample) *
+                                   static_cast<std::uint64_t>(options.max_oversample);
+  const Mesh& sculpt = meshes.sculpt;
+  return CheckMemoryForSculpt(sculpt.num_vertices(), sculpt.num_faces(),
+                              sculpt.face_indices.size(),
+                              std::min<std::uint64_t>(max_texels, 1ull << 31), memory_limit);
+}
+
+}  // namespace
+
+StatusOr<ExtractInputs> LoadInputs(const ExtractOptions& options, std::uint64_t memory_limit,
+                                   ExtractReport& report) {
+  DISPEX_RETURN_IF_ERROR(CheckMemoryBeforeReading(options, memory_limit));
+  DISPEX_ASSIGN_OR_RETURN(MeshesRead meshes, ReadMeshes(options, report));
+  ReportMeshes(options, meshes, report);
+  DISPEX_RETURN_IF_ERROR(CheckMemoryForInputs(options, meshes, memory_limit));
+
+  Stopwatch clock;
+  TracerOptions tracer_options;
+  tracer_options.quality = options.bvh_quality;
+  tracer_options.isa = options.embree_isa;
+  DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer,
+                          MakeEmbreeTracer(meshes.sculpt, tracer_options));
+  report.t_bvh = clock.seconds();
+  report.tracer = tracer->stats().backend;
+  if (CancelRequested()) return Cancelled();
+
+  std::vector<PtexFaceInfo> faces = PtexFaceTable(meshes.surface);
+  return ExtractInputs{std::move(meshes.base), std::move(meshes.sculpt),
+                       std::move(meshes.surface), std::move(faces), std::move(tracer)};
+}
+
+}  // namespace dispex

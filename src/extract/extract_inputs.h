@@ -1,0 +1,32 @@
+// The first stage of an extraction: everything read or built from the input files before
+// any setting is resolved.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "dispex/extract.h"
+#include "dispex/mesh.h"
+#include "dispex/ptex.h"
+#include "dispex/subdiv.h"
+#include "dispex/trace.h"
+
+namespace dispex {
+
+struct ExtractInputs {
+  Mesh base;
+  Mesh sculpt;
+  LimitSurface surface;                 // of the base
+  std::vector<PtexFaceInfo> faces;      // the map's face table, from `surface`
+  std::unique_ptr<Tracer> tracer;       // the sculpt's BVH; reads the sculpt's arrays
+};
+
+// Reads the sculpt while the base is read and its limit surface built, fingerprints both
+// files, checks the estimated memory against `memory_limit` (bytes; 0: no check) before
+// reading and again once the sculpt's size is known, and builds the BVH. Fills the report's
+// input counts, fingerprints, timings and warnings.
+StatusOr<ExtractInputs> LoadInputs(const ExtractOptions& options, std::uint64_t memory_limit,
+                                   ExtractReport& report);
+
+}  // namespace dispex

@@ -1,0 +1,90 @@
+#include "extract/extract_settings.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "core/system.h"
+#include "extract/coarse_sampling.h"
+
+namespace dispex {
+
+namespace {
+
+// The longer search for samples that missed: this many times the automatic search distance.
+constexpr double kRetryFactor = 4.0;
+
+Status ResolveTolerance(const ExtractOptions& options, const Mesh& sculpt, ExtractReport& report) {
+  report.sculpt_median_edge = MedianEdgeLength(sculpt);
+  report.tolerance_auto = options.tolerance <= 0;
+  report.tolerance = report.tolerance_auto
+                         ? options.tolerance_fraction * report.sculpt_median_edge
+                         : options.tolerance;
+  if (!(report.tolerance > 0)) {
+    return Status::Error(fmt::format("{}: cannot derive a tolerance (median edge length {}); "
+                                     "set tolerance", options.sculpt_path,
+                                     report.sculpt_median_edge));
+  }
+  return Status::Ok();
+}
+
+Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs& inputs,
+                              const CoarseSampling& coarse, ExtractReport& report) {
+  report.search_distance_auto = options.search_distance.kind == SearchDistanceSpec::Kind::kAuto;
+  if (report.search_distance_auto) {
+    auto estimate = EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals,
+                                           report.base_diagonal);
+    if (!estimate.ok()) {
+      return Status::Error(fmt::format("{} and {} do not overlap: {}", options.base_path,
+                                       options.sculpt_path, estimate.status().message()));
+    }
+    report.search_estimate = *estimate;
+    report.search_distance = estimate->distance;
+  } else {
+    DISPEX_ASSIGN_OR_RETURN(report.search_distance,
+                            ResolveSearchDistance(options.search_distance, report.base_diagonal));
+  }
+  // With an automatic search distance, samples that missed get a second, longer search: the
+  // sparse estimate can miss thin or strongly curved parts where the sculpt is farther from
+  // the limit surface than almost everywhere else.
+  report.retry_search_distance =
+      report.search_distance_auto
+          ? std::max(report.search_distance,
+                     std::min(kRetryFactor * report.search_distance,
+                              report.search_estimate.ray_length))
+          : 0.0;
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
+                                          const ExtractInputs& inputs, ExtractReport& report) {
+  Stopwatch clock;
+  DISPEX_RETURN_IF_ERROR(ResolveTolerance(options, inputs.sculpt, report));
+  ExtractSettings settings;
+  {
+    DISPEX_ASSIGN_OR_RETURN(CoarseSampling coarse, SampleCoarsely(inputs.surface));
+    DISPEX_RETURN_IF_ERROR(ResolveSearchDistances(options, inputs, coarse, report));
+    settings.plan = PlanOversampling(inputs.surface, inputs.sculpt, coarse.face_areas,
+                                     options.oversample, options.min_oversample,
+                                     options.max_oversample);
+  }
+  report.oversample_subdivision_level = settings.plan.subdivision_level;
+  report.t_search = clock.seconds();
+
+  settings.search_distance = report.search_distance;
+  settings.query.distance = static_cast<float>(report.search_distance);
+  settings.query.policy = options.ray_policy;
+  settings.retry_query = settings.query;
+  settings.retry_query.distance = static_cast<float>(report.retry_search_distance);
+  settings.spectral.rule = options.resolution_rule;
+  settings.spectral.tolerance = report.tolerance;
+  settings.spectral.nonzero_threshold = options.nonzero_threshold;
+  settings.spectral.fixed_ulog2 = options.fixed_ulog2;
+  settings.spectral.fixed_vlog2 = options.fixed_vlog2;
+  settings.holes = options.holes;
+  return settings;
+}
+
+}  // namespace dispex

@@ -1,0 +1,30 @@
+// The second stage of an extraction: the automatic settings resolved from the inputs, and
+// what every face is asked for.
+#pragma once
+
+#include "dispex/extract.h"
+#include "dispex/spectral.h"
+#include "dispex/trace.h"
+#include "extract/extract_inputs.h"
+#include "extract/oversampling.h"
+
+namespace dispex {
+
+struct ExtractSettings {
+  OversamplingPlan plan;  // samples per side of each Ptex face
+  double search_distance = 0;  // as resolved; `query` holds it as a float
+  NormalQuery query;           // the rays along +-n
+  // The longer second search for samples that missed; its distance is 0 when there is none
+  // (the search distance was given).
+  NormalQuery retry_query;
+  SpectralOptions spectral;  // resolution rule and the resolved tolerance
+  HolePolicy holes = HolePolicy::kFill;
+};
+
+// Tolerance (from the sculpt's median edge length unless given), search distance (estimated
+// from a coarse sampling of the limit surface unless given) and its retry, oversampling per
+// face. Records them, and the time taken, in the report.
+StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
+                                          const ExtractInputs& inputs, ExtractReport& report);
+
+}  // namespace dispex

@@ -1,0 +1,122 @@
+#include "extract/face_pipeline.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <span>
+
+#include "core/system.h"
+
+namespace dispex {
+
+namespace {
+
+std::span<const Float3> AsFloat3(const std::vector<float>& v, std::size_t n) {
+  return {reinterpret_cast<const Float3*>(v.data()), n};
+}
+
+// Rays along +-n from every sample; with a retry distance, the samples that missed are
+// searched again that far. Returns how many the second search found.
+std::int32_t TraceSamples(const Tracer& tracer, const ExtractSettings& settings, std::size_t count,
+                          FaceScratch& w) {
+  tracer.TraceNormals(AsFloat3(w.positions, count), AsFloat3(w.normals, count), settings.query,
+                      NormalHits{w.t, {}, w.flags}, w.counters);
+  if (!(settings.retry_query.distance > 0)) return 0;
+  w.retry_origins.clear();
+  w.retry_normals.clear();
+  w.retry_index.clear();
+  for (std::size_t i = 0; i < count; ++i) {
+    if (w.flags[i] & HitFlags::kHit) continue;
+    w.retry_index.push_back(static_cast<std::int32_t>(i));
+    w.retry_origins.push_back(AsFloat3(w.positions, count)[i]);
+    w.retry_normals.push_back(AsFloat3(w.normals, count)[i]);
+  }
+  if (w.retry_index.empty()) return 0;
+  const std::size_t m = w.retry_index.size();
+  w.retry_t.resize(m);
+  w.retry_flags.resize(m);
+  tracer.TraceNormals(w.retry_origins, w.retry_normals, settings.retry_query,
+                      NormalHits{w.retry_t, {}, w.retry_flags}, w.counters);
+  std::int32_t recovered = 0;
+  for (std::size_t k = 0; k < m; ++k) {
+    if (!(w.retry_flags[k] & HitFlags::kHit)) continue;
+    const auto i = static_cast<std::size_t>(w.retry_index[k]);
+    w.t[i] = w.retry_t[k];
+    w.flags[i] = w.retry_flags[k];
+    ++recovered;
+  }
+  return recovered;
+}
+
+// Signed distances from the hits (0 where a ray missed), and the hit counts.
+void TakeDistances(std::size_t count, FaceScratch& w, FaceStats& stats) {
+  stats.samples = static_cast<std::int64_t>(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::uint8_t fl = w.flags[i];
+    const bool hit = fl & HitFlags::kHit;
+    w.valid[i] = hit;
+    w.values[i] = hit ? w.t[i] : 0.0f;
+    stats.misses += !hit;
+    stats.hits_negative += hit && (fl & HitFlags::kNegative);
+    // The sculpt faces the limit normal's way where it is met from behind along +n or from
+    // the front along -n; the other way round it faces against it: a fold or another sheet.
+    const bool negative = fl & HitFlags::kNegative, back = fl & HitFlags::kBackFace;
+    stats.hits_opposed += hit && (negative == back);
+  }
+}
+
+}  // namespace
+
+StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
+                                 const ExtractSettings& settings, FaceScratch& w) {
+  FaceResult result;
+  if (inputs.surface.is_hole(face)) return result;
+  FaceStats& r = result.stats;
+  const int n = 1 << settings.plan.log2[static_cast<std::size_t>(face.value)];
+  const std::size_t count = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+  w.positions.resize(3 * count);
+  w.normals.resize(3 * count);
+  w.t.resize(count);
+  w.flags.resize(count);
+  w.values.resize(count);
+  w.valid.resize(count);
+
+  ThreadCpuStopwatch step;
+  DISPEX_RETURN_IF_ERROR(w.evaluator.EvaluateGrid(face, n, n, w.positions, w.normals));
+  w.cpu_limit += step.seconds();
+  step.Reset();
+  r.recovered = TraceSamples(*inputs.tracer, settings, count, w);
+  w.cpu_trace += step.seconds();
+  TakeDistances(count, w, r);
+
+  if (r.misses > 0) {
+    if (settings.holes == HolePolicy::kFail) {
+      return Status::Error(fmt::format(
+          "Ptex face {}: {} of {} rays missed the sculpt within the search distance {:.6g} "
+          "(holes = fail)", face.value, r.misses, count, settings.search_distance));
+    }
+    if (r.misses == static_cast<std::int32_t>(count) && settings.holes == HolePolicy::kFill) {
+      r.all_missed = true;
+      result.kind = FaceResult::Kind::kAllMissed;
+      return result;
+    }
+    if (settings.holes == HolePolicy::kFill) {
+      r.filled = FillHolesPullPush(w.values.data(), w.valid.data(), n, n, w.pull_push);
+    }
+  }
+  r.min = *std::min_element(w.values.begin(), w.values.end());
+  r.max = *std::max_element(w.values.begin(), w.values.end());
+  for (float v : w.values) r.sum_squares += double(v) * double(v);
+  result.edge_means = ComputeEdgeMeans(w.values.data(), n, n);
+
+  step.Reset();
+  DISPEX_ASSIGN_OR_RETURN(result.analysed, w.analyzer.Analyze(w.values, n, n, settings.spectral));
+  w.cpu_spectral += step.seconds();
+  r.spectral = result.analysed.stats;
+  r.ulog2 = static_cast<std::int8_t>(result.analysed.ulog2);
+  r.vlog2 = static_cast<std::int8_t>(result.analysed.vlog2);
+  result.kind = FaceResult::Kind::kAnalysed;
+  return result;
+}
+
+}  // namespace dispex

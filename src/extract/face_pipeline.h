@@ -1,0 +1,66 @@
+// One Ptex face through the pipeline: limit points and normals on its grid of texel centres
+// -> rays along +-n (and a longer second search for the samples that missed) -> signed
+// distances -> holes -> the DCT resolution. ProcessFace can be run for any face, any number of
+// times, on any thread that has its own FaceScratch; it does not write the map.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "dispex/spectral.h"
+#include "dispex/subdiv.h"
+#include "dispex/trace.h"
+#include "extract/extract_inputs.h"
+#include "extract/extract_settings.h"
+#include "extract/hole_fill.h"
+
+namespace dispex {
+
+// What a face contributes to the report, kept for every face until the totals.
+struct FaceStats {
+  std::int64_t samples = 0;
+  std::int32_t misses = 0;
+  std::int32_t recovered = 0;  // misses found by the longer search
+  std::int32_t filled = 0;     // misses filled within the face
+  std::int32_t hits_negative = 0;
+  std::int32_t hits_opposed = 0;
+  bool all_missed = false;  // no value at all: filled from the neighbours later
+  float min = 0, max = 0;
+  double sum_squares = 0;
+  SpectralFaceStats spectral;
+  std::int8_t ulog2 = 0, vlog2 = 0;
+};
+
+struct FaceResult {
+  enum class Kind : std::uint8_t {
+    kHole,       // no limit surface: written as constant 0
+    kAllMissed,  // every ray missed under HolePolicy::kFill: nothing to write yet
+    kAnalysed,   // `analysed` holds the face to write
+  };
+  Kind kind = Kind::kHole;
+  FaceStats stats;
+  EdgeMeans edge_means;   // what a neighbour that missed entirely is filled from
+  SpectralFace analysed;  // its texels live in the scratch until its next ProcessFace
+};
+
+// Per-thread buffers and evaluators, reused across faces, and the thread's counters.
+struct FaceScratch {
+  explicit FaceScratch(const LimitSurface& surface) : evaluator(surface) {}
+  LimitEvaluator evaluator;
+  SpectralAnalyzer analyzer;
+  std::vector<float> positions, normals, t, values;
+  std::vector<std::uint8_t> flags, valid;
+  std::vector<Float3> retry_origins, retry_normals;  // missed samples, for the longer search
+  std::vector<float> retry_t;
+  std::vector<std::uint8_t> retry_flags;
+  std::vector<std::int32_t> retry_index;
+  PullPushScratch pull_push;
+  TraceCounters counters;
+  double cpu_limit = 0, cpu_trace = 0, cpu_spectral = 0, cpu_write = 0;  // this thread's seconds
+};
+
+// Fails on an evaluation or analysis error, or on a miss under HolePolicy::kFail.
+StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
+                                 const ExtractSettings& settings, FaceScratch& scratch);
+
+}  // namespace dispex

@@ -1,0 +1,78 @@
+#include "extract/face_totals.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace dispex {
+
+namespace {
+
+void SumFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
+              const ProcessedFaces& faces, ExtractReport& report) {
+  double sum_squares = 0;
+  bool first = true;
+  for (int f = 0; f < inputs.surface.num_ptex_faces(); ++f) {
+    const FaceStats& r = faces.stats[static_cast<std::size_t>(f)];
+    if (inputs.surface.is_hole(PtexFaceId(f))) continue;
+    report.oversample_faces[settings.plan.log2[static_cast<std::size_t>(f)]]++;
+    report.samples += r.samples;
+    report.misses += r.misses;
+    report.misses_recovered += r.recovered;
+    report.holes_filled += r.filled;
+    report.faces_with_misses += r.misses > 0;
+    report.hits_negative += r.hits_negative;
+    report.hits_positive += r.samples - r.misses - r.hits_negative;
+    report.hits_opposed += r.hits_opposed;
+    if (r.all_missed) {
+      SpectralFaceStats constant;
+      constant.texels_before = r.samples;
+      constant.texels_after = 1;
+      constant.constant = true;
+      report.spectral.Add(constant, 0, 0);
+    } else {
+      report.spectral.Add(r.spectral, r.ulog2, r.vlog2);
+    }
+    sum_squares += r.sum_squares;
+    report.displacement_min = first ? r.min : std::min<double>(report.displacement_min, r.min);
+    report.displacement_max = first ? r.max : std::max<double>(report.displacement_max, r.max);
+    first = false;
+  }
+  report.displacement_rms = report.samples ? std::sqrt(sum_squares / double(report.samples)) : 0;
+  report.miss_fraction = report.samples ? double(report.misses) / double(report.samples) : 0;
+}
+
+Status CheckMissFraction(const ExtractOptions& options, const ExtractReport& report) {
+  if (!(report.miss_fraction > options.max_miss_fraction)) return Status::Ok();
+  return Status::Error(fmt::format(
+      "{:.1f}% of the samples ({} of {}) found no surface of {} within the search distance "
+      "{:.6g}{}, more than the limit of {:.4g}%: the sculpt covers only part of {} or is not "
+      "aligned with it; align the meshes, give a longer search distance, or raise the limit "
+      "of missed samples",
+      100 * report.miss_fraction, report.misses, report.samples, options.sculpt_path,
+      report.search_distance,
+      report.retry_search_distance > report.search_distance
+          ? fmt::format(" (and {:.6g} on the second search)", report.retry_search_distance)
+          : "",
+      100 * options.max_miss_fraction, options.base_path));
+}
+
+}  // namespace
+
+Status AddFaceTotals(const ExtractOptions& options, const ExtractInputs& inputs,
+                     const ExtractSettings& settings, const ProcessedFaces& faces,
+                     ExtractReport& report) {
+  SumFaces(inputs, settings, faces, report);
+  DISPEX_RETURN_IF_ERROR(CheckMissFraction(options, report));
+  const WorkerTotals& w = faces.workers;
+  report.rays_cast += w.rays_cast;
+  report.cpu_limit += w.cpu_limit;
+  report.cpu_trace += w.cpu_trace;
+  report.cpu_spectral += w.cpu_spectral;
+  report.cpu_compress += w.cpu_write;
+  report.fallback_normals += w.fallback_normals;
+  return inputs.tracer->status();
+}
+
+}  // namespace dispex
