@@ -42,6 +42,7 @@ struct ExtractArgs {
   std::string fixed_resolution = "64x64";
   std::string data_type = "float";
   std::string holes = "fill";
+  std::string watertight = "filter";
   std::string bvh_quality = "low";
   std::string report_path;
   std::string preview_dir;
@@ -117,6 +118,9 @@ Status Resolve(ExtractArgs& a) {
   auto holes = ParseHolePolicy(a.holes);
   if (!holes.ok()) return holes.status().WithPrefix("--holes");
   o.holes = *holes;
+  auto watertight = ParseWatertightEdges(a.watertight);
+  if (!watertight.ok()) return watertight.status().WithPrefix("--watertight");
+  o.watertight = *watertight;
   auto quality = ParseBuildQuality(a.bvh_quality);
   if (!quality.ok()) return quality.status().WithPrefix("--bvh-quality");
   o.bvh_quality = *quality;
@@ -212,6 +216,10 @@ void SetupExtract(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--holes", args->holes,
                   "samples whose rays miss: fill (interpolate), fail (error), zero")
+      ->capture_default_str();
+  cmd->add_option("--watertight", args->watertight,
+                  "shared face edges meet within the tolerance for: filter (the Ptex library's "
+                  "filters), all (also readers that read each face on its own), off")
       ->capture_default_str();
   cmd->add_option("--max-miss-fraction", o.max_miss_fraction,
                   "fail when more than this fraction of the samples miss the sculpt after the "

@@ -29,6 +29,23 @@ enum class HolePolicy : std::uint8_t {
 std::string_view HolePolicyName(HolePolicy policy);  // "fill", "fail", "zero"
 StatusOr<HolePolicy> ParseHolePolicy(std::string_view name);
 
+// Which readers the map is made watertight for: where two Ptex faces meet, the values a
+// renderer reads on either side differ by at most the tolerance (docs/ACCURACY.md,
+// "Watertight edges"), except at edges where the displacement itself jumps.
+enum class WatertightEdges : std::uint8_t {
+  // The reference Ptex filter across faces (what renderers built on the Ptex library read):
+  // resolutions raised where neighbours of different resolution would step. Costs a few
+  // percent of texels (docs/BENCHMARKS.md).
+  kFilter,
+  // Also per-face bilinear reading (readers that do not filter across faces): edge texels
+  // pinned to the edge and resolutions raised until faces read on their own meet. Costs
+  // several times the texels on sculpts detailed at their own resolution.
+  kAll,
+  kOff,  // neither: each face within the tolerance of its own samples only
+};
+std::string_view WatertightEdgesName(WatertightEdges mode);  // "all", "filter", "off"
+StatusOr<WatertightEdges> ParseWatertightEdges(std::string_view name);
+
 struct ExtractOptions {
   std::string base_path;
   std::string sculpt_path;
@@ -53,6 +70,9 @@ struct ExtractOptions {
   double nonzero_threshold = 0;  // for ResolutionRule::kNonzero
   int fixed_ulog2 = 6;           // for ResolutionRule::kFixed
   int fixed_vlog2 = 6;
+  // With ResolutionRule::kErrorBound (the other rules fix the resolution): raise resolutions
+  // until shared edges meet within the tolerance under the readers named.
+  WatertightEdges watertight = WatertightEdges::kFilter;
 
   PtexDataType data_type = PtexDataType::kFloat;  // kFloat or kHalf
   int compression_level = -1;                     // -1: the writer's default
@@ -130,6 +150,21 @@ struct ExtractReport {
 
   // Spectral step.
   SpectralTotals spectral;
+  // Watertight edges (kOff when the option is off or the rule is not kErrorBound). Steps are
+  // the largest over every texel breakpoint of every shared edge (MeasurePtexEdgeSteps) once
+  // the map is final, in object units.
+  WatertightEdges watertight = WatertightEdges::kOff;
+  std::int64_t edge_rounds = 0;        // rounds of raising resolutions
+  std::int64_t edge_raised_faces = 0;  // faces whose resolution the edges raised
+  std::int64_t texels_before_edges = 0;  // texels written had no edge been raised
+  std::int64_t edges_shared = 0;         // between two faces with a surface
+  std::int64_t edges_sharp = 0;          // on infinitely sharp creases: not held
+  // Edges next to faces filled from their neighbours (missed entirely): not held.
+  std::int64_t edges_filled = 0;
+  // Held edges still over the tolerance: the samples are too coarse, or the displacement jumps
+  // there (another sheet, a filled hole), so raising the resolution did not bring them down.
+  std::int64_t edges_over = 0;
+  double edge_step_per_face = 0, edge_step_across_faces = 0;  // largest over held edges
   double displacement_min = 0, displacement_max = 0, displacement_rms = 0;
 
   // Output.

@@ -73,12 +73,12 @@ bool PtexAcrossEdge(std::span<const PtexFaceInfo> faces, PtexFaceId face, int ed
 
 // ---- Steps where faces meet ------------------------------------------------------------------
 
-// The largest step of one edge: from `face`'s edge `edge` at parameter t, to `neighbour`.
+// The largest steps on one edge, from `face`'s edge `edge` to `neighbour`, under each reader,
+// and where along the face's edge (t) they are.
 struct PtexEdgeStep {
   int face = -1, edge = 0, neighbour = -1;
-  double t = 0;
-  double step = 0;
-  bool across_faces = false;  // the cross-face reader's step (else the per-face reader's)
+  double per_face = 0, across_faces = 0;
+  double t_per_face = 0, t_across_faces = 0;
 };
 
 // Steps on every edge between two faces, at t = j / n (j = 0..n) along it, n = max(16, 2 x

@@ -68,6 +68,11 @@ struct SpectralOptions {
   // meet within twice this (0: off). Where even the samples cannot meet it the face stays at
   // the sample resolution (SpectralFaceStats::edge_limited).
   double edge_tolerance = 0.0;
+  // kErrorBound with verify: the outermost texels hold the displacement on the face's edges
+  // (extrapolated from the two outermost sample rows) instead of at their centres, so that
+  // neighbours meet on the edge itself under any reader; the read-back check then measures
+  // the cost inside the face.
+  bool pin_edges = false;
   // kErrorBound: the least resolution (log2 per side, capped at the sample grid's), e.g. for
   // a face whose neighbours need it to meet without a step. Faces with a floor are never
   // made constant.

@@ -1,6 +1,6 @@
 // Extract, read top-down: load the inputs -> resolve the automatic settings -> process every
-// Ptex face -> fill the faces that missed entirely -> add up the totals -> write the map. Each
-// stage is in its own file of src/extract.
+// Ptex face -> fill the faces that missed entirely -> make shared edges meet (watertight) ->
+// add up the totals -> write the map. Each stage is in its own file of src/extract.
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
@@ -14,6 +14,7 @@
 #include "dispex/version.h"
 #include "extract/extract_inputs.h"
 #include "extract/extract_meta.h"
+#include "extract/edge_matching.h"
 #include "extract/extract_settings.h"
 #include "extract/face_totals.h"
 #include "extract/missed_faces.h"
@@ -69,6 +70,10 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
   DISPEX_ASSIGN_OR_RETURN(ProcessedFaces faces,
                           ProcessFaces(inputs, settings, options.progress, writer));
   DISPEX_RETURN_IF_ERROR(FillMissedFaces(options, inputs, faces, writer, report));
+  if (settings.watertight != WatertightEdges::kOff) {
+    DISPEX_RETURN_IF_ERROR(MatchEdges(inputs, settings, faces, report));
+    DISPEX_RETURN_IF_ERROR(WriteKeptFaces(writer, inputs, faces));
+  }
   report.t_sample_trace = faces_clock.seconds();
 
   DISPEX_RETURN_IF_ERROR(AddFaceTotals(options, inputs, settings, faces, report));

@@ -39,6 +39,7 @@ nlohmann::json ExtractOptionsJson(const ExtractOptions& o) {
   j["holes"] = std::string(HolePolicyName(o.holes));
   j["max_miss_fraction"] = o.max_miss_fraction;
   j["bvh_quality"] = std::string(ToString(o.bvh_quality));
+  j["watertight"] = std::string(WatertightEdgesName(o.watertight));
   return j;
 }
 
@@ -94,6 +95,18 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
                    {"faces_by_resolution", resolutions}};
   j["displacement"] = {{"min", r.displacement_min}, {"max", r.displacement_max},
                        {"rms", r.displacement_rms}};
+  j["edges"] = {{"watertight", std::string(WatertightEdgesName(r.watertight))},
+                {"rounds", r.edge_rounds},
+                {"raised_faces", r.edge_raised_faces},
+                {"texels_before", r.texels_before_edges},
+                {"shared", r.edges_shared},
+                {"sharp", r.edges_sharp},
+                {"filled", r.edges_filled},
+                {"over", r.edges_over},
+                {"step_per_face", r.edge_step_per_face},
+                {"step_across_faces", r.edge_step_across_faces},
+                {"max_edge_error", s.max_edge_error},
+                {"edge_limited_faces", s.edge_limited_faces}};
   return j;
 }
 

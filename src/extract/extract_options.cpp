@@ -23,6 +23,23 @@ StatusOr<HolePolicy> ParseHolePolicy(std::string_view name) {
   return Status::Error(fmt::format("unknown hole policy '{}' (expected fill, fail or zero)", name));
 }
 
+std::string_view WatertightEdgesName(WatertightEdges mode) {
+  switch (mode) {
+    case WatertightEdges::kAll: return "all";
+    case WatertightEdges::kFilter: return "filter";
+    case WatertightEdges::kOff: return "off";
+  }
+  return "all";
+}
+
+StatusOr<WatertightEdges> ParseWatertightEdges(std::string_view name) {
+  for (WatertightEdges m : {WatertightEdges::kAll, WatertightEdges::kFilter, WatertightEdges::kOff}) {
+    if (name == WatertightEdgesName(m)) return m;
+  }
+  return Status::Error(
+      fmt::format("unknown watertight mode '{}' (expected all, filter or off)", name));
+}
+
 namespace {
 bool IsPowerOfTwoIn(int v, int lo, int hi) {
   return v >= lo && v <= hi && std::has_single_bit(static_cast<unsigned>(v));

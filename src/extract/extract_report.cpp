@@ -65,6 +65,21 @@ std::string ExtractReportSummary(const ExtractReport& r) {
                      s.texels_before, s.texels_after,
                      s.texels_before ? 100.0 * double(s.texels_after) / double(s.texels_before) : 0,
                      s.constant_faces, s.max_measured_error);
+  if (r.watertight != WatertightEdges::kOff) {
+    out += fmt::format(
+        "  edges ({}): {} shared, largest step {:.3g} across faces, {:.3g} per face ({:.2g} / "
+        "{:.2g} tolerances); {} faces raised in {} rounds, texels {} -> {}",
+        WatertightEdgesName(r.watertight), r.edges_shared, r.edge_step_across_faces,
+        r.edge_step_per_face, r.edge_step_across_faces / r.tolerance,
+        r.edge_step_per_face / r.tolerance, r.edge_raised_faces, r.edge_rounds,
+        r.texels_before_edges, s.texels_after);
+    if (r.edges_over + r.edges_sharp + r.edges_filled > 0) {
+      out += fmt::format("; not held: {} over the tolerance, {} on sharp creases, {} beside "
+                         "filled faces",
+                         r.edges_over, r.edges_sharp, r.edges_filled);
+    }
+    out += "\n";
+  }
   out += fmt::format("  displacement [{:.4g}, {:.4g}] rms {:.4g}\n", r.displacement_min,
                      r.displacement_max, r.displacement_rms);
   out += fmt::format("  time {:.2f}s (read {:.2f}+{:.2f}, bvh {:.2f}, sample+trace {:.2f}, "

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 
 #include "core/system.h"
 #include "extract/coarse_sampling.h"
@@ -84,6 +85,20 @@ StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
   settings.spectral.fixed_ulog2 = options.fixed_ulog2;
   settings.spectral.fixed_vlog2 = options.fixed_vlog2;
   settings.holes = options.holes;
+  settings.watertight = options.resolution_rule == ResolutionRule::kErrorBound
+                            ? options.watertight
+                            : WatertightEdges::kOff;
+  settings.edge_step_budget = report.tolerance;
+  settings.max_samples_log2 = std::bit_width(static_cast<unsigned>(options.max_oversample)) - 1;
+  // Each side of an edge within half the tolerance of the displacement there: two faces read
+  // on their own then meet within the tolerance.
+  // For faces read on their own (kAll): edge texels hold the edge's values, and each side of
+  // an edge stays within half the tolerance of them, so two faces meet within the tolerance.
+  if (settings.watertight == WatertightEdges::kAll) {
+    settings.spectral.pin_edges = true;
+    settings.spectral.edge_tolerance = 0.5 * report.tolerance;
+  }
+  report.watertight = settings.watertight;
   return settings;
 }
 

@@ -19,6 +19,13 @@ struct ExtractSettings {
   NormalQuery retry_query;
   SpectralOptions spectral;  // resolution rule and the resolved tolerance
   HolePolicy holes = HolePolicy::kFill;
+  // Watertight edges (kOff unless the rule is kErrorBound), and the largest step MatchEdges
+  // lets a shared edge keep: the tolerance.
+  WatertightEdges watertight = WatertightEdges::kOff;
+  double edge_step_budget = 0;
+  // The most samples per side a face may be re-extracted with when its edges need a finer
+  // resolution than its planned samples hold (log2; max_oversample).
+  int max_samples_log2 = 0;
 };
 
 // Tolerance (from the sculpt's median edge length unless given), search distance (estimated

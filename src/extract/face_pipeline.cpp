@@ -68,11 +68,14 @@ void TakeDistances(std::size_t count, FaceScratch& w, FaceStats& stats) {
 }  // namespace
 
 StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
-                                 const ExtractSettings& settings, FaceScratch& w) {
+                                 const ExtractSettings& settings, FaceScratch& w,
+                                 std::array<int, 2> least_log2) {
   FaceResult result;
   if (inputs.surface.is_hole(face)) return result;
   FaceStats& r = result.stats;
-  const int n = 1 << settings.plan.log2[static_cast<std::size_t>(face.value)];
+  // A least resolution beyond the planned samples takes as many samples.
+  const int n = 1 << std::max<int>({settings.plan.log2[static_cast<std::size_t>(face.value)],
+                                    least_log2[0], least_log2[1]});
   const std::size_t count = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
   w.positions.resize(3 * count);
   w.normals.resize(3 * count);
@@ -110,7 +113,10 @@ StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
   result.edge_means = ComputeEdgeMeans(w.values.data(), n, n);
 
   step.Reset();
-  DISPEX_ASSIGN_OR_RETURN(result.analysed, w.analyzer.Analyze(w.values, n, n, settings.spectral));
+  SpectralOptions spectral = settings.spectral;
+  spectral.min_ulog2 = least_log2[0];
+  spectral.min_vlog2 = least_log2[1];
+  DISPEX_ASSIGN_OR_RETURN(result.analysed, w.analyzer.Analyze(w.values, n, n, spectral));
   w.cpu_spectral += step.seconds();
   r.spectral = result.analysed.stats;
   r.ulog2 = static_cast<std::int8_t>(result.analysed.ulog2);

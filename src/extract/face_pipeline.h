@@ -4,6 +4,7 @@
 // times, on any thread that has its own FaceScratch; it does not write the map.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -60,7 +61,11 @@ struct FaceScratch {
 };
 
 // Fails on an evaluation or analysis error, or on a miss under HolePolicy::kFail.
+// `least_log2`: the least resolution (log2 of u and v texels) the face may get, e.g. for its
+// neighbours to meet it without a step (SpectralOptions::min_ulog2); beyond the planned
+// samples per side the face is sampled that finely.
 StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
-                                 const ExtractSettings& settings, FaceScratch& scratch);
+                                 const ExtractSettings& settings, FaceScratch& scratch,
+                                 std::array<int, 2> least_log2 = {0, 0});
 
 }  // namespace dispex

@@ -33,8 +33,8 @@ Status WriteFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFaceId fac
                            : writer.SetFace(face, info, analysed.texels);
 }
 
-WorkerTotals SumWorkers(const tbb::enumerable_thread_specific<FaceScratch>& scratches) {
-  WorkerTotals totals;
+void AddWorkers(const tbb::enumerable_thread_specific<FaceScratch>& scratches,
+                WorkerTotals& totals) {
   for (const FaceScratch& w : scratches) {
     totals.rays_cast += w.counters.rays_cast;
     totals.cpu_limit += w.cpu_limit;
@@ -43,7 +43,44 @@ WorkerTotals SumWorkers(const tbb::enumerable_thread_specific<FaceScratch>& scra
     totals.cpu_write += w.cpu_write;
     totals.fallback_normals += w.evaluator.stats().fallback_normals;
   }
-  return totals;
+}
+
+KeptFace Keep(const FaceResult& result) {
+  KeptFace kept;
+  switch (result.kind) {
+    case FaceResult::Kind::kAllMissed:
+      return kept;
+    case FaceResult::Kind::kHole:
+      kept.texels = {0.0f};
+      break;
+    case FaceResult::Kind::kAnalysed:
+      kept.ulog2 = static_cast<std::int8_t>(result.analysed.ulog2);
+      kept.vlog2 = static_cast<std::int8_t>(result.analysed.vlog2);
+      kept.texels.assign(result.analysed.texels.begin(), result.analysed.texels.end());
+      break;
+  }
+  kept.kept = true;
+  return kept;
+}
+
+// In parallel over `count` items, item k being face face_of(k); the error of the lowest face.
+template <class FaceOf, class Work>
+Status ForEachFace(int count, FaceOf face_of,
+                   tbb::enumerable_thread_specific<FaceScratch>& scratches, Progress* bar,
+                   Work work) {
+  FirstError error;
+  tbb::parallel_for(tbb::blocked_range<int>(0, count, 1), [&](const tbb::blocked_range<int>& range) {
+    FaceScratch& w = scratches.local();
+    for (int k = range.begin(); k != range.end(); ++k) {
+      const int f = face_of(k);
+      if (error.failed()) return;
+      if (CancelRequested()) return error.Record(-1, Cancelled());
+      Status s = work(PtexFaceId(f), w);
+      if (!s.ok()) return error.Record(f, s);
+      if (bar) bar->Advance();
+    }
+  });
+  return error.failed() ? error.status() : Status::Ok();
 }
 
 }  // namespace
@@ -56,37 +93,75 @@ Status WriteConstantFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFa
 StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
                                       bool progress, PtexWriter& writer) {
   const int num_faces = inputs.surface.num_ptex_faces();
+  const bool keep = settings.watertight != WatertightEdges::kOff;
   ProcessedFaces out;
   out.stats.resize(static_cast<std::size_t>(num_faces));
   out.edge_means.resize(static_cast<std::size_t>(num_faces));
+  if (keep) out.kept.resize(static_cast<std::size_t>(num_faces));
   tbb::enumerable_thread_specific<FaceScratch> scratches(
       [&] { return FaceScratch(inputs.surface); });
-  FirstError error;
   Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", progress);
 
   auto process = [&](PtexFaceId face, FaceScratch& w) -> Status {
     DISPEX_ASSIGN_OR_RETURN(FaceResult result, ProcessFace(face, inputs, settings, w));
+    const auto f = static_cast<std::size_t>(face.value);
+    out.stats[f] = result.stats;
+    out.edge_means[f] = result.edge_means;
+    if (keep) {
+      out.kept[f] = Keep(result);
+      return Status::Ok();
+    }
     ThreadCpuStopwatch step;
     Status written = WriteFace(writer, inputs, face, result);
     if (result.kind == FaceResult::Kind::kAnalysed) w.cpu_write += step.seconds();
-    out.stats[static_cast<std::size_t>(face.value)] = result.stats;
-    out.edge_means[static_cast<std::size_t>(face.value)] = result.edge_means;
     return written;
   };
-  tbb::parallel_for(tbb::blocked_range<int>(0, num_faces, 1), [&](const tbb::blocked_range<int>& range) {
-    FaceScratch& w = scratches.local();
-    for (int f = range.begin(); f != range.end(); ++f) {
-      if (error.failed()) return;
-      if (CancelRequested()) return error.Record(-1, Cancelled());
-      Status s = process(PtexFaceId(f), w);
-      if (!s.ok()) return error.Record(f, s);
-      bar.Advance();
-    }
-  });
+  Status status = ForEachFace(num_faces, [](int k) { return k; }, scratches, &bar, process);
   bar.Finish();
-  if (error.failed()) return error.status();
-  out.workers = SumWorkers(scratches);
+  DISPEX_RETURN_IF_ERROR(status);
+  AddWorkers(scratches, out.workers);
   return out;
+}
+
+Status ReprocessFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
+                      std::span<const int> faces, std::span<const std::array<int, 2>> least_log2,
+                      ProcessedFaces& processed) {
+  tbb::enumerable_thread_specific<FaceScratch> scratches(
+      [&] { return FaceScratch(inputs.surface); });
+  auto process = [&](PtexFaceId face, FaceScratch& w) -> Status {
+    const auto f = static_cast<std::size_t>(face.value);
+    DISPEX_ASSIGN_OR_RETURN(FaceResult result,
+                            ProcessFace(face, inputs, settings, w, least_log2[f]));
+    processed.stats[f] = result.stats;
+    processed.kept[f] = Keep(result);
+    return Status::Ok();
+  };
+  DISPEX_RETURN_IF_ERROR(ForEachFace(
+      static_cast<int>(faces.size()), [&](int k) { return faces[static_cast<std::size_t>(k)]; },
+      scratches, nullptr, process));
+  WorkerTotals extra;
+  AddWorkers(scratches, extra);
+  processed.workers.rays_cast += extra.rays_cast;
+  processed.workers.cpu_limit += extra.cpu_limit;
+  processed.workers.cpu_trace += extra.cpu_trace;
+  processed.workers.cpu_spectral += extra.cpu_spectral;
+  return Status::Ok();
+}
+
+Status WriteKeptFaces(PtexWriter& writer, const ExtractInputs& inputs,
+                      const ProcessedFaces& processed) {
+  const int num_faces = inputs.surface.num_ptex_faces();
+  FirstError error;
+  tbb::parallel_for(0, num_faces, [&](int f) {
+    const KeptFace& kept = processed.kept[static_cast<std::size_t>(f)];
+    if (!kept.kept || error.failed()) return;
+    const PtexFaceInfo info = FaceInfo(inputs, PtexFaceId(f), kept.ulog2, kept.vlog2);
+    Status s = kept.texels.size() == 1
+                   ? writer.SetConstantFace(PtexFaceId(f), info, {kept.texels.data(), 1})
+                   : writer.SetFace(PtexFaceId(f), info, kept.texels);
+    if (!s.ok()) error.Record(f, s);
+  });
+  return error.failed() ? error.status() : Status::Ok();
 }
 
 }  // namespace dispex

@@ -2,7 +2,9 @@
 // written to the map as soon as it is done, so its buffers live only while it is processed.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "dispex/ptex.h"
@@ -19,15 +21,35 @@ struct WorkerTotals {
   double cpu_limit = 0, cpu_trace = 0, cpu_spectral = 0, cpu_write = 0;
 };
 
+// A face's texels held back from the writer until its neighbours are final (watertight edges).
+struct KeptFace {
+  std::int8_t ulog2 = 0, vlog2 = 0;
+  bool kept = false;          // false: a face that missed entirely (written when filled)
+  std::vector<float> texels;  // ures x vres, or one value for a constant face
+};
+
 struct ProcessedFaces {
   std::vector<FaceStats> stats;          // per Ptex face
   std::vector<EdgeMeans> edge_means;     // per Ptex face
+  std::vector<KeptFace> kept;            // per Ptex face, when settings.watertight is on
   WorkerTotals workers;
 };
 
-// On an error, the error of the lowest face id (whatever the scheduling), or the cancellation.
+// Every face through ProcessFace, in parallel. Each face is written to the map as soon as it
+// is done, or, with watertight edges, kept for MatchEdges and WriteKeptFaces. On an error, the
+// error of the lowest face id (whatever the scheduling), or the cancellation.
 StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
                                       bool progress, PtexWriter& writer);
+
+// Runs ProcessFace again for `faces` with their least resolutions (`least_log2`, per Ptex
+// face), replacing their kept texels and statistics; the rays cast count in the totals.
+Status ReprocessFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
+                      std::span<const int> faces, std::span<const std::array<int, 2>> least_log2,
+                      ProcessedFaces& processed);
+
+// Writes every kept face.
+Status WriteKeptFaces(PtexWriter& writer, const ExtractInputs& inputs,
+                      const ProcessedFaces& processed);
 
 // Writes a constant face with the face table's adjacency.
 Status WriteConstantFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFaceId face,

@@ -44,7 +44,7 @@ PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
         continue;
       }
       const int points = std::max(16, 2 * std::max(along(f, e), along(a, first.edge)));
-      PtexEdgeStep worst{f, e, a, 0, 0, false};
+      PtexEdgeStep worst{f, e, a, 0, 0, 0, 0};
       for (int j = 0; j <= points; ++j) {
         const double t = double(j) / points;
         PtexEdgeSide other;
@@ -58,8 +58,10 @@ PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
                                             sampler.SampleAcrossFaces(other.face, ou, ov));
         out.per_face.push_back(static_cast<float>(face_step));
         out.across_faces.push_back(static_cast<float>(filter_step));
-        if (face_step > worst.step) worst = {f, e, a, t, face_step, false};
-        if (filter_step > worst.step) worst = {f, e, a, t, filter_step, true};
+        if (face_step > worst.per_face) worst.per_face = face_step, worst.t_per_face = t;
+        if (filter_step > worst.across_faces) {
+          worst.across_faces = filter_step, worst.t_across_faces = t;
+        }
       }
       out.edge_max.push_back(worst);
     }

@@ -64,4 +64,47 @@ double MaxEdgeReadError(const float* texels, const BlockShape& res, const float*
   return worst;
 }
 
+void PinEdgeTexels(float* texels, const BlockShape& res, const float* samples,
+                   const BlockShape& shape) {
+  const int nx = shape.nx, ny = shape.ny, rx = res.nx, ry = res.ny;
+  const std::ptrdiff_t row = nx;
+  auto at = [&](int i, int j) { return double(samples[std::ptrdiff_t(j) * row + i]); };
+  // The edge value beyond sample (i, j) at the bottom / top / left / right.
+  auto bottom = [&](int i) { return Extrapolate(at(i, 0), ny > 1 ? at(i, 1) : 0, ny > 1); };
+  auto top = [&](int i) { return Extrapolate(at(i, ny - 1), ny > 1 ? at(i, ny - 2) : 0, ny > 1); };
+  auto left = [&](int j) { return Extrapolate(at(0, j), nx > 1 ? at(1, j) : 0, nx > 1); };
+  auto right = [&](int j) { return Extrapolate(at(nx - 1, j), nx > 1 ? at(nx - 2, j) : 0, nx > 1); };
+  auto texel = [&](int i, int j) -> float& { return texels[std::ptrdiff_t(j) * rx + i]; };
+  const bool rows = ry >= 2 && ry < ny, columns = rx >= 2 && rx < nx;
+  if (rows) {
+    const int span = nx / rx;
+    for (int i = 0; i < rx; ++i) {
+      double b = 0, t = 0;
+      for (int k = i * span; k < (i + 1) * span; ++k) b += bottom(k), t += top(k);
+      texel(i, 0) = static_cast<float>(b / span);
+      texel(i, ry - 1) = static_cast<float>(t / span);
+    }
+  }
+  if (columns) {
+    const int span = ny / ry;
+    for (int j = 0; j < ry; ++j) {
+      double l = 0, r = 0;
+      for (int k = j * span; k < (j + 1) * span; ++k) l += left(k), r += right(k);
+      texel(0, j) = static_cast<float>(l / span);
+      texel(rx - 1, j) = static_cast<float>(r / span);
+    }
+  }
+  if (rows && columns) {
+    for (int cj : {0, 1}) {
+      for (int ci : {0, 1}) {
+        const int i0 = ci ? nx - 1 : 0, i1 = ci ? nx - 2 : 1;
+        const int j0 = cj ? ny - 1 : 0, j1 = cj ? ny - 2 : 1;
+        auto edge_value = [&](int j) { return Extrapolate(at(i0, j), at(i1, j), true); };
+        texel(ci ? rx - 1 : 0, cj ? ry - 1 : 0) =
+            static_cast<float>(Extrapolate(edge_value(j0), edge_value(j1), true));
+      }
+    }
+  }
+}
+
 }  // namespace dispex::spectral

@@ -14,4 +14,15 @@ namespace dispex::spectral {
 double MaxEdgeReadError(const float* texels, const BlockShape& res, const float* samples,
                         const BlockShape& samples_shape);
 
+// Makes the outermost texels hold the displacement on the face's edges rather than at their
+// own centres, half a texel inside: where 2 or more texels but fewer than the samples run
+// across an edge, the outermost row (column) gets the extrapolated edge values box-averaged
+// over each texel's span of samples, and where both do, the corner texels the values at the
+// corners (extrapolated both ways). At the samples' own resolution nothing changes (the
+// texels are the samples, which read back exactly). Readers then meet the
+// neighbour's values on the edge itself, per face and through the cross-face filter, and
+// the read-back check sees what this costs inside the face. Requires res <= samples_shape.
+void PinEdgeTexels(float* texels, const BlockShape& res, const float* samples,
+                   const BlockShape& samples_shape);
+
 }  // namespace dispex::spectral

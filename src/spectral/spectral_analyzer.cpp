@@ -222,8 +222,14 @@ StatusOr<SpectralFace> SpectralAnalyzer::Analyze(std::span<const float> samples,
     ky = std::max(ky, std::min(options.min_vlog2, shape.ly));
   }
 
+  const bool pin = verify && options.pin_edges;
+  auto resample = [&](const BlockShape& res, int into) -> const float* {
+    float* t = m.ResampleLoaded(shape, res, summary.mean, into);
+    if (pin) spectral::PinEdgeTexels(t, res, m.samples.data(), shape);
+    return t;
+  };
   int slot = 0;
-  const float* texels = m.ResampleLoaded(shape, ShapeOfLog2(kx, ky), summary.mean, slot);
+  const float* texels = resample(ShapeOfLog2(kx, ky), slot);
   const bool early_stop = verify && edge_tolerance <= 0;
   double error = spectral::MaxReadBackError(texels, ShapeOfLog2(kx, ky), m.samples.data(), shape,
                                             verify ? tolerance : kInfinity);
@@ -246,13 +252,13 @@ StatusOr<SpectralFace> SpectralAnalyzer::Analyze(std::span<const float> samples,
     double error_v = kInfinity, edge_v = kInfinity;
     if (can_u) {
       const BlockShape res = ShapeOfLog2(kx + 1, ky);
-      const float* t = m.ResampleLoaded(shape, res, summary.mean, slot_u);
+      const float* t = resample(res, slot_u);
       error_u = spectral::MaxReadBackError(t, res, m.samples.data(), shape, kInfinity);
       edge_u = edge_error(t, res);
     }
     if (can_v) {
       const BlockShape res = ShapeOfLog2(kx, ky + 1);
-      const float* t = m.ResampleLoaded(shape, res, summary.mean, slot_v);
+      const float* t = resample(res, slot_v);
       error_v = spectral::MaxReadBackError(t, res, m.samples.data(), shape,
                                            early_stop ? error_u : kInfinity);
       edge_v = edge_error(t, res);

@@ -241,12 +241,17 @@ Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFil
   r.crease_edges = steps.skipped_edges;
   r.edge_per_face = Summarise(steps.per_face);
   r.edge_across_faces = Summarise(steps.across_faces);
-  std::stable_sort(steps.edge_max.begin(), steps.edge_max.end(),
-                   [](const auto& x, const auto& y) { return x.step > y.step; });
+  std::vector<VerifyReport::WorstEdge> worst;
   for (const PtexEdgeStep& s : steps.edge_max) {
-    if (r.worst_edges.size() == 10 || s.step == 0) break;
-    r.worst_edges.push_back(
-        {s.face, s.edge, s.neighbour, s.t, s.step, s.across_faces ? "across-faces" : "per-face"});
+    worst.push_back({s.face, s.edge, s.neighbour, s.t_per_face, s.per_face, "per-face"});
+    worst.push_back(
+        {s.face, s.edge, s.neighbour, s.t_across_faces, s.across_faces, "across-faces"});
+  }
+  std::stable_sort(worst.begin(), worst.end(),
+                   [](const auto& x, const auto& y) { return x.step > y.step; });
+  for (const auto& w : worst) {
+    if (r.worst_edges.size() == 10 || w.step == 0) break;
+    r.worst_edges.push_back(w);
   }
   const double tau = options.tolerance > 0 ? options.tolerance : r.map_tolerance;
   if ((options.max_edge_step > 0 || options.max_edge_step_p99 > 0) && !(tau > 0)) {

@@ -1,0 +1,165 @@
+#include "extract/edge_matching.h"
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "dispex/ptex_sampler.h"
+
+namespace dispex {
+
+namespace {
+
+constexpr int kMaxRounds = 8;
+// A raise must bring an edge's step below this fraction of what it was to be worth another.
+constexpr double kProgress = 0.75;
+
+// The map as it stands, for the sampler: resolutions and texels of every kept face.
+struct MapView {
+  std::vector<PtexFaceInfo> faces;
+  std::vector<std::vector<float>> texels;
+  std::vector<std::uint8_t> skip_faces;  // holes, and faces that missed entirely
+};
+
+MapView ViewOf(const ExtractInputs& inputs, const ProcessedFaces& processed) {
+  MapView view;
+  view.faces = inputs.faces;
+  const std::size_t n = view.faces.size();
+  view.texels.resize(n);
+  view.skip_faces.resize(n);
+  for (std::size_t f = 0; f < n; ++f) {
+    const KeptFace& kept = processed.kept[f];
+    view.skip_faces[f] = !kept.kept || inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
+    if (!kept.kept) {
+      view.texels[f] = {0.0f};
+      continue;
+    }
+    view.faces[f].ulog2 = kept.ulog2;
+    view.faces[f].vlog2 = kept.vlog2;
+    view.texels[f] = kept.texels;
+  }
+  return view;
+}
+
+// log2 texels of face f along its edge e and across it; a quad next to sub-faces counts one
+// level less, as the filter reads it (a sub-face is a quarter of a quad to it).
+struct EdgeRes {
+  int along = 0, across = 0;
+  int along_dim = 0;  // 0: u, 1: v
+};
+EdgeRes ResAt(const PtexFaceInfo& info, int e, bool quad_beside_subface) {
+  EdgeRes r;
+  r.along_dim = e % 2 == 0 ? 0 : 1;
+  r.along = r.along_dim == 0 ? info.ulog2 : info.vlog2;
+  r.across = r.along_dim == 0 ? info.vlog2 : info.ulog2;
+  if (quad_beside_subface) --r.along, --r.across;
+  return r;
+}
+
+std::int64_t Texels(const ProcessedFaces& processed, const ExtractInputs& inputs) {
+  std::int64_t total = 0;
+  for (std::size_t f = 0; f < processed.kept.size(); ++f) {
+    if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
+    const KeptFace& kept = processed.kept[f];
+    total += kept.kept ? static_cast<std::int64_t>(kept.texels.size()) : 1;
+  }
+  return total;
+}
+
+}  // namespace
+
+Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
+                  ProcessedFaces& faces, ExtractReport& report) {
+  const double budget = settings.edge_step_budget;
+  const bool per_face = settings.watertight == WatertightEdges::kAll;
+  const std::vector<std::uint8_t> sharp = SharpCreaseEdges(inputs.base, inputs.surface);
+  const std::size_t n = faces.kept.size();
+  report.texels_before_edges = Texels(faces, inputs);
+
+  std::vector<std::array<int, 2>> least(n, {0, 0});
+  std::vector<std::uint8_t> raised(n, 0);
+  std::map<std::pair<int, int>, double> last_step;  // (face, edge) -> step when last raised
+  PtexEdgeSteps steps;
+  MapView view;
+  for (int round = 0;; ++round) {
+    view = ViewOf(inputs, faces);
+    steps = MeasurePtexEdgeSteps(view.faces, view.texels, sharp, view.skip_faces);
+    if (round == kMaxRounds) break;
+    std::vector<std::array<int, 2>> want = least;
+    auto raise = [&](int f, int dim) {
+      const PtexFaceInfo& info = view.faces[static_cast<std::size_t>(f)];
+      const int now = dim == 0 ? info.ulog2 : info.vlog2;
+      const int cap = std::max<int>(settings.plan.log2[static_cast<std::size_t>(f)],
+                                    settings.max_samples_log2);
+      if (now + 1 > cap) return false;
+      int& w = want[static_cast<std::size_t>(f)][static_cast<std::size_t>(dim)];
+      w = std::max(w, now + 1);
+      return true;
+    };
+    for (const PtexEdgeStep& s : steps.edge_max) {
+      const bool over_filter = s.across_faces > budget;
+      const bool over_face = per_face && s.per_face > budget;
+      if (!over_filter && !over_face) continue;
+      const double step = std::max(over_filter ? s.across_faces : 0.0, over_face ? s.per_face : 0.0);
+      const auto key = std::make_pair(s.face, s.edge);
+      if (auto it = last_step.find(key); it != last_step.end() && step > kProgress * it->second) {
+        continue;  // the last raise did not help: the displacement itself steps here
+      }
+      const PtexFaceInfo& a = view.faces[static_cast<std::size_t>(s.face)];
+      const PtexFaceInfo& b = view.faces[static_cast<std::size_t>(s.neighbour)];
+      const int b_edge = a.adjedges[static_cast<std::size_t>(s.edge)];
+      const EdgeRes ra = ResAt(a, s.edge, !a.subface && b.subface);
+      const EdgeRes rb = ResAt(b, b_edge, !b.subface && a.subface);
+      bool any = false;
+      if (over_filter) {
+        if (ra.along != rb.along) {
+          any |= ra.along < rb.along ? raise(s.face, ra.along_dim) : raise(s.neighbour, rb.along_dim);
+        } else if (ra.across != rb.across) {
+          any |= ra.across < rb.across ? raise(s.face, 1 - ra.along_dim)
+                                       : raise(s.neighbour, 1 - rb.along_dim);
+        } else {
+          any |= raise(s.face, ra.along_dim);
+          any |= raise(s.neighbour, rb.along_dim);
+        }
+      }
+      if (over_face) {
+        any |= raise(s.face, 1 - ra.along_dim);
+        any |= raise(s.neighbour, 1 - rb.along_dim);
+      }
+      if (any) last_step[key] = step;
+    }
+    std::vector<int> redo;
+    for (std::size_t f = 0; f < n; ++f) {
+      if (want[f] == least[f]) continue;
+      least[f] = want[f];
+      redo.push_back(static_cast<int>(f));
+      raised[f] = 1;
+    }
+    if (redo.empty()) break;
+    ++report.edge_rounds;
+    DISPEX_RETURN_IF_ERROR(ReprocessFaces(inputs, settings, redo, least, faces));
+  }
+
+  report.edges_shared = static_cast<std::int64_t>(steps.edges);
+  report.edges_sharp = static_cast<std::int64_t>(steps.skipped_edges);
+  for (std::size_t f = 0; f < n; ++f) {
+    report.edge_raised_faces += raised[f];
+    if (!view.skip_faces[f] || inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
+    for (int e = 0; e < 4; ++e) {  // edges of faces filled from their neighbours, once each
+      const int a = view.faces[f].adjfaces[static_cast<std::size_t>(e)];
+      if (a < 0 || inputs.surface.is_hole(PtexFaceId(a))) continue;
+      if (view.skip_faces[static_cast<std::size_t>(a)] && a < static_cast<int>(f)) continue;
+      ++report.edges_filled;
+    }
+  }
+  for (const PtexEdgeStep& s : steps.edge_max) {
+    report.edge_step_per_face = std::max(report.edge_step_per_face, s.per_face);
+    report.edge_step_across_faces = std::max(report.edge_step_across_faces, s.across_faces);
+    report.edges_over += s.across_faces > budget || (per_face && s.per_face > budget);
+  }
+  return Status::Ok();
+}
+
+}  // namespace dispex

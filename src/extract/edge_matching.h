@@ -1,0 +1,25 @@
+// The watertight-edges stage of an extraction (docs/ACCURACY.md, "Watertight edges"): once
+// every face has its texels, the steps where faces meet are measured under the readers
+// renderers use, and faces are re-extracted at a higher resolution until every shared edge
+// meets within the tolerance, or raising no longer helps.
+#pragma once
+
+#include "dispex/extract.h"
+#include "extract/extract_inputs.h"
+#include "extract/extract_settings.h"
+#include "extract/process_faces.h"
+
+namespace dispex {
+
+// In rounds: measure every shared edge (MeasurePtexEdgeSteps); for each edge over
+// settings.edge_step_budget, raise the resolution that causes it -- through the cross-face
+// filter the coarser side (along the edge first, then across), for per-face reading
+// (WatertightEdges::kAll) both sides across the edge -- and run ProcessFace again for the
+// raised faces. An edge whose step fell by less than a quarter since its last raise, or whose
+// faces are already at their sample resolution, is left as it is and counted. Edges on
+// infinitely sharp creases and next to faces that missed entirely are not held. Fills the
+// report's edge fields. Deterministic: decisions depend only on the texels.
+Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
+                  ProcessedFaces& faces, ExtractReport& report);
+
+}  // namespace dispex
