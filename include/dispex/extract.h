@@ -159,8 +159,11 @@ struct ExtractReport {
   std::int64_t texels_before_edges = 0;  // texels written had no edge been raised
   std::int64_t edges_shared = 0;         // between two faces with a surface
   std::int64_t edges_sharp = 0;          // on infinitely sharp creases: not held
-  // Edges next to faces filled from their neighbours (missed entirely): not held.
-  std::int64_t edges_filled = 0;
+  // Edges beside faces whose displacement may jump -- samples filled over holes of the
+  // sculpt, hits on another sheet, or no hit at all -- not held; those faces, by id (stored in
+  // the map as dispex:discontinuous_faces for verify).
+  std::int64_t edges_discontinuous = 0;
+  std::vector<std::int32_t> discontinuous_faces;
   // Held edges still over the tolerance: the samples are too coarse, or the displacement jumps
   // there (another sheet, a filled hole), so raising the resolution did not bring them down.
   std::int64_t edges_over = 0;

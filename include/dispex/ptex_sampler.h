@@ -93,6 +93,12 @@ struct PtexEdgeSteps {
   std::vector<float> per_face, across_faces;  // one |step| per point, in edge order
   std::vector<PtexEdgeStep> edge_max;         // per measured edge its largest step
 };
+// Edges between two faces not in `skip_faces` of which at least one is in `touching`, each
+// counted once (e.g. the edges a measurement left out because a face's data is not held).
+std::size_t CountEdgesTouching(std::span<const PtexFaceInfo> faces,
+                               std::span<const std::uint8_t> touching,
+                               std::span<const std::uint8_t> skip_faces);
+
 PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
                                    std::span<const std::vector<float>> texels,
                                    std::span<const std::uint8_t> skip_edges,

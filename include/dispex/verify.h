@@ -177,7 +177,8 @@ struct VerifyOptions {
   // Steps where faces meet (docs/ACCURACY.md, "Watertight edges"): fail when the largest
   // step on a shared edge, under either reader, exceeds max_edge_step x tau, or their 99th
   // percentile exceeds max_edge_step_p99 x tau (0: off). tau as for the truth bounds. Edges
-  // on infinitely sharp creases of the base are counted, not checked.
+  // on infinitely sharp creases of the base, and beside the faces the map lists as
+  // discontinuous, are counted, not checked.
   double max_edge_step = 0;
   double max_edge_step_p99 = 0;
   int threads = 0;
@@ -225,6 +226,9 @@ struct VerifyReport {
   bool measured_edges = false;
   std::size_t edges = 0;         // shared edges between faces with a surface
   std::size_t crease_edges = 0;  // of those, on infinitely sharp creases: not measured
+  // Of those, beside faces the map lists as discontinuous (dispex:discontinuous_faces: filled
+  // holes, other-sheet hits): not measured.
+  std::size_t discontinuous_edges = 0;
   ErrorStats edge_per_face, edge_across_faces;
   double edge_tolerance = 0;  // tau the steps are checked against (0: not checked)
   double edge_max_limit = 0, edge_p99_limit = 0;  // object units; 0: not checked

@@ -16,6 +16,12 @@ constexpr int kMaxRounds = 8;
 // A raise must bring an edge's step below this fraction of what it was to be worth another.
 constexpr double kProgress = 0.75;
 
+// A face whose data may jump at its edges: samples filled over holes of the sculpt, or hits
+// on another sheet (folds, thin parts). Its edges are not held; they are counted.
+bool Discontinuous(const FaceStats& stats) {
+  return stats.all_missed || stats.filled > 0 || stats.hits_opposed > 0;
+}
+
 // The map as it stands, for the sampler: resolutions and texels of every kept face.
 struct MapView {
   std::vector<PtexFaceInfo> faces;
@@ -31,7 +37,8 @@ MapView ViewOf(const ExtractInputs& inputs, const ProcessedFaces& processed) {
   view.skip_faces.resize(n);
   for (std::size_t f = 0; f < n; ++f) {
     const KeptFace& kept = processed.kept[f];
-    view.skip_faces[f] = !kept.kept || inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
+    view.skip_faces[f] = !kept.kept || inputs.surface.is_hole(PtexFaceId(static_cast<int>(f))) ||
+                         Discontinuous(processed.stats[f]);
     if (!kept.kept) {
       view.texels[f] = {0.0f};
       continue;
@@ -144,16 +151,15 @@ Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
 
   report.edges_shared = static_cast<std::int64_t>(steps.edges);
   report.edges_sharp = static_cast<std::int64_t>(steps.skipped_edges);
+  std::vector<std::uint8_t> holes(n), discontinuous(n);
   for (std::size_t f = 0; f < n; ++f) {
     report.edge_raised_faces += raised[f];
-    if (!view.skip_faces[f] || inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
-    for (int e = 0; e < 4; ++e) {  // edges of faces filled from their neighbours, once each
-      const int a = view.faces[f].adjfaces[static_cast<std::size_t>(e)];
-      if (a < 0 || inputs.surface.is_hole(PtexFaceId(a))) continue;
-      if (view.skip_faces[static_cast<std::size_t>(a)] && a < static_cast<int>(f)) continue;
-      ++report.edges_filled;
-    }
+    holes[f] = inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
+    discontinuous[f] = !holes[f] && view.skip_faces[f];
+    if (discontinuous[f]) report.discontinuous_faces.push_back(static_cast<std::int32_t>(f));
   }
+  report.edges_discontinuous =
+      static_cast<std::int64_t>(CountEdgesTouching(view.faces, discontinuous, holes));
   for (const PtexEdgeStep& s : steps.edge_max) {
     report.edge_step_per_face = std::max(report.edge_step_per_face, s.per_face);
     report.edge_step_across_faces = std::max(report.edge_step_across_faces, s.across_faces);

@@ -101,7 +101,7 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
                 {"texels_before", r.texels_before_edges},
                 {"shared", r.edges_shared},
                 {"sharp", r.edges_sharp},
-                {"filled", r.edges_filled},
+                {"discontinuous", r.edges_discontinuous},
                 {"over", r.edges_over},
                 {"step_per_face", r.edge_step_per_face},
                 {"step_across_faces", r.edge_step_across_faces},
@@ -125,6 +125,11 @@ Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractRep
   const double tolerance = report.tolerance, distance = report.search_distance;
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:tolerance", std::span(&tolerance, 1)));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:search_distance", std::span(&distance, 1)));
+  if (!report.discontinuous_faces.empty()) {
+    DISPEX_RETURN_IF_ERROR(
+        writer.AddMetaData("dispex:discontinuous_faces",
+                           std::span<const std::int32_t>(report.discontinuous_faces)));
+  }
   return Status::Ok();
 }
 

@@ -73,10 +73,10 @@ std::string ExtractReportSummary(const ExtractReport& r) {
         r.edge_step_per_face, r.edge_step_across_faces / r.tolerance,
         r.edge_step_per_face / r.tolerance, r.edge_raised_faces, r.edge_rounds,
         r.texels_before_edges, s.texels_after);
-    if (r.edges_over + r.edges_sharp + r.edges_filled > 0) {
+    if (r.edges_over + r.edges_sharp + r.edges_discontinuous > 0) {
       out += fmt::format("; not held: {} over the tolerance, {} on sharp creases, {} beside "
-                         "filled faces",
-                         r.edges_over, r.edges_sharp, r.edges_filled);
+                         "filled holes or other sheets",
+                         r.edges_over, r.edges_sharp, r.edges_discontinuous);
     }
     out += "\n";
   }

@@ -77,4 +77,23 @@ PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
   return steps;
 }
 
+std::size_t CountEdgesTouching(std::span<const PtexFaceInfo> faces,
+                               std::span<const std::uint8_t> touching,
+                               std::span<const std::uint8_t> skip_faces) {
+  std::size_t count = 0;
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    if (skip_faces[f]) continue;
+    for (int e = 0; e < 4; ++e) {
+      PtexEdgeSide other;
+      if (!PtexAcrossEdge(faces, PtexFaceId(static_cast<int>(f)), e, 0.0, other)) continue;
+      const auto a = static_cast<std::size_t>(other.face.value);
+      if (skip_faces[a] || !(touching[f] || touching[a])) continue;
+      // Once per edge: between faces of one kind from the lower id, else from the sub-face.
+      if (faces[f].subface == faces[a].subface && (a < f || (a == f && other.edge < e))) continue;
+      ++count;
+    }
+  }
+  return count;
+}
+
 }  // namespace dispex

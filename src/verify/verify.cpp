@@ -234,10 +234,22 @@ Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFil
     }
   });
   if (error.failed()) return error.status();
-  PtexEdgeSteps steps =
-      MeasurePtexEdgeSteps(faces, texels, SharpCreaseEdges(base, surface), holes);
+  std::vector<std::uint8_t> skip = holes, discontinuous(faces.size(), 0);
+  if (const PtexMetaItem* listed = map.FindMetaData("dispex:discontinuous_faces")) {
+    for (std::int32_t f : listed->AsInt32()) {
+      if (f < 0 || static_cast<std::size_t>(f) >= faces.size()) {
+        return Status::Error(fmt::format("{}: dispex:discontinuous_faces names face {}, not one of "
+                                         "its {} faces",
+                                         map.name(), f, faces.size()));
+      }
+      if (!holes[static_cast<std::size_t>(f)]) discontinuous[static_cast<std::size_t>(f)] = 1;
+      skip[static_cast<std::size_t>(f)] = 1;
+    }
+  }
+  PtexEdgeSteps steps = MeasurePtexEdgeSteps(faces, texels, SharpCreaseEdges(base, surface), skip);
   r.measured_edges = true;
-  r.edges = steps.edges;
+  r.discontinuous_edges = CountEdgesTouching(faces, discontinuous, holes);
+  r.edges = steps.edges + r.discontinuous_edges;
   r.crease_edges = steps.skipped_edges;
   r.edge_per_face = Summarise(steps.per_face);
   r.edge_across_faces = Summarise(steps.across_faces);
@@ -545,6 +557,7 @@ std::string VerifyReportJson(const VerifyReport& r) {
     }
     j["edges"] = {{"shared", r.edges},
                   {"sharp_creases", r.crease_edges},
+                  {"discontinuous", r.discontinuous_edges},
                   {"tolerance", r.edge_tolerance},
                   {"max_limit", r.edge_max_limit},
                   {"p99_limit", r.edge_p99_limit},
@@ -598,9 +611,10 @@ std::string VerifyReportSummary(const VerifyReport& r) {
       }
       return fmt::format("  {:<12} p99 {:.4g}  max {:.4g}{}\n", what, s.p99, s.max, tolerances);
     };
-    out += fmt::format("  edge steps on {} shared edges ({} points; {} on sharp creases not "
-                       "measured):\n",
-                       r.edges - r.crease_edges, r.edge_per_face.count, r.crease_edges);
+    out += fmt::format("  edge steps on {} shared edges ({} points; not measured: {} on sharp "
+                       "creases, {} beside faces the map lists as discontinuous):\n",
+                       r.edges - r.crease_edges - r.discontinuous_edges, r.edge_per_face.count,
+                       r.crease_edges, r.discontinuous_edges);
     out += line("per-face", r.edge_per_face);
     out += line("across-faces", r.edge_across_faces);
     if (!r.worst_edges.empty()) {
