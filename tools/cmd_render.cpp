@@ -1,4 +1,5 @@
-// dispex render BASE [MAP.ptx] -o image.png [--compare [--sculpt SCULPT]] [--view V] [--size WxH]
+// dispex render BASE [MAP.ptx] -o image.png [--compare [--sculpt SCULPT]] [--per-face] [--view V]
+// [--size WxH]
 #include <fmt/format.h>
 
 #include <cmath>
@@ -142,6 +143,9 @@ void SetupRender(CLI::App& app, int& exit_code) {
                   "ambient occlusion ray length, fraction of the bounding-box diagonal")
       ->check(Positive())
       ->capture_default_str();
+  cmd->add_flag("--per-face", o.per_face_displacement,
+                "displace each face by its own map value where faces meet, as a renderer "
+                "reading faces on their own does (cracks and steps show), instead of the mean");
   cmd->add_option("--channel", o.channel, "map channel used as the displacement")
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")

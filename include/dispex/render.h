@@ -201,6 +201,13 @@ struct SurfaceRenderOptions {
   double ao_distance = 0.05;  // AO ray length, fraction of the framed points' bounding diagonal
   int channel = 0;            // map channel used as the displacement
   int threads = 0;            // 0: all cores
+  // Where faces meet, displace each face by its own map value instead of the faces' mean, as
+  // a renderer that reads each face on its own (PtexFile::Sample, no filtering across edges)
+  // does: every face gets its own copy of the shared points (same undisplaced limit position
+  // and normal), so where the faces' values differ the displaced surface cracks or steps and
+  // the shading shows a seam there, and the picture shows what such a renderer shows. The
+  // default (false) averages the values, so no cracks open. Without a map it changes nothing.
+  bool per_face_displacement = false;
 };
 
 // Checks every option's range, the view's included (width, height, density, min_density,
@@ -210,12 +217,12 @@ Status ValidateSurfaceRenderOptions(const SurfaceRenderOptions& options);
 
 // Renders the limit surface of the Catmull-Clark cage `base`, displaced along its limit normal
 // by `map` (read bilinearly per face, as a renderer reads it; values averaged where faces
-// meet, so no cracks open) when map is not null, framed on the cage's vertices. Shading:
-// clay albedo lit by a headlight and a two-light rig (key and fill), smooth normals averaged
-// from the displaced tessellation; hidden holes show the background. Fails when the cage is
-// not a valid Catmull-Clark mesh, the map's face count differs from the cage's Ptex face
-// count (naming both), the map is a triangle Ptex or lacks the channel, its data is corrupt
-// or not finite, or options are out of range.
+// meet, so no cracks open, unless options.per_face_displacement) when map is not null, framed
+// on the cage's vertices. Shading: clay albedo lit by a headlight and a two-light rig (key and
+// fill), smooth normals averaged from the displaced tessellation; hidden holes show the
+// background. Fails when the cage is not a valid Catmull-Clark mesh, the map's face count
+// differs from the cage's Ptex face count (naming both), the map is a triangle Ptex or lacks
+// the channel, its data is corrupt or not finite, or options are out of range.
 StatusOr<Image> RenderSurface(const Mesh& base, const PtexFile* map,
                               const SurfaceRenderOptions& options);
 

@@ -124,7 +124,10 @@ StatusOr<render::ShadedMesh> Surface(const Mesh& base, const LimitSurface& surfa
                                      const PtexFile* density_map, const PtexFile* map,
                                      const SurfaceRenderOptions& o) {
   const auto density = Densities(surface, density_map, o);
-  return render::TessellateLimitSurface(base, surface, density, map, o.channel);
+  return render::TessellateLimitSurface(base, surface, density, map, o.channel,
+                                        o.per_face_displacement
+                                            ? render::BoundaryDisplacement::kPerFace
+                                            : render::BoundaryDisplacement::kMean);
 }
 
 template <class F>

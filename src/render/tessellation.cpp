@@ -6,7 +6,9 @@
 // is named exactly, by the line and a reduced fraction along it (or, at a line's ends, by the
 // cage vertex, edge midpoint or face centre there), so the faces around a point find the same
 // name and share one vertex: position and normal from the lowest-numbered face, displacement
-// averaged over all of them. Along a line the points of all its faces are merged, and a cell
+// averaged over all of them (or, with per-face displacement, one copy of the vertex per face,
+// each displaced by its own face's value, as a renderer that reads each face on its own
+// displaces it). Along a line the points of all its faces are merged, and a cell
 // whose side received points from a finer neighbour becomes a fan around the cell centre, as
 // in the usual crack-free stitching of adaptive tessellations (e.g. Moreton, "Watertight
 // tessellation using forward differencing", 2001, and OpenSubdiv's Bfr::Tessellation with
@@ -21,6 +23,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <mutex>
 #include <numeric>
@@ -69,19 +72,23 @@ struct PointKey {
   auto operator<=>(const PointKey&) const = default;
 };
 
-// One face's view of one shared point.
+// One face's view of one shared point, from one of its sides.
 struct Record {
   PointKey key;
   std::int32_t face = 0;
   float u = 0, v = 0;
   std::int64_t line_point = 0;  // the point's index in the flat array of line points
+  std::int32_t side = 0;        // the side of `face` whose line holds the point
 };
+// A total order. The side comes last: records equal up to it differ in nothing the mean
+// displacement reads.
 bool RecordLess(const Record& x, const Record& y) {
   if (x.key != y.key) return x.key < y.key;
   if (x.face != y.face) return x.face < y.face;
   if (x.u != y.u) return x.u < y.u;
   if (x.v != y.v) return x.v < y.v;
-  return x.line_point < y.line_point;
+  if (x.line_point != y.line_point) return x.line_point < y.line_point;
+  return x.side < y.side;
 }
 
 void SideUv(int side, double s, float& u, float& v) {
@@ -232,9 +239,10 @@ void VertexNormals(std::size_t num_vertices, std::span<const std::uint32_t> face
 class Tessellation {
  public:
   Tessellation(const Mesh& cage, const LimitSurface& surface,
-               std::span<const std::array<int, 2>> density, const PtexFile* map, int channel)
+               std::span<const std::array<int, 2>> density, const PtexFile* map, int channel,
+               BoundaryDisplacement boundary)
       : cage_(cage), surface_(surface), density_(density), map_(map), channel_(channel),
-        n_(surface.num_ptex_faces()) {}
+        per_face_(boundary == BoundaryDisplacement::kPerFace), n_(surface.num_ptex_faces()) {}
 
   StatusOr<ShadedMesh> Run() {
     DISPEX_CHECK_EQ(density_.size(), static_cast<std::size_t>(n_));
@@ -271,6 +279,23 @@ class Tessellation {
   std::int64_t GridPoint(int f, int side, int i) const {
     const std::int64_t e = entry_of_[4 * static_cast<std::size_t>(f) + side];
     return entry_grid_point_[static_cast<std::size_t>(grid_offset_[static_cast<std::size_t>(e)] + i)];
+  }
+  // The lowest line point an entry covers (its line points are consecutive from there).
+  std::int64_t EntryFirstPoint(std::size_t e) const {
+    const auto first = static_cast<std::size_t>(grid_offset_[e]);
+    return std::min(entry_grid_point_[first],
+                    entry_grid_point_[first + static_cast<std::size_t>(entries_[e].segs)]);
+  }
+  // Where entry_point_vertex_ holds face f's vertex for line point p of its side `side`.
+  std::size_t EntryPointSlot(int f, int side, std::int64_t p) const {
+    const auto e = static_cast<std::size_t>(entry_of_[4 * static_cast<std::size_t>(f) + side]);
+    return static_cast<std::size_t>(entry_point_offset_[e] + (p - EntryFirstPoint(e)));
+  }
+  // The vertex face f uses for line point p of its side `side`: the point's one vertex, or
+  // with per-face displacement the face's own copy.
+  std::int32_t SharedVertex(int f, int side, std::int64_t p) const {
+    if (!per_face_) return line_point_vertex_[static_cast<std::size_t>(p)];
+    return entry_point_vertex_[EntryPointSlot(f, side, p)];
   }
   // Points a neighbour added between grid points i and i + 1 of a side.
   int ExtraPoints(int f, int side, int i) const {
@@ -379,6 +404,7 @@ class Tessellation {
           Record& rec = records_[r++];
           rec.key = key;
           rec.face = entries_[e].face;
+          rec.side = entries_[e].side;
           rec.line_point = base + p;
           SideUv(entries_[e].side, SigmaOf(entries_[e], t), rec.u, rec.v);
         }
@@ -386,17 +412,52 @@ class Tessellation {
     });
   }
 
-  // 3. One vertex per distinct point.
+  // 3. One vertex per distinct point; with per-face displacement one per point and face (a
+  // face that meets a point at two (u, v), as around a degenerate edge, gets one for each).
   void NumberSharedVertices() {
     tbb::parallel_sort(records_.begin(), records_.end(), RecordLess);
-    line_point_vertex_.assign(line_point_frac_.size(), -1);
+    if (!per_face_) line_point_vertex_.assign(line_point_frac_.size(), -1);
     for (std::size_t r = 0; r < records_.size(); ++r) {
-      if (r == 0 || records_[r].key != records_[r - 1].key) vertex_records_.push_back(r);
-      line_point_vertex_[static_cast<std::size_t>(records_[r].line_point)] =
-          static_cast<std::int32_t>(vertex_records_.size() - 1);
+      if (r == 0 || records_[r].key != records_[r - 1].key) point_records_.push_back(r);
+      if (!per_face_) {
+        line_point_vertex_[static_cast<std::size_t>(records_[r].line_point)] =
+            static_cast<std::int32_t>(point_records_.size() - 1);
+      }
     }
-    vertex_records_.push_back(records_.size());
-    num_shared_ = vertex_records_.size() - 1;
+    point_records_.push_back(records_.size());
+    num_points_ = point_records_.size() - 1;
+    num_shared_ = per_face_ ? NumberFaceCopies() : num_points_;
+  }
+
+  // Per-face displacement: copy c holds records [copy_records_[c], [c + 1]), point k's copies
+  // are [point_copies_[k], [k + 1]), and every (entry, line point it covers) names its copy in
+  // entry_point_vertex_. Returns the number of copies.
+  std::size_t NumberFaceCopies() {
+    const std::size_t num_entries = entries_.size();
+    entry_point_offset_.assign(num_entries + 1, 0);
+    for (std::size_t e = 0; e < num_entries; ++e) {
+      const auto first = static_cast<std::size_t>(grid_offset_[e]);
+      const std::int64_t a = entry_grid_point_[first];
+      const std::int64_t b = entry_grid_point_[first + static_cast<std::size_t>(entries_[e].segs)];
+      entry_point_offset_[e + 1] = entry_point_offset_[e] + std::abs(b - a) + 1;
+    }
+    DISPEX_CHECK_EQ(static_cast<std::size_t>(entry_point_offset_[num_entries]), records_.size());
+    entry_point_vertex_.assign(records_.size(), -1);
+    for (std::size_t r = 0; r < records_.size(); ++r) {
+      const Record& rec = records_[r];
+      const bool new_point = r == 0 || rec.key != records_[r - 1].key;
+      if (new_point) point_copies_.push_back(copy_records_.size());
+      if (new_point || rec.face != records_[r - 1].face || rec.u != records_[r - 1].u ||
+          rec.v != records_[r - 1].v) {
+        copy_records_.push_back(r);
+      }
+      entry_point_vertex_[EntryPointSlot(rec.face, rec.side, rec.line_point)] =
+          static_cast<std::int32_t>(copy_records_.size() - 1);
+    }
+    point_copies_.push_back(copy_records_.size());
+    const std::size_t copies = copy_records_.size();
+    copy_records_.push_back(records_.size());
+    return copies;
   }
 
   // 4. Per face: interior grid points and the centres of stitched cells, and its triangles.
@@ -459,11 +520,12 @@ class Tessellation {
                               s.p[i + 2] + h * s.nrm[i + 2]};
   }
 
-  // 5. Shared vertices: evaluated on their first face, displaced by the mean of all faces.
+  // 5. Shared vertices: each point evaluated on its first face, displaced by the mean of all
+  // faces, or with per-face displacement each face's copy by that face's own value.
   Status PlaceSharedVertices() {
-    std::vector<std::pair<std::int32_t, std::int32_t>> owners(num_shared_);  // (face, vertex)
-    for (std::size_t v = 0; v < num_shared_; ++v) {
-      owners[v] = {records_[vertex_records_[v]].face, static_cast<std::int32_t>(v)};
+    std::vector<std::pair<std::int32_t, std::int32_t>> owners(num_points_);  // (face, point)
+    for (std::size_t v = 0; v < num_points_; ++v) {
+      owners[v] = {records_[point_records_[v]].face, static_cast<std::int32_t>(v)};
     }
     std::sort(owners.begin(), owners.end());
     std::vector<std::size_t> owner_start;
@@ -479,7 +541,7 @@ class Tessellation {
       s.p.resize(3 * (end - begin));
       s.nrm.resize(3 * (end - begin));
       for (std::size_t k = begin; k < end; ++k) {
-        const Record& r = records_[vertex_records_[static_cast<std::size_t>(owners[k].second)]];
+        const Record& r = records_[point_records_[static_cast<std::size_t>(owners[k].second)]];
         s.uv[2 * (k - begin)] = r.u;
         s.uv[2 * (k - begin) + 1] = r.v;
       }
@@ -487,17 +549,29 @@ class Tessellation {
       if (!st.ok()) return error_.Record(f, st);
       for (std::size_t k = begin; k < end; ++k) {
         const auto v = static_cast<std::size_t>(owners[k].second);
+        if (per_face_) {
+          for (std::size_t c = point_copies_[v]; c < point_copies_[v + 1]; ++c) {
+            const Record& own = records_[copy_records_[c]];
+            float h = 0;
+            if (map_) {
+              h = map_->Sample(PtexFaceId(own.face), own.u, own.v, channel_);
+              if (!std::isfinite(h)) return error_.Record(own.face, MapValueError(*map_, own.face));
+            }
+            Place(c, s, k - begin, h);
+          }
+          continue;
+        }
         float h = 0;
         if (map_) {
           double sum = 0;
-          for (std::size_t r = vertex_records_[v]; r < vertex_records_[v + 1]; ++r) {
+          for (std::size_t r = point_records_[v]; r < point_records_[v + 1]; ++r) {
             const float value =
                 map_->Sample(PtexFaceId(records_[r].face), records_[r].u, records_[r].v, channel_);
             if (!std::isfinite(value))
               return error_.Record(records_[r].face, MapValueError(*map_, records_[r].face));
             sum += value;
           }
-          h = static_cast<float>(sum / double(vertex_records_[v + 1] - vertex_records_[v]));
+          h = static_cast<float>(sum / double(point_records_[v + 1] - point_records_[v]));
         }
         Place(v, s, k - begin, h);
       }
@@ -562,9 +636,7 @@ class Tessellation {
     const int kx = Kx(f), ky = Ky(f);
     const auto first = static_cast<std::size_t>(vertex_start_[static_cast<std::size_t>(f)]);
     Mesh& mesh = out_.mesh;
-    auto shared = [&](int side, int i) {
-      return line_point_vertex_[static_cast<std::size_t>(GridPoint(f, side, i))];
-    };
+    auto shared = [&](int side, int i) { return SharedVertex(f, side, GridPoint(f, side, i)); };
     auto grid_vertex = [&](int i, int j) -> std::int32_t {
       if (j == 0) return shared(0, i);
       if (i == kx) return shared(1, j);
@@ -577,7 +649,7 @@ class Tessellation {
       const std::int64_t a = GridPoint(f, side, i), b = GridPoint(f, side, i + 1);
       const std::int64_t step = b > a ? 1 : -1;
       for (std::int64_t p = a + step; p != b; p += step) {
-        s.polygon.push_back(line_point_vertex_[static_cast<std::size_t>(p)]);
+        s.polygon.push_back(SharedVertex(f, side, p));
       }
     };
     std::int32_t* tri = mesh.face_indices.data() + 3 * triangle_start_[static_cast<std::size_t>(f)];
@@ -622,7 +694,9 @@ class Tessellation {
                  mesh.face_indices.data() + 3 * triangle_start_[static_cast<std::size_t>(f) + 1]);
   }
 
-  // 7. Smooth normals.
+  // 7. Smooth normals. With per-face displacement the copies of a point that sit at the same
+  // displaced position (the faces' values agree there) are one vertex for the average, so the
+  // shading is smooth where the surface is and shows a seam where it cracks.
   void SmoothNormals() {
     const Mesh& mesh = out_.mesh;
     std::vector<Float3> triangle_normals(mesh.face_indices.size() / 3);
@@ -634,8 +708,35 @@ class Tessellation {
       triangle_normals[t] = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z,
                              e1.x * e2.y - e1.y * e2.x};
     });
-    VertexNormals(mesh.positions.size(), mesh.face_offsets, mesh.face_indices, triangle_normals,
+    if (!per_face_) {
+      VertexNormals(mesh.positions.size(), mesh.face_offsets, mesh.face_indices, triangle_normals,
+                    limit_normals_, out_.normals);
+      return;
+    }
+    // Each copy stands for the lowest-numbered copy of its point at the same position.
+    std::vector<std::int32_t> joined(num_shared_);
+    tbb::parallel_for(std::size_t{0}, num_points_, [&](std::size_t k) {
+      for (std::size_t c = point_copies_[k]; c < point_copies_[k + 1]; ++c) {
+        joined[c] = static_cast<std::int32_t>(c);
+        for (std::size_t d = point_copies_[k]; d < c; ++d) {
+          if (std::memcmp(&mesh.positions[c], &mesh.positions[d], sizeof(Float3)) == 0) {
+            joined[c] = static_cast<std::int32_t>(d);
+            break;
+          }
+        }
+      }
+    });
+    std::vector<std::int32_t> indices(mesh.face_indices.size());
+    tbb::parallel_for(std::size_t{0}, indices.size(), [&](std::size_t i) {
+      const std::int32_t v = mesh.face_indices[i];
+      const auto k = static_cast<std::size_t>(v);
+      indices[i] = k < num_shared_ ? joined[k] : v;
+    });
+    VertexNormals(mesh.positions.size(), mesh.face_offsets, indices, triangle_normals,
                   limit_normals_, out_.normals);
+    for (std::size_t c = 0; c < num_shared_; ++c) {
+      out_.normals[c] = out_.normals[static_cast<std::size_t>(joined[c])];
+    }
   }
 
   const Mesh& cage_;
@@ -643,7 +744,8 @@ class Tessellation {
   std::span<const std::array<int, 2>> density_;
   const PtexFile* map_;
   int channel_;
-  int n_;  // Ptex faces
+  bool per_face_;  // BoundaryDisplacement::kPerFace
+  int n_;          // Ptex faces
 
   std::vector<SideEntry> entries_;        // face sides, by line
   std::vector<std::int64_t> entry_of_;    // 4 f + side -> its entry, or -1
@@ -654,9 +756,14 @@ class Tessellation {
   std::vector<Frac> line_point_frac_;
   std::vector<std::int64_t> line_point_count_;
   std::vector<Record> records_;
-  std::vector<std::int32_t> line_point_vertex_;
-  std::vector<std::size_t> vertex_records_;  // records of vertex i: [vertex_records_[i], [i + 1])
-  std::size_t num_shared_ = 0;
+  std::vector<std::int32_t> line_point_vertex_;  // line point -> its vertex (mean displacement)
+  std::vector<std::size_t> point_records_;  // records of point i: [point_records_[i], [i + 1])
+  std::size_t num_points_ = 0;
+  // Per-face displacement only (see NumberFaceCopies).
+  std::vector<std::size_t> copy_records_, point_copies_;
+  std::vector<std::int64_t> entry_point_offset_;
+  std::vector<std::int32_t> entry_point_vertex_;
+  std::size_t num_shared_ = 0;  // vertices 0 .. num_shared_ - 1 are the shared points' (copies)
   std::vector<std::int64_t> vertex_start_, triangle_start_;  // per face, prefix sums
 
   ShadedMesh out_;
@@ -670,8 +777,9 @@ class Tessellation {
 
 StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface& surface,
                                             std::span<const std::array<int, 2>> density,
-                                            const PtexFile* map, int channel) {
-  return Tessellation(cage, surface, density, map, channel).Run();
+                                            const PtexFile* map, int channel,
+                                            BoundaryDisplacement boundary) {
+  return Tessellation(cage, surface, density, map, channel, boundary).Run();
 }
 
 ShadedMesh ShadePolygonMesh(const Mesh& mesh) {

@@ -191,6 +191,44 @@ TEST_F(SpotRender, CommandsWriteTheLibrarysPixels) {
   EXPECT_TRUE(ReadPng(dir / "plain.png").ok());
 }
 
+// `dispex render --per-face` writes the library's per-face pixels, which differ from the
+// default's where the map's faces disagree (one face of the cube raised).
+TEST(RenderCommand, PerFaceWritesEachFaceDisplacedOnItsOwn) {
+  TempDir dir;
+  const std::string cube = DataPath("meshes/opensubdiv/catmark_cube.obj");
+  render_test::WriteMap(dir / "raised.ptx", 6, 2,
+                        [](int f, double, double) { return f == 0 ? 0.3f : 0.f; });
+  const std::string common = " --size 240x180 --ao 2 -q";
+  const std::string inputs = "render " + cube + " " + (dir / "raised.ptx");
+  auto r = RunDispex(inputs + " --per-face --threads 1 -o " + (dir / "own.png") + common, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunDispex(inputs + " -o " + (dir / "mean.png") + common, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto own = ReadPng(dir / "own.png");
+  auto mean = ReadPng(dir / "mean.png");
+  ASSERT_TRUE(own.ok() && mean.ok());
+  EXPECT_EQ(own->width, 240);
+  EXPECT_EQ(own->height, 180);
+
+  auto base = ReadMesh(cube);
+  auto map = PtexFile::Open(dir / "raised.ptx");
+  ASSERT_TRUE(base.ok() && map.ok());
+  SurfaceRenderOptions options;
+  options.width = 240;
+  options.height = 180;
+  options.ao_samples = 2;
+  options.threads = 2;
+  options.per_face_displacement = true;
+  auto expected = RenderSurface(*base, &*map, options);
+  ASSERT_TRUE(expected.ok()) << expected.status().message();
+  EXPECT_EQ(own->rgb, expected->rgb);
+  int differ = 0;
+  for (int y = 0; y < own->height; ++y) {
+    for (int x = 0; x < own->width; ++x) differ += own->at(x, y) != mean->at(x, y);
+  }
+  EXPECT_GT(differ, 100) << "--per-face made no visible difference";
+}
+
 TEST_F(SpotRender, WritePreviewsWritesTheAtlasAndTheComparison) {
   TempDir dir;
   const std::string out = dir / "previews/nested";

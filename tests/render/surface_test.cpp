@@ -183,6 +183,73 @@ TEST(RenderSurface, SamePixelsWithOneOrTwoThreads) {
   EXPECT_EQ(one->rgb, two->rgb);
 }
 
+// Per-face displacement changes nothing where the faces' values agree along their edges: the
+// surface, its normals and so the pixels are the mean's.
+TEST(RenderSurface, PerFaceDisplacementIsTheMeanWhereFacesAgree) {
+  TempDir dir;
+  const std::string cube = render_test::DataPath("meshes/opensubdiv/catmark_cube.obj");
+  auto base = ReadMesh(cube);
+  ASSERT_TRUE(base.ok());
+  render_test::WriteMap(dir / "c.ptx", 6, 3, [](int, double, double) { return 0.2f; });
+  auto map = PtexFile::Open(dir / "c.ptx");
+  ASSERT_TRUE(map.ok());
+  SurfaceRenderOptions options;
+  options.width = 200;
+  options.height = 150;
+  options.ao_samples = 4;
+  auto mean = RenderSurface(*base, &*map, options);
+  options.per_face_displacement = true;
+  auto own = RenderSurface(*base, &*map, options);
+  ASSERT_TRUE(mean.ok() && own.ok());
+  EXPECT_EQ(own->rgb, mean->rgb);
+  // The constant moved the surface: the picture is not the undisplaced one.
+  auto plain = RenderSurface(*base, nullptr, options);
+  ASSERT_TRUE(plain.ok());
+  EXPECT_NE(own->rgb, plain->rgb);
+}
+
+// One face of the plane raised by a constant, seen from above at an angle: displaced per face,
+// the raised face stands apart from its neighbours and the background shows through the gap
+// along its near edges; the mean joins it to them with slopes and leaves no such hole.
+TEST(RenderSurface, PerFaceDisplacementShowsTheGapsAroundARaisedFace) {
+  Scene scene;
+  constexpr int kRaised = 3 * kGrid + 4;
+  render_test::WriteMap(scene.dir / "raised.ptx", kGrid * kGrid, 2,
+                        [](int f, double, double) { return f == kRaised ? 0.25f : 0.f; });
+  auto map = PtexFile::Open(scene.dir / "raised.ptx");
+  ASSERT_TRUE(map.ok());
+  SurfaceRenderOptions options;
+  options.width = 320;
+  options.height = 240;
+  options.view.preset = ViewPreset::kFront;
+  options.view.elevation = 30;
+  options.view.azimuth = 0;
+  auto mean = RenderSurface(scene.base, &*map, options);
+  options.per_face_displacement = true;
+  auto own = RenderSurface(scene.base, &*map, options);
+  options.threads = 1;
+  auto own_one_thread = RenderSurface(scene.base, &*map, options);
+  ASSERT_TRUE(mean.ok() && own.ok() && own_one_thread.ok());
+  EXPECT_EQ(own->rgb, own_one_thread->rgb);
+  // Background pixels with surface both above and below them in their column: holes in the
+  // plane as seen.
+  auto holes = [](const Image& image) {
+    int count = 0;
+    for (int x = 0; x < image.width; ++x) {
+      int top = -1, bottom = -1;
+      for (int y = 0; y < image.height; ++y) {
+        if (image.at(x, y) == kBackground) continue;
+        if (top < 0) top = y;
+        bottom = y;
+      }
+      for (int y = top + 1; y < bottom; ++y) count += image.at(x, y) == kBackground;
+    }
+    return count;
+  };
+  EXPECT_EQ(holes(*mean), 0);
+  EXPECT_GT(holes(*own), 50);
+}
+
 TEST(RenderSurface, MapOfAnotherMeshIsAnError) {
   Scene scene;
   render_test::WriteMap(scene.dir / "small.ptx", 10, 1, [](int, double, double) { return 0.f; });
@@ -218,13 +285,16 @@ TEST(RenderSurface, MapValuesThatAreNotFiniteAreAnErrorNamingTheFace) {
   ASSERT_TRUE(writer->Finish().ok());
   auto map = PtexFile::Open(path);
   ASSERT_TRUE(map.ok());
-  for (int threads : {1, 2}) {
-    SurfaceRenderOptions o = SideView();
-    o.threads = threads;
-    auto image = RenderSurface(scene.base, &*map, o);
-    ASSERT_FALSE(image.ok());
-    EXPECT_NE(image.status().message().find("nan.ptx: face 37 "), std::string::npos)
-        << image.status().message();
+  for (bool per_face : {false, true}) {
+    for (int threads : {1, 2}) {
+      SurfaceRenderOptions o = SideView();
+      o.threads = threads;
+      o.per_face_displacement = per_face;
+      auto image = RenderSurface(scene.base, &*map, o);
+      ASSERT_FALSE(image.ok());
+      EXPECT_NE(image.status().message().find("nan.ptx: face 37 "), std::string::npos)
+          << image.status().message();
+    }
   }
 }
 

@@ -259,6 +259,185 @@ TEST(Tessellation, SameMeshWithOneOrTwoThreads) {
   }
 }
 
+// Per-face displacement (BoundaryDisplacement::kPerFace).
+
+struct CageAndSurface {
+  Mesh cage;
+  std::optional<LimitSurface> surface;
+};
+
+CageAndSurface LoadCage(const std::string& path) {
+  CageAndSurface c;
+  auto cage = ReadMesh(path);
+  EXPECT_TRUE(cage.ok()) << cage.status().message();
+  c.cage = std::move(*cage);
+  auto surface = LimitSurface::Build(c.cage);
+  EXPECT_TRUE(surface.ok()) << surface.status().message();
+  c.surface.emplace(std::move(*surface));
+  return c;
+}
+
+ShadedMesh TessellateWith(const CageAndSurface& c, std::span<const std::array<int, 2>> density,
+                          const PtexFile* map, BoundaryDisplacement boundary) {
+  auto mesh = TessellateLimitSurface(c.cage, *c.surface, density, map, 0, boundary);
+  EXPECT_TRUE(mesh.ok()) << mesh.status().message();
+  return mesh.ok() ? std::move(*mesh) : ShadedMesh{};
+}
+
+bool SameBits(const Float3& a, const Float3& b) {
+  return std::memcmp(&a, &b, sizeof(Float3)) == 0;
+}
+
+// Positions as exact bit patterns, for counting distinct points.
+std::array<std::uint32_t, 3> Bits(const Float3& p) {
+  std::array<std::uint32_t, 3> b;
+  std::memcpy(b.data(), &p, sizeof(Float3));
+  return b;
+}
+
+std::size_t DistinctPositions(const Mesh& mesh) {
+  std::set<std::array<std::uint32_t, 3>> seen;
+  for (const Float3& p : mesh.positions) seen.insert(Bits(p));
+  return seen.size();
+}
+
+// Where every face's value agrees along the edges (a constant map), displacing each face on its
+// own gives the mean's surface: triangle by triangle the same positions and the same normals,
+// though every face has its own copies of the shared points.
+TEST(TessellationPerFace, SameSurfaceAsTheMeanWhereFacesAgree) {
+  TempDir dir;
+  for (const char* name : {"meshes/opensubdiv/catmark_cube.obj",
+                           "meshes/opensubdiv/catmark_pyramid.obj",
+                           "meshes/opensubdiv/catmark_fan.obj"}) {
+    for (int seed : {0, 2}) {
+      SCOPED_TRACE(std::string(name) + " seed " + std::to_string(seed));
+      const CageAndSurface c = LoadCage(DataPath(name));
+      const int faces = c.surface->num_ptex_faces();
+      render_test::WriteMap(dir / "c.ptx", faces, 2, [](int, double, double) { return 0.125f; });
+      auto map = PtexFile::Open(dir / "c.ptx");
+      ASSERT_TRUE(map.ok());
+      const auto density = MixedDensities(faces, seed);
+      const ShadedMesh mean = TessellateWith(c, density, &*map, BoundaryDisplacement::kMean);
+      const ShadedMesh own = TessellateWith(c, density, &*map, BoundaryDisplacement::kPerFace);
+      EXPECT_GT(own.mesh.num_vertices(), mean.mesh.num_vertices()) << "no per-face copies";
+      EXPECT_EQ(DistinctPositions(own.mesh), mean.mesh.num_vertices());
+      ASSERT_EQ(own.mesh.face_indices.size(), mean.mesh.face_indices.size());
+      int different = 0;
+      for (std::size_t k = 0; k < own.mesh.face_indices.size(); ++k) {
+        const auto a = static_cast<std::size_t>(own.mesh.face_indices[k]);
+        const auto b = static_cast<std::size_t>(mean.mesh.face_indices[k]);
+        different += !SameBits(own.mesh.positions[a], mean.mesh.positions[b]) ||
+                     !SameBits(own.normals[a], mean.normals[b]);
+      }
+      EXPECT_EQ(different, 0) << "triangle corners with another position or normal";
+    }
+  }
+}
+
+// One face raised by a constant, every other face 0. With per-face displacement each point of
+// the raised face's border has two vertices at the same undisplaced position, one moved by the
+// raise and one not: the gap is the raise, on that face's border only, and every triangle
+// (stitched fans included) uses its own face's copies. The mean welds them: no gap anywhere.
+TEST(TessellationPerFace, RaisedFaceOpensAGapOfTheRaiseAlongItsBorder) {
+  TempDir dir;
+  constexpr float kRaise = 0.1f;
+  struct Case {
+    const char* name;
+    int raised;
+    std::array<int, 2> raised_density, other_density;
+    std::size_t border_points;  // points on the raised face's border
+  };
+  const Case cases[] = {
+      {"meshes/opensubdiv/catmark_cube.obj", 0, {4, 4}, {4, 4}, 16},
+      {"meshes/opensubdiv/catmark_cube.obj", 0, {2, 2}, {4, 4}, 16},  // its cells stitched
+      {"meshes/opensubdiv/catmark_cube.obj", 3, {4, 4}, {2, 2}, 16},  // neighbours' stitched
+      // Sides of 2 and 4 segments beside 3: 5 and 7 merged points, corners counted twice.
+      {"meshes/opensubdiv/catmark_cube.obj", 5, {2, 4}, {3, 3}, 2 * 5 + 2 * 7 - 4},
+      {"meshes/opensubdiv/catmark_pyramid.obj", 0, {4, 4}, {4, 4}, 16},  // a sub-face
+      // The quad: each side beside two triangles' sub-faces of 4 segments on half of it.
+      {"meshes/opensubdiv/catmark_pyramid.obj", 12, {2, 2}, {4, 4}, 4 * 9 - 4},
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(std::string(k.name) + " face " + std::to_string(k.raised));
+    const CageAndSurface c = LoadCage(DataPath(k.name));
+    const int faces = c.surface->num_ptex_faces();
+    render_test::WriteMap(dir / "zero.ptx", faces, 2, [](int, double, double) { return 0.f; });
+    render_test::WriteMap(dir / "raised.ptx", faces, 2,
+                          [&](int f, double, double) { return f == k.raised ? kRaise : 0.f; });
+    auto zero = PtexFile::Open(dir / "zero.ptx");
+    auto raised = PtexFile::Open(dir / "raised.ptx");
+    ASSERT_TRUE(zero.ok() && raised.ok());
+    std::vector<std::array<int, 2>> density(static_cast<std::size_t>(faces), k.other_density);
+    density[static_cast<std::size_t>(k.raised)] = k.raised_density;
+
+    // Per face: the vertices are numbered independently of the map, so vertex v of `flat` is
+    // vertex v of `own` undisplaced.
+    const ShadedMesh flat = TessellateWith(c, density, &*zero, BoundaryDisplacement::kPerFace);
+    const ShadedMesh own = TessellateWith(c, density, &*raised, BoundaryDisplacement::kPerFace);
+    ASSERT_EQ(flat.mesh.num_vertices(), own.mesh.num_vertices());
+    const std::size_t n = own.mesh.num_vertices();
+    std::vector<int> moved(n);  // 1: moved by the raise, 0: not moved
+    int bad = 0;
+    for (std::size_t v = 0; v < n; ++v) {
+      const Float3& a = flat.mesh.positions[v];
+      const Float3& b = own.mesh.positions[v];
+      const double d = std::hypot(b.x - a.x, b.y - a.y, b.z - a.z);
+      moved[v] = d > kRaise / 2;
+      bad += std::abs(d - (moved[v] ? kRaise : 0.0)) > 1e-5;
+    }
+    EXPECT_EQ(bad, 0) << "vertices moved by neither the raise nor 0";
+    int mixed = 0, raised_triangles = 0;
+    for (std::size_t t = 0; t < own.mesh.num_faces(); ++t) {
+      const auto f = own.mesh.face(t);
+      int sum = 0;
+      for (std::int32_t v : f) sum += moved[static_cast<std::size_t>(v)];
+      mixed += sum == 1 || sum == 2;
+      raised_triangles += sum == 3;
+    }
+    EXPECT_EQ(mixed, 0) << "triangles using another face's copy of a point";
+    EXPECT_GT(raised_triangles, 0);
+    // Vertices at one undisplaced position: on the raised face's border some moved, some not.
+    std::map<std::array<std::uint32_t, 3>, std::array<int, 2>> at;  // -> (not moved, moved)
+    for (std::size_t v = 0; v < n; ++v) ++at[Bits(flat.mesh.positions[v])][moved[v]];
+    std::size_t gaps = 0;
+    for (const auto& [position, count] : at) gaps += count[0] > 0 && count[1] > 0;
+    EXPECT_EQ(gaps, k.border_points);
+    EXPECT_EQ(DistinctPositions(own.mesh), DistinctPositions(flat.mesh) + k.border_points);
+
+    // The mean: one vertex per point, raised or not, so no gap.
+    const ShadedMesh mean = TessellateWith(c, density, &*raised, BoundaryDisplacement::kMean);
+    const ShadedMesh mean_flat = TessellateWith(c, density, &*zero, BoundaryDisplacement::kMean);
+    EXPECT_EQ(mean.mesh.num_vertices(), DistinctPositions(flat.mesh));
+    EXPECT_EQ(DistinctPositions(mean.mesh), mean.mesh.num_vertices());
+    EXPECT_EQ(DistinctPositions(mean.mesh), DistinctPositions(mean_flat.mesh));
+  }
+}
+
+TEST(TessellationPerFace, SameMeshWithOneOrTwoThreads) {
+  TempDir dir;
+  const CageAndSurface c = LoadCage(DataPath("meshes/opensubdiv/catmark_fan.obj"));
+  const int faces = c.surface->num_ptex_faces();
+  render_test::WriteMap(dir / "m.ptx", faces, 2, [](int f, double u, double v) {
+    return static_cast<float>(0.01 * f + 0.05 * u * v);
+  });
+  auto map = PtexFile::Open(dir / "m.ptx");
+  ASSERT_TRUE(map.ok());
+  const auto density = MixedDensities(faces, 5);
+  ShadedMesh one, two;
+  tbb::task_arena(1).execute(
+      [&] { one = TessellateWith(c, density, &*map, BoundaryDisplacement::kPerFace); });
+  tbb::task_arena(2).execute(
+      [&] { two = TessellateWith(c, density, &*map, BoundaryDisplacement::kPerFace); });
+  EXPECT_EQ(one.mesh.face_indices, two.mesh.face_indices);
+  ASSERT_EQ(one.mesh.positions.size(), two.mesh.positions.size());
+  ASSERT_EQ(one.normals.size(), two.normals.size());
+  EXPECT_EQ(std::memcmp(one.mesh.positions.data(), two.mesh.positions.data(),
+                        one.mesh.positions.size() * sizeof(Float3)),
+            0);
+  EXPECT_EQ(
+      std::memcmp(one.normals.data(), two.normals.data(), one.normals.size() * sizeof(Float3)), 0);
+}
+
 TEST(Tessellation, PolygonMeshNormalsAndFans) {
   TempDir dir;
   // A pentagon and a quad sharing an edge, both facing +z.
