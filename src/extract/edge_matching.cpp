@@ -15,6 +15,7 @@ namespace {
 constexpr int kMaxRounds = 8;
 // A raise must bring an edge's step below this fraction of what it was to be worth another.
 constexpr double kProgress = 0.75;
+constexpr int kFutileRaises = 2;
 
 // A face whose data may jump at its edges: samples filled over holes of the sculpt, or hits
 // on another sheet (folds, thin parts). Its edges are not held; they are counted.
@@ -88,6 +89,7 @@ Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
   std::vector<std::array<int, 2>> least(n, {0, 0});
   std::vector<std::uint8_t> raised(n, 0);
   std::map<std::pair<int, int>, double> last_step;  // (face, edge) -> step when last raised
+  std::map<std::pair<int, int>, int> futile;        // raises that did not bring it down
   PtexEdgeSteps steps;
   MapView view;
   for (int round = 0;; ++round) {
@@ -112,7 +114,8 @@ Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
       const double step = std::max(over_filter ? s.across_faces : 0.0, over_face ? s.per_face : 0.0);
       const auto key = std::make_pair(s.face, s.edge);
       if (auto it = last_step.find(key); it != last_step.end() && step > kProgress * it->second) {
-        continue;  // the last raise did not help: the displacement itself steps here
+        // The last raise did not help; after two such the displacement itself steps here.
+        if (++futile[key] >= kFutileRaises) continue;
       }
       const PtexFaceInfo& a = view.faces[static_cast<std::size_t>(s.face)];
       const PtexFaceInfo& b = view.faces[static_cast<std::size_t>(s.neighbour)];

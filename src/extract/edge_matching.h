@@ -15,7 +15,7 @@ namespace dispex {
 // settings.edge_step_budget, raise the resolution that causes it -- through the cross-face
 // filter the coarser side (along the edge first, then across), for per-face reading
 // (WatertightEdges::kAll) both sides across the edge -- and run ProcessFace again for the
-// raised faces. An edge whose step fell by less than a quarter since its last raise, or whose
+// raised faces. An edge whose step twice fell by less than a quarter after a raise, or whose
 // faces are already at their sample resolution, is left as it is and counted. Edges on
 // infinitely sharp creases and next to faces that missed entirely are not held. Fills the
 // report's edge fields. Deterministic: decisions depend only on the texels.
