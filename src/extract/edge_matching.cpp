@@ -154,21 +154,28 @@ Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
 
   report.edges_shared = static_cast<std::int64_t>(steps.edges);
   report.edges_sharp = static_cast<std::int64_t>(steps.skipped_edges);
-  std::vector<std::uint8_t> holes(n), discontinuous(n);
-  for (std::size_t f = 0; f < n; ++f) {
-    report.edge_raised_faces += raised[f];
-    holes[f] = inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
-    discontinuous[f] = !holes[f] && view.skip_faces[f];
-    if (discontinuous[f]) report.discontinuous_faces.push_back(static_cast<std::int32_t>(f));
-  }
-  report.edges_discontinuous =
-      static_cast<std::int64_t>(CountEdgesTouching(view.faces, discontinuous, holes));
+  for (std::size_t f = 0; f < n; ++f) report.edge_raised_faces += raised[f];
+  ListDiscontinuousFaces(inputs, faces, report);
   for (const PtexEdgeStep& s : steps.edge_max) {
     report.edge_step_per_face = std::max(report.edge_step_per_face, s.per_face);
     report.edge_step_across_faces = std::max(report.edge_step_across_faces, s.across_faces);
     report.edges_over += s.across_faces > budget || (per_face && s.per_face > budget);
   }
   return Status::Ok();
+}
+
+void ListDiscontinuousFaces(const ExtractInputs& inputs, const ProcessedFaces& faces,
+                            ExtractReport& report) {
+  const std::size_t n = faces.stats.size();
+  std::vector<std::uint8_t> holes(n), discontinuous(n);
+  report.discontinuous_faces.clear();
+  for (std::size_t f = 0; f < n; ++f) {
+    holes[f] = inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
+    discontinuous[f] = !holes[f] && Discontinuous(faces.stats[f]);
+    if (discontinuous[f]) report.discontinuous_faces.push_back(static_cast<std::int32_t>(f));
+  }
+  report.edges_discontinuous =
+      static_cast<std::int64_t>(CountEdgesTouching(inputs.faces, discontinuous, holes));
 }
 
 }  // namespace dispex

@@ -22,4 +22,10 @@ namespace dispex {
 Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
                   ProcessedFaces& faces, ExtractReport& report);
 
+// Faces whose displacement may jump (samples filled over holes of the sculpt, other-sheet hits,
+// no hit at all) into report.discontinuous_faces, and the edges beside them into
+// report.edges_discontinuous, whether or not edges are made watertight.
+void ListDiscontinuousFaces(const ExtractInputs& inputs, const ProcessedFaces& faces,
+                            ExtractReport& report);
+
 }  // namespace dispex

@@ -19,8 +19,8 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& report);
 // Adds the standard mesh meta data (PtexFaceVertCounts, ...) and dispex's own keys:
 // dispex:version, dispex:base, dispex:base_fingerprint, dispex:sculpt,
 // dispex:sculpt_fingerprint, dispex:options (JSON), dispex:statistics (JSON),
-// dispex:tolerance, dispex:search_distance, and with watertight edges
-// dispex:discontinuous_faces (int32 Ptex face ids whose edges were not held; when any).
+// dispex:tolerance, dispex:search_distance, and dispex:discontinuous_faces (int32 Ptex face
+// ids whose data may jump at their edges; when there are any).
 Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractReport& report);
 
 }  // namespace dispex
