@@ -5,7 +5,7 @@ JOBS        ?= $(shell nproc)
 WERROR      ?= OFF
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build demo test test-sanitize test-tsan bench fuzz format clean
+.PHONY: all deps configure build demo test test-sanitize test-tsan bench fuzz format format-check clean
 
 all: build
 
@@ -51,8 +51,16 @@ test-tsan: deps
 	@scripts/build-tsan-tbb.sh $(BUILD)-tsan/tbb
 	@scripts/tsan-extract.sh $(BUILD)-tsan
 
+# The tree's formatting, by Debian's clang-format 14 (pinned: other versions format some
+# constructs differently). `format-check` fails, listing the files, when one differs.
+CLANG_FORMAT ?= clang-format-14
 format:
-	@clang-format -i $$(git ls-files '*.cpp' '*.h')
+	@DISPEX_WITH_FORMAT=1 scripts/install-deps.sh
+	@$(CLANG_FORMAT) -i $$(git ls-files '*.cpp' '*.h')
+
+format-check:
+	@DISPEX_WITH_FORMAT=1 scripts/install-deps.sh
+	@$(CLANG_FORMAT) --dry-run --Werror $$(git ls-files '*.cpp' '*.h')
 
 clean:
 	rm -rf $(BUILD) $(BUILD)-sanitize $(BUILD)-tsan

@@ -10,6 +10,9 @@ packages=(
   libfast-float-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libpng-dev libgtest-dev libgmock-dev libbenchmark-dev
 )
+if [[ "${DISPEX_WITH_FORMAT:-0}" == 1 ]]; then
+  packages+=(clang-format-14)
+fi
 if [[ "${DISPEX_WITH_FUZZ:-0}" == 1 ]]; then
   packages+=(clang libclang-rt-14-dev)
 fi
