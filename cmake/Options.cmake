@@ -7,11 +7,12 @@ if(DISPEX_WERROR)
   target_compile_options(dispex_warnings INTERFACE -Werror)
 endif()
 
-# dispex_options: flags every dispex target shares (sanitizers, include root).
+# dispex_options: flags every dispex target shares (sanitizers, the public include root).
+# src/ is not on it: a module's internal headers are reached only through its
+# dispex::<name>_internal target (see dispex_add_library).
 add_library(dispex_options INTERFACE)
 target_include_directories(dispex_options INTERFACE
-  $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>
-  $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src>)
+  $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>)
 if(DISPEX_SANITIZE)
   target_compile_options(dispex_options INTERFACE -fsanitize=address,undefined
     -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
@@ -25,9 +26,27 @@ if(DISPEX_TSAN)
   target_link_options(dispex_options INTERFACE -fsanitize=thread)
 endif()
 
-# dispex_add_library(NAME SOURCES... ) : one static library per src/ folder, alias dispex::NAME.
+# dispex_add_library(NAME SOURCES... ) : one static library per src/ folder, alias dispex::NAME,
+# plus dispex::NAME_internal, an interface target that puts the module's own headers
+# (src/NAME/*.h, included as "NAME/x.h") on the include path and nothing else of src/. Each
+# include root under build/internal_include/NAME holds one link, NAME -> src/NAME, so a target
+# sees exactly the internals it links: the module itself (PRIVATE), core's (every module builds
+# on core), and, for tests and benchmarks, those they link by name. The public headers
+# (include/dispex) are visible to all; tests/layering checks they point down the pipeline.
 function(dispex_add_library name)
   add_library(dispex_${name} STATIC ${ARGN})
   add_library(dispex::${name} ALIAS dispex_${name})
-  target_link_libraries(dispex_${name} PRIVATE dispex_warnings PUBLIC dispex_options)
+  set(root ${PROJECT_BINARY_DIR}/internal_include/${name})
+  file(MAKE_DIRECTORY ${root})
+  file(CREATE_LINK ${PROJECT_SOURCE_DIR}/src/${name} ${root}/${name} SYMBOLIC)
+  add_library(dispex_${name}_internal INTERFACE)
+  add_library(dispex::${name}_internal ALIAS dispex_${name}_internal)
+  target_include_directories(dispex_${name}_internal INTERFACE $<BUILD_INTERFACE:${root}>)
+  target_link_libraries(dispex_${name}_internal INTERFACE dispex_options)
+  if(NOT name STREQUAL "core")
+    target_link_libraries(dispex_${name}_internal INTERFACE dispex_core_internal)
+    target_link_libraries(dispex_${name} PRIVATE dispex_core)
+  endif()
+  target_link_libraries(dispex_${name} PRIVATE dispex_warnings dispex_${name}_internal
+                        PUBLIC dispex_options)
 endfunction()

@@ -5,9 +5,9 @@
 
 #include "command.h"
 #include "flag_names.h"
-#include "core/atomic_output.h"
-#include "core/cancel.h"
+#include "dispex/cancel.h"
 #include "dispex/extract.h"
+#include "dispex/files.h"
 #include "dispex/render.h"
 
 namespace dispex::cli {

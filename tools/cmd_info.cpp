@@ -1,7 +1,7 @@
 #include <fstream>
 
 #include "command.h"
-#include "core/mapped_file.h"
+#include "dispex/files.h"
 #include "info.h"
 
 namespace dispex::cli {

@@ -2,12 +2,12 @@
 // [--size WxH]
 #include <fmt/format.h>
 
+#include <chrono>
 #include <cmath>
 #include <optional>
 
 #include "command.h"
 #include "flag_names.h"
-#include "core/system.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
 #include "dispex/render.h"
@@ -65,7 +65,7 @@ Status Resolve(RenderArgs& a) {
 int RunRender(RenderArgs& args) {
   Status resolved = Resolve(args);
   if (!resolved.ok()) return ReportFailure(resolved, kRenderFlags, 2);
-  Stopwatch clock;
+  const auto start = std::chrono::steady_clock::now();
   ReadOptions read;
   read.threads = args.options.threads;
   auto base = ReadMesh(args.files[0], read);
@@ -95,7 +95,8 @@ int RunRender(RenderArgs& args) {
   if (!written.ok()) return ReportFailure(written);
   if (!args.quiet) {
     fmt::print(stderr, "dispex: {} ({}x{}, {} view) in {:.2f}s\n", args.output_path, image->width,
-               image->height, args.view, clock.seconds());
+               image->height, args.view,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   return 0;
 }

@@ -6,7 +6,7 @@
 
 #include "command.h"
 #include "flag_names.h"
-#include "core/atomic_output.h"
+#include "dispex/files.h"
 #include "dispex/verify.h"
 
 namespace dispex::cli {

@@ -28,7 +28,7 @@ struct Summary {
 
 constexpr float kInfiniteSharpness = 10.0f;  // Sdc::Crease::SHARPNESS_INFINITE
 
-const char* BoundaryName(BoundaryInterpolation b) {
+std::string_view BoundaryName(BoundaryInterpolation b) {
   switch (b) {
     case BoundaryInterpolation::kNone:
       return "none";
@@ -40,11 +40,11 @@ const char* BoundaryName(BoundaryInterpolation b) {
   return "?";
 }
 
-const char* CreaseMethodName(CreaseMethod m) {
+std::string_view CreaseMethodName(CreaseMethod m) {
   return m == CreaseMethod::kChaikin ? "chaikin" : "uniform";
 }
 
-const char* TrianglesName(TriangleSubdivision t) {
+std::string_view TrianglesName(TriangleSubdivision t) {
   return t == TriangleSubdivision::kSmooth ? "smooth" : "catmark";
 }
 
@@ -152,11 +152,11 @@ void PrintJson(const InfoOptions& options, const Mesh& mesh, const Summary& s) {
                {"infinitely_sharp_creases", s.infinite_creases},
                {"corners", t.corners.size()},
                {"holes", t.holes.size()},
-               {"boundary", BoundaryName(t.boundary)},
+               {"boundary", std::string(BoundaryName(t.boundary))},
                {"boundary_from_file", t.boundary_from_file},
-               {"crease_method", CreaseMethodName(t.crease_method)},
+               {"crease_method", std::string(CreaseMethodName(t.crease_method))},
                {"crease_method_from_file", t.crease_method_from_file},
-               {"triangles", TrianglesName(t.triangles)},
+               {"triangles", std::string(TrianglesName(t.triangles))},
                {"triangles_from_file", t.triangles_from_file},
                {"ignored", t.ignored_tag_names.size()},
                {"ignored_names", DistinctNames(t.ignored_tag_names)}};

@@ -12,8 +12,8 @@
 
 #include "command.h"
 #include "dispex/ptex.h"
+#include "dispex/ptex_describe.h"
 #include "info.h"
-#include "ptex/describe.h"
 
 namespace dispex::cli {
 
@@ -24,7 +24,7 @@ constexpr std::size_t kMaxJsonValues = 64;
 nlohmann::json MetaJson(const PtexMetaItem& item) {
   nlohmann::json j;
   j["key"] = item.key;
-  j["type"] = PtexName(item.type);
+  j["type"] = std::string(PtexMetaTypeName(item.type));
   j["count"] = item.count();
   j["large"] = item.large;
   if (item.type == PtexMetaType::kString) {
@@ -44,8 +44,8 @@ nlohmann::json SummaryJson(const PtexFile& file, bool with_faces) {
   j["file"] = file.name();
   j["size_bytes"] = h.file_size;
   j["minor_version"] = h.minor_version;
-  j["mesh_type"] = PtexName(h.mesh_type);
-  j["data_type"] = PtexName(h.data_type);
+  j["mesh_type"] = std::string(PtexMeshTypeName(h.mesh_type));
+  j["data_type"] = std::string(PtexDataTypeName(h.data_type));
   j["channels"] = h.num_channels;
   j["alpha_channel"] = h.alpha_channel;
   j["faces"] = h.num_faces;
@@ -65,9 +65,9 @@ nlohmann::json SummaryJson(const PtexFile& file, bool with_faces) {
   nlohmann::json levels = nlohmann::json::array();
   for (const PtexLevelInfo& l : file.levels()) levels.push_back(l.num_entries);
   j["level_entries"] = levels;
-  j["u_border"] = PtexName(h.u_border);
-  j["v_border"] = PtexName(h.v_border);
-  j["edge_filter"] = PtexName(h.edge_filter);
+  j["u_border"] = std::string(PtexBorderModeName(h.u_border));
+  j["v_border"] = std::string(PtexBorderModeName(h.v_border));
+  j["edge_filter"] = std::string(PtexEdgeFilterModeName(h.edge_filter));
   j["texels_level0"] = texels0;
   j["texels_reductions"] = texels_reduced;
   j["has_edits"] = h.has_edits;
@@ -116,14 +116,14 @@ int PtexInfo(const InfoOptions& options) {
   }
   std::string out;
   if (options.faces) {
-    if (Status s = ptex::FormatPtexFaces(file, out); !s.ok()) return ReportFailure(s);
+    if (Status s = FormatPtexFaces(file, out); !s.ok()) return ReportFailure(s);
   }
   if (options.dump_face >= 0) {
-    if (Status s = ptex::FormatPtexTexels(file, PtexFaceId(options.dump_face), out); !s.ok()) {
+    if (Status s = FormatPtexTexels(file, PtexFaceId(options.dump_face), out); !s.ok()) {
       return ReportFailure(s);
     }
   }
-  if (!options.faces && options.dump_face < 0) out = ptex::FormatPtexSummary(file);
+  if (!options.faces && options.dump_face < 0) out = FormatPtexSummary(file);
   std::fputs(out.c_str(), stdout);
   return 0;
 }

@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
     TracerOptions o;
     o.quality = q;
     auto tracer = Must(MakeEmbreeTracer(sculpt, o));
-    out[key] = {{"what", fmt::format("BVH build, {} quality", ToString(q))},
+    out[key] = {{"what", fmt::format("BVH build, {} quality", BuildQualityName(q))},
                 {"seconds", tracer->stats().build_seconds},
                 {"bytes", tracer->stats().backend_bytes}};
   }
@@ -135,9 +135,9 @@ int main(int argc, char** argv) {
     }
     std::uint64_t rays = 0;
     for (auto& c : counters) rays += c.rays_cast;
-    out[fmt::format("rays_{}", ToString(mode))] = {
+    out[fmt::format("rays_{}", RayModeName(mode))] = {
         {"what", fmt::format("dispex's {} kernel alone on the samples (cuts, guard, exact t)",
-                             ToString(mode))},
+                             RayModeName(mode))},
         {"seconds", seconds},
         {"rays", rays},
         {"mrays_per_s", double(rays) / 1e6 / seconds}};

@@ -166,6 +166,12 @@ StatusOr<Mesh> ParseObj(std::string_view bytes, const std::string& name,
 StatusOr<Mesh> ParsePly(std::string_view bytes, const std::string& name,
                         const ReadOptions& options = {});
 
+// Writes `mesh` as a Wavefront OBJ (`header` verbatim, e.g. comment lines, then v and f lines,
+// 1-based indices), atomically: the file appears whole or not at all. Floats are printed in their
+// shortest round-trip form, so ReadObj gives back the same positions bit for bit. Faces only:
+// no UVs, no subdivision tags.
+Status WriteObj(const std::string& path, const Mesh& mesh, const std::string& header = {});
+
 // ---- Validation and summary ----------------------------------------------------------------
 
 // What ValidateMesh finds. clean() ignores boundary edges (open meshes are fine).
@@ -214,5 +220,9 @@ BoundingBox ComputeBounds(const Mesh& mesh);
 // median of every k-th side, k the smallest prime >= max(5, sides / 2^22): deterministic, and
 // a prime stride does not alias with the corners of triangles and quads.
 double MedianEdgeLength(const Mesh& mesh);
+
+// Total area of the faces (n-gons as triangle fans from their first vertex), in double.
+// Deterministic for any thread count.
+double MeshArea(const Mesh& mesh);
 
 }  // namespace dispex

@@ -48,11 +48,11 @@ enum class PtexMetaType : std::uint8_t {
 int PtexDataSize(PtexDataType type);
 // "uint8", "uint16", "half", "float32"; "triangle", "quad"; "clamp", "black", "periodic";
 // "none", "tanvec"; "string", "int8", "int16", "int32", "float", "double".
-const char* PtexName(PtexDataType type);
-const char* PtexName(PtexMeshType type);
-const char* PtexName(PtexBorderMode mode);
-const char* PtexName(PtexEdgeFilterMode mode);
-const char* PtexName(PtexMetaType type);
+std::string_view PtexDataTypeName(PtexDataType type);
+std::string_view PtexMeshTypeName(PtexMeshType type);
+std::string_view PtexBorderModeName(PtexBorderMode mode);
+std::string_view PtexEdgeFilterModeName(PtexEdgeFilterMode mode);
+std::string_view PtexMetaTypeName(PtexMetaType type);
 
 // The face record of the file (20 bytes on disk), unpacked.
 struct PtexFaceInfo {

@@ -153,6 +153,10 @@ struct SpectralFace {
 // algorithm does not depend on timing, plus FFTW_CONSERVE_MEMORY, so that FFTW wisdom other
 // code in the process gathers with default flags is not adopted (it would change last bits).
 // A moved-from analyzer may only be destroyed or assigned to.
+namespace spectral {
+struct AnalyzerSteps;
+}  // namespace spectral
+
 class SpectralAnalyzer {
  public:
   SpectralAnalyzer();
@@ -170,6 +174,11 @@ class SpectralAnalyzer {
   StatusOr<SpectralFace> Analyze(std::span<const float> samples, int nx, int ny,
                                  const SpectralOptions& options);
 
+ private:
+  // The analysis's steps one at a time, for tests and benchmarks: reached through
+  // spectral::AnalyzerSteps (src/spectral/analyzer_steps.h), not part of the library's API.
+  friend struct spectral::AnalyzerSteps;
+
   // Orthonormal 2-D DCT-II of an nx x ny block: coefficients[v * nx + u] = F(u,v).
   // Same size rules as Analyze; `coefficients` must hold nx * ny values and not overlap.
   Status ForwardDct(std::span<const float> samples, int nx, int ny, std::span<float> coefficients);
@@ -184,21 +193,8 @@ class SpectralAnalyzer {
   Status Resample(std::span<const float> samples, int nx, int ny, int ulog2, int vlog2,
                   std::span<float> texels);
 
- private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-// What a renderer reads from a face of 2^ulog2 x 2^vlog2 texels at the nx x ny sample
-// positions ((i+0.5)/nx, (j+0.5)/ny): bilinear interpolation between texel centres
-// ((k+0.5)/rx, ...), the value of the edge texel beyond the outermost centres (Ptex's clamp
-// at a face border). `out` holds nx * ny values. Errors: sizes as for Analyze, span sizes.
-Status BilinearReadBack(std::span<const float> texels, int ulog2, int vlog2, int nx, int ny,
-                        std::span<float> out);
-
-// max over samples of |BilinearReadBack(texels)(i,j) - samples(i,j)|, computed in double
-// without rounding the read-back to float. Allocation-free. Errors as BilinearReadBack.
-StatusOr<double> MaxBilinearError(std::span<const float> texels, int ulog2, int vlog2,
-                                  std::span<const float> samples, int nx, int ny);
 
 }  // namespace dispex

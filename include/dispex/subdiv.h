@@ -120,10 +120,12 @@ class LimitSurface {
   // gap or an overlap. Boundary edges are not listed.
   std::span<const CageEdge> inf_sharp_edges() const;
 
-  struct Impl;
-  const Impl& impl() const { return *impl_; }  // for dispex::subdiv internals
+  struct Impl;  // defined in src/subdiv/surface_impl.h
 
  private:
+  // Evaluators and uniform refinement read the surface's state through SurfaceImpl
+  // (src/subdiv/surface_impl.h).
+  friend const Impl& SurfaceImpl(const LimitSurface& surface);
   explicit LimitSurface(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

@@ -86,10 +86,10 @@ struct TracerOptions {
 std::span<const std::string_view> EmbreeIsaNames();
 std::vector<std::string_view> SupportedEmbreeIsas();
 
-std::string_view ToString(HitPolicy policy);      // "nearest", "outside-first", "inside-first"
-std::string_view ToString(BuildQuality quality);  // "low", "medium", "high"
-std::string_view ToString(RayMode mode);  // "single", "packet4", "packet8", "packet16", "stream"
-// Inverses of ToString. An unknown name is an error that lists the valid names.
+std::string_view HitPolicyName(HitPolicy policy);  // "nearest", "outside-first", "inside-first"
+std::string_view BuildQualityName(BuildQuality quality);  // "low", "medium", "high"
+std::string_view RayModeName(RayMode mode);  // "single", "packet4", "packet8", "packet16", "stream"
+// Inverses of the names. An unknown name is an error that lists the valid names.
 StatusOr<HitPolicy> ParseHitPolicy(std::string_view name);
 StatusOr<BuildQuality> ParseBuildQuality(std::string_view name);
 StatusOr<RayMode> ParseRayMode(std::string_view name);

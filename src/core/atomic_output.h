@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <string>
 
+#include "dispex/files.h"  // WriteFileAtomically
 #include "dispex/status.h"
 
 namespace dispex {
@@ -43,9 +44,6 @@ class AtomicOutput {
   int slot_ = -1;
   std::size_t written_ = 0;
 };
-
-// Writes `size` bytes to `target` atomically.
-Status WriteFileAtomically(const std::string& target, const void* data, std::size_t size);
 
 // Unlinks every temporary file of live AtomicOutputs. Async-signal-safe: a SIGINT/SIGTERM
 // handler calls it before exiting.

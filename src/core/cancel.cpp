@@ -1,4 +1,4 @@
-#include "core/cancel.h"
+#include "dispex/cancel.h"
 
 #include <signal.h>
 #include <sys/time.h>

@@ -6,6 +6,7 @@
 #include <string>
 #include <string_view>
 
+#include "dispex/files.h"  // CheckReadableFile
 #include "dispex/status.h"
 
 namespace dispex {
@@ -31,9 +32,5 @@ class MappedFile {
   const char* data_ = nullptr;
   std::size_t size_ = 0;
 };
-
-// Checks that `path` names an existing, readable regular file; the message says which of
-// these is not the case.
-Status CheckReadableFile(const std::string& path);
 
 }  // namespace dispex

@@ -8,6 +8,7 @@
 #include <optional>
 #include <span>
 
+#include "core/vec3.h"
 #include "extract/parallel_errors.h"
 
 namespace dispex {
@@ -36,12 +37,12 @@ StatusOr<CoarseSampling> SampleCoarsely(const LimitSurface& surface) {
     for (int j = 0; j + 1 < kGrid; ++j) {
       for (int i = 0; i + 1 < kGrid; ++i) {
         auto at = [&](int ii, int jj, int c) { return double(p[3 * (jj * kGrid + ii) + c]); };
-        double ax = at(i + 1, j + 1, 0) - at(i, j, 0), ay = at(i + 1, j + 1, 1) - at(i, j, 1),
-               az = at(i + 1, j + 1, 2) - at(i, j, 2);
-        double bx = at(i, j + 1, 0) - at(i + 1, j, 0), by = at(i, j + 1, 1) - at(i + 1, j, 1),
-               bz = at(i, j + 1, 2) - at(i + 1, j, 2);
-        double cx = ay * bz - az * by, cy = az * bx - ax * bz, cz = ax * by - ay * bx;
-        area += 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
+        auto point = [&](int ii, int jj) {
+          return Vec3d{at(ii, jj, 0), at(ii, jj, 1), at(ii, jj, 2)};
+        };
+        const Vec3d diagonal1 = point(i + 1, j + 1) - point(i, j);
+        const Vec3d diagonal2 = point(i, j + 1) - point(i + 1, j);
+        area += 0.5 * Length(Cross(diagonal1, diagonal2));
       }
     }
     out.face_areas[static_cast<std::size_t>(f)] = area / (0.75 * 0.75);

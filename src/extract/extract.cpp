@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <optional>
 
-#include "core/cancel.h"
 #include "core/system.h"
+#include "dispex/cancel.h"
 #include "dispex/extract.h"
 #include "dispex/version.h"
 #include "extract/extract_inputs.h"

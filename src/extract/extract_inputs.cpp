@@ -6,9 +6,10 @@
 #include <algorithm>
 #include <optional>
 
-#include "core/cancel.h"
 #include "core/content_hash.h"
 #include "core/system.h"
+#include "dispex/cancel.h"
+#include "extract/memory_check.h"
 #include "extract/parallel_errors.h"
 #include "extract/ptex_face_table.h"
 

@@ -11,7 +11,7 @@ std::string FileName(const std::string& path) {
   return std::filesystem::path(path).filename().string();
 }
 
-const char* SearchKindName(SearchDistanceSpec::Kind kind) {
+std::string_view SearchKindName(SearchDistanceSpec::Kind kind) {
   switch (kind) {
     case SearchDistanceSpec::Kind::kAuto: return "auto";
     case SearchDistanceSpec::Kind::kAbsolute: return "absolute";
@@ -26,19 +26,19 @@ nlohmann::json ExtractOptionsJson(const ExtractOptions& o) {
   j["oversample"] = o.oversample == 0 ? nlohmann::json("auto") : nlohmann::json(o.oversample);
   j["max_oversample"] = o.max_oversample;
   j["min_oversample"] = o.min_oversample;
-  j["search_distance"] = {{"kind", SearchKindName(o.search_distance.kind)},
+  j["search_distance"] = {{"kind", std::string(SearchKindName(o.search_distance.kind))},
                           {"value", o.search_distance.value}};
-  j["ray_policy"] = std::string(ToString(o.ray_policy));
+  j["ray_policy"] = std::string(HitPolicyName(o.ray_policy));
   j["tolerance"] = o.tolerance == 0 ? nlohmann::json("auto") : nlohmann::json(o.tolerance);
   j["tolerance_fraction"] = o.tolerance_fraction;
   j["resolution_rule"] = std::string(ResolutionRuleName(o.resolution_rule));
   j["nonzero_threshold"] = o.nonzero_threshold;
   j["fixed_resolution"] = {1 << o.fixed_ulog2, 1 << o.fixed_vlog2};
-  j["data_type"] = PtexName(o.data_type);
+  j["data_type"] = std::string(PtexDataTypeName(o.data_type));
   j["compression_level"] = o.compression_level;
   j["holes"] = std::string(HolePolicyName(o.holes));
   j["max_miss_fraction"] = o.max_miss_fraction;
-  j["bvh_quality"] = std::string(ToString(o.bvh_quality));
+  j["bvh_quality"] = std::string(BuildQualityName(o.bvh_quality));
   j["watertight"] = std::string(WatertightEdgesName(o.watertight));
   return j;
 }

@@ -1,4 +1,6 @@
 // The max_memory admission check: refuse work that will not fit before doing any of it.
+#include "extract/memory_check.h"
+
 #include <fmt/format.h>
 
 #include <filesystem>

@@ -37,28 +37,6 @@ int SubdivisionLevel(const LimitSurface& surface, const Mesh& sculpt) {
 
 }  // namespace
 
-double MeshArea(const Mesh& mesh) {
-  const std::size_t n = mesh.num_faces();
-  return tbb::parallel_deterministic_reduce(
-      tbb::blocked_range<std::size_t>(0, n, 4096), 0.0,
-      [&](const tbb::blocked_range<std::size_t>& range, double sum) {
-        for (std::size_t f = range.begin(); f < range.end(); ++f) {
-          auto face = mesh.face(f);
-          const Float3& a = mesh.positions[static_cast<std::size_t>(face[0])];
-          for (std::size_t k = 1; k + 1 < face.size(); ++k) {
-            const Float3& b = mesh.positions[static_cast<std::size_t>(face[k])];
-            const Float3& c = mesh.positions[static_cast<std::size_t>(face[k + 1])];
-            double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
-            double vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
-            double cx = uy * vz - uz * vy, cy = uz * vx - ux * vz, cz = ux * vy - uy * vx;
-            sum += 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
-          }
-        }
-        return sum;
-      },
-      [](double a, double b) { return a + b; });
-}
-
 OversamplingPlan PlanOversampling(const LimitSurface& surface, const Mesh& sculpt,
                                   const std::vector<double>& face_areas, int fixed,
                                   int min_samples, int max_samples) {

@@ -29,7 +29,4 @@ OversamplingPlan PlanOversampling(const LimitSurface& surface, const Mesh& sculp
                                   const std::vector<double>& face_areas, int fixed,
                                   int min_samples, int max_samples);
 
-// Total area of a polygon mesh (n-gons as fans). Deterministic for any thread count.
-double MeshArea(const Mesh& mesh);
-
 }  // namespace dispex

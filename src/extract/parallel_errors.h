@@ -4,8 +4,8 @@
 
 #include <fmt/format.h>
 
-#include "core/cancel.h"
 #include "core/first_error.h"
+#include "dispex/cancel.h"
 #include "dispex/status.h"
 
 namespace dispex {

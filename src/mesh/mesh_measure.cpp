@@ -1,4 +1,4 @@
-// ComputeBounds, BoundingBox::diagonal and MedianEdgeLength.
+// ComputeBounds, BoundingBox::diagonal, MedianEdgeLength and MeshArea.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
@@ -7,6 +7,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/vec3.h"
 #include "dispex/mesh.h"
 
 namespace dispex {
@@ -95,6 +96,28 @@ double MedianEdgeLength(const Mesh& mesh) {
   const double lower =
       *std::max_element(lengths.begin(), lengths.begin() + static_cast<std::ptrdiff_t>(mid));
   return 0.5 * (lower + upper);
+}
+
+double MeshArea(const Mesh& mesh) {
+  const std::size_t n = mesh.num_faces();
+  return tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<std::size_t>(0, n, 4096), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double sum) {
+        for (std::size_t f = range.begin(); f < range.end(); ++f) {
+          auto face = mesh.face(f);
+          const Float3& a = mesh.positions[static_cast<std::size_t>(face[0])];
+          for (std::size_t k = 1; k + 1 < face.size(); ++k) {
+            const Float3& b = mesh.positions[static_cast<std::size_t>(face[k])];
+            const Float3& c = mesh.positions[static_cast<std::size_t>(face[k + 1])];
+            // Sides in float, as the positions are stored, then the cross product in double.
+            const Vec3d u{b.x - a.x, b.y - a.y, b.z - a.z};
+            const Vec3d v{c.x - a.x, c.y - a.y, c.z - a.z};
+            sum += 0.5 * Length(Cross(u, v));
+          }
+        }
+        return sum;
+      },
+      [](double a, double b) { return a + b; });
 }
 
 }  // namespace dispex

@@ -84,7 +84,7 @@ bool IsInteger(Type type) {
   return type != Type::kFloat32 && type != Type::kFloat64;
 }
 
-const char* TypeName(Type type) {
+std::string_view TypeName(Type type) {
   for (const TypeInfo& info : kTypes) {
     if (info.type == type) return info.name;
   }

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <string_view>
 #include <vector>
 
 #include "dispex/status.h"
@@ -35,7 +36,7 @@ enum class Type : std::uint8_t {
 
 int SizeOf(Type type);
 bool IsInteger(Type type);
-const char* TypeName(Type type);
+std::string_view TypeName(Type type);
 
 struct Property {
   std::string name;

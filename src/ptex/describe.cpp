@@ -42,7 +42,7 @@ std::string TexelText(const std::uint8_t* p, int channels, PtexDataType type) {
   return s + ")";
 }
 
-const char* EncodingName(PtexBlockInfo::Encoding e) {
+std::string_view EncodingName(PtexBlockInfo::Encoding e) {
   switch (e) {
     case PtexBlockInfo::Encoding::kConstant:
       return "constant";
@@ -103,6 +103,12 @@ std::string FormatMetaValue(const PtexMetaItem& item, std::size_t max_values) {
   return s;
 }
 
+}  // namespace dispex::ptex
+
+namespace dispex {
+
+using namespace ptex;  // NOLINT: the helpers above, ReductionOrder
+
 std::string FormatPtexSummary(const PtexFile& file, std::size_t max_values) {
   const PtexHeaderInfo& h = file.header();
   std::size_t constant = 0, subfaces = 0, level0_texels = 0, reduced_texels = 0;
@@ -120,8 +126,8 @@ std::string FormatPtexSummary(const PtexFile& file, std::size_t max_values) {
   s += fmt::format("file          {}\n", file.name());
   s += fmt::format("size on disk  {} bytes\n", h.file_size);
   s += fmt::format("format        Ptex 1.{}\n", h.minor_version);
-  s += fmt::format("mesh type     {}\n", PtexName(h.mesh_type));
-  s += fmt::format("data type     {}\n", PtexName(h.data_type));
+  s += fmt::format("mesh type     {}\n", PtexMeshTypeName(h.mesh_type));
+  s += fmt::format("data type     {}\n", PtexDataTypeName(h.data_type));
   s += fmt::format("channels      {}\n", h.num_channels);
   s += fmt::format("alpha         {}\n", h.alpha_channel < 0
                                              ? std::string("none")
@@ -131,14 +137,14 @@ std::string FormatPtexSummary(const PtexFile& file, std::size_t max_values) {
   s += fmt::format("levels        {} (entries:", h.num_levels);
   for (const PtexLevelInfo& l : file.levels()) s += fmt::format(" {}", l.num_entries);
   s += ")\n";
-  s += fmt::format("border modes  u {}, v {}\n", PtexName(h.u_border), PtexName(h.v_border));
-  s += fmt::format("edge filter   {}\n", PtexName(h.edge_filter));
+  s += fmt::format("border modes  u {}, v {}\n", PtexBorderModeName(h.u_border), PtexBorderModeName(h.v_border));
+  s += fmt::format("edge filter   {}\n", PtexEdgeFilterModeName(h.edge_filter));
   s += fmt::format("texels        {} at level 0 in non-constant faces, {} in reductions\n",
                    level0_texels, reduced_texels);
   s += fmt::format("edits         {}\n", h.has_edits ? "yes" : "no");
   s += fmt::format("meta data     {} items\n", file.meta_data().size());
   for (const PtexMetaItem& item : file.meta_data()) {
-    s += fmt::format("  {} {}[{}]{}: {}\n", item.key, PtexName(item.type), item.count(),
+    s += fmt::format("  {} {}[{}]{}: {}\n", item.key, PtexMetaTypeName(item.type), item.count(),
                      item.large ? " (large)" : "", FormatMetaValue(item, max_values));
   }
   return s;
@@ -184,7 +190,7 @@ Status FormatPtexTexels(const PtexFile& file, PtexFaceId face, std::string& out)
   DISPEX_RETURN_IF_ERROR(file.ReadFaceRaw(face, 0, raw));
   const std::size_t pixel = std::size_t(h.pixel_size());
   out += fmt::format("face {} {}x{} {} {}\n", face.value, info.ures(), info.vres(),
-                     PtexName(h.data_type), FlagsText(info));
+                     PtexDataTypeName(h.data_type), FlagsText(info));
   for (int v = 0; v < info.vres(); ++v) {
     out += fmt::format("v={}:", v);
     for (int u = 0; u < info.ures(); ++u) {
@@ -203,9 +209,9 @@ Status FormatPtexStructure(const PtexFile& file, std::string& out) {
   out += fmt::format(
       "header: mesh {} data {} channels {} alpha {} faces {} levels {} minor {} borders {} {} "
       "edgefilter {}\n",
-      PtexName(h.mesh_type), PtexName(h.data_type), h.num_channels, h.alpha_channel, h.num_faces,
-      h.num_levels, h.minor_version, PtexName(h.u_border), PtexName(h.v_border),
-      PtexName(h.edge_filter));
+      PtexMeshTypeName(h.mesh_type), PtexDataTypeName(h.data_type), h.num_channels,
+      h.alpha_channel, h.num_faces, h.num_levels, h.minor_version, PtexBorderModeName(h.u_border),
+      PtexBorderModeName(h.v_border), PtexEdgeFilterModeName(h.edge_filter));
   for (int f = 0; f < h.num_faces; ++f) {
     const PtexFaceInfo& info = file.face_info(PtexFaceId(f));
     out += fmt::format(
@@ -258,10 +264,10 @@ Status FormatPtexStructure(const PtexFile& file, std::string& out) {
   }
   out += fmt::format("meta data: {} items\n", file.meta_data().size());
   for (const PtexMetaItem& item : file.meta_data()) {
-    out += fmt::format("  {} {}[{}]{}: {}\n", item.key, PtexName(item.type), item.count(),
+    out += fmt::format("  {} {}[{}]{}: {}\n", item.key, PtexMetaTypeName(item.type), item.count(),
                        item.large ? " large" : "", FormatMetaValue(item, item.count()));
   }
   return Status::Ok();
 }
 
-}  // namespace dispex::ptex
+}  // namespace dispex

@@ -19,7 +19,7 @@ int PtexDataSize(PtexDataType type) {
   return 1;
 }
 
-const char* PtexName(PtexDataType type) {
+std::string_view PtexDataTypeName(PtexDataType type) {
   switch (type) {
     case PtexDataType::kUint8:
       return "uint8";
@@ -33,11 +33,11 @@ const char* PtexName(PtexDataType type) {
   return "?";
 }
 
-const char* PtexName(PtexMeshType type) {
+std::string_view PtexMeshTypeName(PtexMeshType type) {
   return type == PtexMeshType::kTriangle ? "triangle" : "quad";
 }
 
-const char* PtexName(PtexBorderMode mode) {
+std::string_view PtexBorderModeName(PtexBorderMode mode) {
   switch (mode) {
     case PtexBorderMode::kClamp:
       return "clamp";
@@ -49,11 +49,11 @@ const char* PtexName(PtexBorderMode mode) {
   return "?";
 }
 
-const char* PtexName(PtexEdgeFilterMode mode) {
+std::string_view PtexEdgeFilterModeName(PtexEdgeFilterMode mode) {
   return mode == PtexEdgeFilterMode::kTangentVector ? "tanvec" : "none";
 }
 
-const char* PtexName(PtexMetaType type) {
+std::string_view PtexMetaTypeName(PtexMetaType type) {
   switch (type) {
     case PtexMetaType::kString:
       return "string";

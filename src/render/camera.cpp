@@ -8,19 +8,12 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/vec3.h"
 #include "dispex/render.h"
-#include "render/vec3.h"
 
 namespace dispex {
 
 namespace {
-
-using render::Cross;
-using render::Dot;
-using render::Normalize;
-using render::ToFloat3;
-using render::ToV3;
-using render::V3;
 
 void PresetAngles(ViewPreset preset, double& azimuth, double& elevation) {
   switch (preset) {
@@ -52,22 +45,22 @@ void Camera::RayThrough(double px, double py, Float3& origin, Float3& direction)
   const double aspect = double(width) / double(height);
   const double sx = (2.0 * px / width - 1.0) * aspect * half_height + shift_x;
   const double sy = (1.0 - 2.0 * py / height) * half_height + shift_y;
-  const V3 e = ToV3(eye), f = ToV3(forward), r = ToV3(right), u = ToV3(up);
+  const Vec3d e = ToVec3d(eye), f = ToVec3d(forward), r = ToVec3d(right), u = ToVec3d(up);
   if (projection == Projection::kOrthographic) {
-    origin = ToFloat3(e + r * sx + u * sy);
+    origin = FromVec3d<Float3>(e + r * sx + u * sy);
     direction = forward;
   } else {
     origin = eye;
-    direction = ToFloat3(Normalize(f + r * sx + u * sy));
+    direction = FromVec3d<Float3>(Normalize(f + r * sx + u * sy));
   }
 }
 
 bool Camera::Project(const Float3& point, double& px, double& py) const {
   const double aspect = double(width) / double(height);
-  const V3 rel = ToV3(point) - ToV3(eye);
-  double x = Dot(rel, ToV3(right)), y = Dot(rel, ToV3(up));
+  const Vec3d rel = ToVec3d(point) - ToVec3d(eye);
+  double x = Dot(rel, ToVec3d(right)), y = Dot(rel, ToVec3d(up));
   if (projection == Projection::kPerspective) {
-    const double z = Dot(rel, ToV3(forward));
+    const double z = Dot(rel, ToVec3d(forward));
     if (!(z > 0)) return false;
     x /= z;
     y /= z;
@@ -98,7 +91,7 @@ StatusOr<Camera> FrameCamera(std::span<const Float3> points, const ViewOptions& 
     return Status::Error(fmt::format("margin {}: must be 0..0.45", view.margin));
   }
   if (points.empty()) return Status::Error("nothing to frame: no points");
-  V3 lo = ToV3(points[0]), hi = lo;
+  Vec3d lo = ToVec3d(points[0]), hi = lo;
   for (const Float3& p : points) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
       return Status::Error("cannot frame a point that is not finite");
@@ -108,10 +101,10 @@ StatusOr<Camera> FrameCamera(std::span<const Float3> points, const ViewOptions& 
   }
 
   const double a = azimuth * std::numbers::pi / 180.0, e = elevation * std::numbers::pi / 180.0;
-  const V3 towards_eye = {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)};
-  const V3 right = {std::cos(a), 0.0, -std::sin(a)};
-  const V3 up = Cross(towards_eye, right);
-  const V3 centre = (lo + hi) * 0.5;
+  const Vec3d towards_eye = {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)};
+  const Vec3d right = {std::cos(a), 0.0, -std::sin(a)};
+  const Vec3d up = Cross(towards_eye, right);
+  const Vec3d centre = (lo + hi) * 0.5;
   const double radius = std::max(0.5 * std::sqrt(Dot(hi - lo, hi - lo)), 1e-30);
   const double aspect = double(width) / double(height);
   const double usable = 1.0 - 2.0 * view.margin;
@@ -120,9 +113,9 @@ StatusOr<Camera> FrameCamera(std::span<const Float3> points, const ViewOptions& 
   camera.projection = view.projection;
   camera.width = width;
   camera.height = height;
-  camera.forward = ToFloat3(towards_eye * -1.0);
-  camera.right = ToFloat3(right);
-  camera.up = ToFloat3(up);
+  camera.forward = FromVec3d<Float3>(towards_eye * -1.0);
+  camera.right = FromVec3d<Float3>(right);
+  camera.up = FromVec3d<Float3>(up);
 
   // The extent of the points seen from distance `distance` (perspective: x / depth; ortho:
   // x), as [min, max] along right and up.
@@ -133,7 +126,7 @@ StatusOr<Camera> FrameCamera(std::span<const Float3> points, const ViewOptions& 
   auto extent = [&](double distance) {
     Extent ext;
     for (const Float3& p : points) {
-      const V3 rel = ToV3(p) - centre;
+      const Vec3d rel = ToVec3d(p) - centre;
       double x = Dot(rel, right), y = Dot(rel, up);
       if (distance > 0) {
         const double depth = distance - Dot(rel, towards_eye);
@@ -150,7 +143,7 @@ StatusOr<Camera> FrameCamera(std::span<const Float3> points, const ViewOptions& 
   if (view.projection == Projection::kOrthographic) {
     ext = extent(0);
     camera.half_height = std::max(ext.half(aspect) / usable, 1e-9 * radius);
-    camera.eye = ToFloat3(centre + towards_eye * (2.0 * radius));
+    camera.eye = FromVec3d<Float3>(centre + towards_eye * (2.0 * radius));
   } else {
     const double tan_half = std::tan(0.5 * view.fov_degrees * std::numbers::pi / 180.0);
     const double target = tan_half * usable;
@@ -158,7 +151,7 @@ StatusOr<Camera> FrameCamera(std::span<const Float3> points, const ViewOptions& 
     // which their (shifted) extent still fits, by bisection.
     double max_depth_offset = -radius, far = 0;
     for (const Float3& p : points) {
-      const V3 rel = ToV3(p) - centre;
+      const Vec3d rel = ToVec3d(p) - centre;
       const double z = Dot(rel, towards_eye);
       max_depth_offset = std::max(max_depth_offset, z);
       far = std::max({far, z + std::fabs(Dot(rel, up)) / target,
@@ -176,7 +169,7 @@ StatusOr<Camera> FrameCamera(std::span<const Float3> points, const ViewOptions& 
     }
     ext = extent(far);
     camera.half_height = tan_half;
-    camera.eye = ToFloat3(centre + towards_eye * far);
+    camera.eye = FromVec3d<Float3>(centre + towards_eye * far);
   }
   camera.shift_x = 0.5 * (ext.x0 + ext.x1);
   camera.shift_y = 0.5 * (ext.y0 + ext.y1);

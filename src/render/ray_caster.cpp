@@ -16,7 +16,7 @@
 #include <numbers>
 #include <vector>
 
-#include "render/vec3.h"
+#include "core/vec3.h"
 
 namespace dispex::render {
 
@@ -43,17 +43,17 @@ std::uint8_t ToDisplay(double linear) {
       std::lround(255.0 * std::pow(std::clamp(linear, 0.0, 1.0), 1.0 / 2.2)));
 }
 
-constexpr V3 kClay = {0.62, 0.56, 0.48};      // front faces, linear
-constexpr V3 kBackClay = {0.30, 0.38, 0.55};  // back faces (inside of open surfaces)
+constexpr Vec3d kClay = {0.62, 0.56, 0.48};      // front faces, linear
+constexpr Vec3d kBackClay = {0.30, 0.38, 0.55};  // back faces (inside of open surfaces)
 
 struct Rig {
-  V3 key, fill;
+  Vec3d key, fill;
 };
 
 struct RowScratch {
   std::vector<Ray> rays, ao_rays;
   std::vector<RayHit> hits, ao_hits;
-  std::vector<V3> normal, geometric, colour;  // per camera ray
+  std::vector<Vec3d> normal, geometric, colour;  // per camera ray
   std::vector<double> ao;
   std::vector<int> ao_owner;
 };
@@ -65,10 +65,10 @@ StatusOr<Image> CastPanel(const ShadedMesh& mesh, const Tracer& tracer, const Ca
   const int w = camera.width, h = camera.height, ss = options.supersample;
   const int per_pixel = ss * ss;
   Image image(w, h, kPanelBackground);
-  const V3 right = ToV3(camera.right), up = ToV3(camera.up), back = ToV3(camera.forward) * -1.0;
+  const Vec3d right = ToVec3d(camera.right), up = ToVec3d(camera.up), back = ToVec3d(camera.forward) * -1.0;
   const Rig rig{Normalize(right * -0.7 + up * 0.6 + back * 0.4),
                 Normalize(right * 0.7 + up * 0.05 + back * 0.7)};
-  const V3 background = {ToLinear(kPanelBackground[0]), ToLinear(kPanelBackground[1]),
+  const Vec3d background = {ToLinear(kPanelBackground[0]), ToLinear(kPanelBackground[1]),
                          ToLinear(kPanelBackground[2])};
   const auto& P = mesh.mesh.positions;
   const auto& I = mesh.mesh.face_indices;
@@ -102,21 +102,21 @@ StatusOr<Image> CastPanel(const ShadedMesh& mesh, const Tracer& tracer, const Ca
       const std::size_t i0 = static_cast<std::size_t>(I[3 * t]);
       const std::size_t i1 = static_cast<std::size_t>(I[3 * t + 1]);
       const std::size_t i2 = static_cast<std::size_t>(I[3 * t + 2]);
-      const V3 a = ToV3(P[i0]), b = ToV3(P[i1]), c = ToV3(P[i2]);
-      const V3 d = ToV3(s.rays[r].direction), o = ToV3(s.rays[r].origin);
-      const V3 e1 = b - a, e2 = c - a, p = Cross(d, e2);
+      const Vec3d a = ToVec3d(P[i0]), b = ToVec3d(P[i1]), c = ToVec3d(P[i2]);
+      const Vec3d d = ToVec3d(s.rays[r].direction), o = ToVec3d(s.rays[r].origin);
+      const Vec3d e1 = b - a, e2 = c - a, p = Cross(d, e2);
       const double det = Dot(e1, p);
       double bu = 1.0 / 3, bv = 1.0 / 3;
       if (std::fabs(det) > 0) {
-        const V3 tv = o - a, q = Cross(tv, e1);
+        const Vec3d tv = o - a, q = Cross(tv, e1);
         bu = Dot(tv, p) / det;
         bv = Dot(d, q) / det;
         bu = std::clamp(bu, 0.0, 1.0);
         bv = std::clamp(bv, 0.0, 1.0 - bu);
       }
-      V3 n = Normalize(ToV3(mesh.normals[i0]) * (1.0 - bu - bv) + ToV3(mesh.normals[i1]) * bu +
-                       ToV3(mesh.normals[i2]) * bv);
-      V3 g = ToV3(hit.normal);
+      Vec3d n = Normalize(ToVec3d(mesh.normals[i0]) * (1.0 - bu - bv) + ToVec3d(mesh.normals[i1]) * bu +
+                       ToVec3d(mesh.normals[i2]) * bv);
+      Vec3d g = ToVec3d(hit.normal);
       if (Dot(g, d) > 0) {  // the back side: shade the side we see
         g = g * -1.0;
         n = n * -1.0;
@@ -138,11 +138,11 @@ StatusOr<Image> CastPanel(const ShadedMesh& mesh, const Tracer& tracer, const Ca
       s.ao_owner.clear();
       for (std::size_t r = 0; r < count; ++r) {
         if (!s.hits[r].hit()) continue;
-        const V3 g = s.geometric[r];
-        const V3 t1 = Normalize(std::fabs(g.x) > 0.5 ? Cross(g, {0, 1, 0}) : Cross(g, {1, 0, 0}));
-        const V3 t2 = Cross(g, t1);
-        const V3 hit_point = ToV3(s.rays[r].origin) + ToV3(s.rays[r].direction) * s.hits[r].t;
-        const V3 origin = hit_point + g * (1e-3 * options.ao_distance);
+        const Vec3d g = s.geometric[r];
+        const Vec3d t1 = Normalize(std::fabs(g.x) > 0.5 ? Cross(g, {0, 1, 0}) : Cross(g, {1, 0, 0}));
+        const Vec3d t2 = Cross(g, t1);
+        const Vec3d hit_point = ToVec3d(s.rays[r].origin) + ToVec3d(s.rays[r].direction) * s.hits[r].t;
+        const Vec3d origin = hit_point + g * (1e-3 * options.ao_distance);
         const std::uint32_t pixel =
             Mix(static_cast<std::uint32_t>(y) * 0x9e3779b9u ^ static_cast<std::uint32_t>(r)) ^
             options.seed;
@@ -150,11 +150,11 @@ StatusOr<Image> CastPanel(const ShadedMesh& mesh, const Tracer& tracer, const Ca
           const std::uint32_t bits = Mix(pixel + static_cast<std::uint32_t>(k) * 0x632be5abu);
           const double u1 = Uniform(bits), u2 = Uniform(Mix(bits ^ 0x5bd1e995u));
           const double radius = std::sqrt(u2), phi = 2.0 * std::numbers::pi * u1;
-          const V3 dir = t1 * (radius * std::cos(phi)) + t2 * (radius * std::sin(phi)) +
+          const Vec3d dir = t1 * (radius * std::cos(phi)) + t2 * (radius * std::sin(phi)) +
                          g * std::sqrt(std::max(0.0, 1.0 - u2));
           Ray ray;
-          ray.origin = ToFloat3(origin);
-          ray.direction = ToFloat3(Normalize(dir));
+          ray.origin = FromVec3d<Float3>(origin);
+          ray.direction = FromVec3d<Float3>(Normalize(dir));
           ray.tnear = 0;
           ray.tfar = options.ao_distance;
           s.ao_rays.push_back(ray);
@@ -171,7 +171,7 @@ StatusOr<Image> CastPanel(const ShadedMesh& mesh, const Tracer& tracer, const Ca
 
     // Shading and the pixel average.
     for (int x = 0; x < w; ++x) {
-      V3 sum;
+      Vec3d sum;
       int hits = 0;
       for (int k = 0; k < per_pixel; ++k) {
         const std::size_t r = static_cast<std::size_t>(x) * per_pixel + k;
@@ -180,7 +180,7 @@ StatusOr<Image> CastPanel(const ShadedMesh& mesh, const Tracer& tracer, const Ca
           continue;
         }
         ++hits;
-        const V3 n = s.normal[r], view = ToV3(s.rays[r].direction) * -1.0;
+        const Vec3d n = s.normal[r], view = ToVec3d(s.rays[r].direction) * -1.0;
         const double occlusion = 0.35 + 0.65 * std::max(0.0, s.ao[r]);
         const double diffuse = 0.08 + 0.25 * std::max(0.0, Dot(n, view)) +
                                0.75 * std::max(0.0, Dot(n, rig.key)) +
@@ -189,10 +189,10 @@ StatusOr<Image> CastPanel(const ShadedMesh& mesh, const Tracer& tracer, const Ca
             Dot(n, rig.key) > 0
                 ? 0.10 * std::pow(std::max(0.0, Dot(n, Normalize(rig.key + view))), 48)
                 : 0.0;
-        sum = sum + s.colour[r] * (diffuse * occlusion) + V3{specular, specular, specular};
+        sum = sum + s.colour[r] * (diffuse * occlusion) + Vec3d{specular, specular, specular};
       }
       if (hits == 0) continue;  // exactly the background
-      const V3 mean = sum * (1.0 / per_pixel);
+      const Vec3d mean = sum * (1.0 / per_pixel);
       image.set(x, y, {ToDisplay(mean.x), ToDisplay(mean.y), ToDisplay(mean.z)});
     }
   });

@@ -141,8 +141,6 @@ double MaxReadBackError(const float* texels, const BlockShape& res, const float*
   return max_error;
 }
 
-}  // namespace spectral
-
 Status BilinearReadBack(std::span<const float> texels, int ulog2, int vlog2, int nx, int ny,
                         std::span<float> out) {
   DISPEX_ASSIGN_OR_RETURN(const spectral::BlockShape res, spectral::MakeTexelShape(ulog2, vlog2));
@@ -163,4 +161,5 @@ StatusOr<double> MaxBilinearError(std::span<const float> texels, int ulog2, int 
                                     std::numeric_limits<double>::infinity());
 }
 
+}  // namespace spectral
 }  // namespace dispex

@@ -39,7 +39,7 @@ struct LimitEvaluator::Impl {
 };
 
 LimitEvaluator::LimitEvaluator(const LimitSurface& surface)
-    : impl_(std::make_unique<Impl>(surface.impl())) {}
+    : impl_(std::make_unique<Impl>(SurfaceImpl(surface))) {}
 LimitEvaluator::LimitEvaluator(LimitEvaluator&&) noexcept = default;
 LimitEvaluator& LimitEvaluator::operator=(LimitEvaluator&&) noexcept = default;
 LimitEvaluator::~LimitEvaluator() = default;

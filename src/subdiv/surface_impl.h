@@ -40,4 +40,9 @@ struct LimitSurface::Impl {
   }
 };
 
+// The state of a surface, for the subdiv module's evaluators and uniform refinement.
+inline const LimitSurface::Impl& SurfaceImpl(const LimitSurface& surface) {
+  return *surface.impl_;
+}
+
 }  // namespace dispex

@@ -522,8 +522,8 @@ StatusOr<std::uint64_t> CountRefinedFaces(const LimitSurface::Impl& s, int level
 StatusOr<RefinedMesh> RefineUniform(const LimitSurface& surface, int levels,
                                     const RefineOptions& options) {
   DISPEX_ASSIGN_OR_RETURN(const std::uint64_t expected_faces,
-                          CountRefinedFaces(surface.impl(), levels, options));
-  Refinement refinement(surface.impl(), levels, options);
+                          CountRefinedFaces(SurfaceImpl(surface), levels, options));
+  Refinement refinement(SurfaceImpl(surface), levels, options);
   DISPEX_RETURN_IF_ERROR(refinement.BuildTopology(expected_faces));
   refinement.FindOwners();
   refinement.Compact();

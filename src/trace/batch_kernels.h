@@ -30,6 +30,7 @@
 #include <limits>
 #include <span>
 
+#include "core/vec3.h"
 #include "dispex/trace.h"
 #include "trace/embree_scene.h"
 #include "trace/ray_casters.h"
@@ -116,12 +117,11 @@ inline float ExactT(const EmbreeScene& scene, unsigned geom, unsigned prim, floa
   const Float3& fa = p[ids[second ? 2 : 0]];
   const Float3& fb = p[ids[second ? 3 : 1]];
   const Float3& fc = p[ids[second ? 1 : (g.corners == 4 ? 3 : 2)]];
-  const double e1x = double(fb.x) - fa.x, e1y = double(fb.y) - fa.y, e1z = double(fb.z) - fa.z;
-  const double e2x = double(fc.x) - fa.x, e2y = double(fc.y) - fa.y, e2z = double(fc.z) - fa.z;
-  const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
-  const double den = nx * d.x + ny * d.y + nz * d.z;
+  const Vec3d a = ToVec3d(fa);
+  const Vec3d n = Cross(ToVec3d(fb) - a, ToVec3d(fc) - a);
+  const double den = n.x * d.x + n.y * d.y + n.z * d.z;
   const double t =
-      (nx * (double(fa.x) - o.x) + ny * (double(fa.y) - o.y) + nz * (double(fa.z) - o.z)) / den;
+      (n.x * (double(fa.x) - o.x) + n.y * (double(fa.y) - o.y) + n.z * (double(fa.z) - o.z)) / den;
   return std::isfinite(t) ? static_cast<float>(t) : fallback;
 }
 

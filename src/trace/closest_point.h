@@ -2,30 +2,9 @@
 // queries (the `verify` command's error measure).
 #pragma once
 
+#include "core/vec3.h"
+
 namespace dispex::trace {
-
-struct Vec3d {
-  double x = 0, y = 0, z = 0;
-};
-
-inline Vec3d operator+(const Vec3d& a, const Vec3d& b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-inline Vec3d operator-(const Vec3d& a, const Vec3d& b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-inline Vec3d operator*(double s, const Vec3d& a) {
-  return {s * a.x, s * a.y, s * a.z};
-}
-inline double Dot(const Vec3d& a, const Vec3d& b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-inline Vec3d Cross(const Vec3d& a, const Vec3d& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-inline double Distance2(const Vec3d& a, const Vec3d& b) {
-  return Dot(a - b, a - b);
-}
 
 // The point of segment [a, b] nearest to p (a when a == b).
 Vec3d ClosestPointOnSegment(const Vec3d& p, const Vec3d& a, const Vec3d& b);

@@ -10,7 +10,7 @@
 
 namespace dispex::trace {
 
-const char* RtcErrorName(RTCError code) {
+std::string_view RtcErrorName(RTCError code) {
   switch (code) {
     case RTC_ERROR_NONE:
       return "RTC_ERROR_NONE";

@@ -81,6 +81,6 @@ class EmbreeDevice {
 };
 
 // "RTC_ERROR_OUT_OF_MEMORY" etc.
-const char* RtcErrorName(RTCError code);
+std::string_view RtcErrorName(RTCError code);
 
 }  // namespace dispex::trace

@@ -180,7 +180,7 @@ Status EmbreeScene::Setup(const Mesh& mesh, const TracerOptions& options) {
   stats_.backend_bytes = device_->bytes();
   stats_.backend_peak_bytes = device_->peak_bytes();
   stats_.backend = fmt::format(
-      "{}, {} build{}{}{}{}", device_->Describe(), ToString(options.quality),
+      "{}, {} build{}{}{}{}", device_->Describe(), BuildQualityName(options.quality),
       options.robust ? ", robust" : "", options.compact ? ", compact" : "",
       options.retry_misses ? ", retry misses" : "", options.verify_hits ? ", verify hits" : "");
   return Status::Ok();

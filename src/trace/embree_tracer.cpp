@@ -22,7 +22,7 @@ class EmbreeTracer final : public Tracer {
  public:
   EmbreeTracer(std::unique_ptr<EmbreeScene> scene, RayMode mode)
       : scene_(std::move(scene)), mode_(mode), stats_(scene_->stats()) {
-    stats_.backend += fmt::format(", {}", ToString(mode));
+    stats_.backend += fmt::format(", {}", RayModeName(mode));
   }
 
   void TraceNormals(std::span<const Float3> origins, std::span<const Float3> normals,

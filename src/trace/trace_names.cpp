@@ -49,13 +49,13 @@ StatusOr<E> Parse(const std::array<std::pair<E, std::string_view>, N>& table, st
 
 }  // namespace
 
-std::string_view ToString(HitPolicy policy) {
+std::string_view HitPolicyName(HitPolicy policy) {
   return Name(kPolicies, policy);
 }
-std::string_view ToString(BuildQuality quality) {
+std::string_view BuildQualityName(BuildQuality quality) {
   return Name(kQualities, quality);
 }
-std::string_view ToString(RayMode mode) {
+std::string_view RayModeName(RayMode mode) {
   return Name(kModes, mode);
 }
 

@@ -21,7 +21,6 @@
 #include "dispex/mesh.h"
 #include "dispex/subdiv.h"
 #include "dispex/verify.h"
-#include "verify/obj_writer.h"
 #include "verify/pattern_field.h"
 
 namespace dispex {

@@ -13,8 +13,8 @@
 #include <string>
 
 #include "dispex/ptex.h"
+#include "dispex/ptex_describe.h"
 #include "golden_cases.h"
-#include "ptex/describe.h"
 #include "ptex_test_util.h"
 
 namespace dispex {
@@ -26,9 +26,9 @@ std::string GoldenPath(const std::string& name) {
 
 std::string Dump(const PtexFile& file) {
   std::string faces, structure;
-  Status s = ptex::FormatPtexFaces(file, faces);
+  Status s = FormatPtexFaces(file, faces);
   EXPECT_TRUE(s.ok()) << s.message();
-  s = ptex::FormatPtexStructure(file, structure);
+  s = FormatPtexStructure(file, structure);
   EXPECT_TRUE(s.ok()) << s.message();
   return "# dispex info --faces\n" + faces + "# structure\n" + structure;
 }

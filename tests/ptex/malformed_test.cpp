@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "dispex/ptex.h"
-#include "ptex/describe.h"
+#include "dispex/ptex_describe.h"
 #include "ptex_test_util.h"
 
 namespace dispex {
@@ -48,8 +48,8 @@ void Exercise(const PtexFile& file) {
     }
   }
   std::string text;
-  (void)ptex::FormatPtexStructure(file, text);
-  (void)ptex::FormatPtexSummary(file);
+  (void)FormatPtexStructure(file, text);
+  (void)FormatPtexSummary(file);
 }
 
 void ExpectError(const std::vector<std::uint8_t>& bytes, const std::string& needle) {

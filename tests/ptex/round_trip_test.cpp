@@ -234,7 +234,7 @@ struct Config {
   PtexMeshType mesh;
 };
 void PrintTo(const Config& c, std::ostream* os) {
-  *os << PtexName(c.type) << " x" << c.channels << " alpha " << c.alpha << " " << PtexName(c.mesh);
+  *os << PtexDataTypeName(c.type) << " x" << c.channels << " alpha " << c.alpha << " " << PtexMeshTypeName(c.mesh);
 }
 
 class PtexRoundTrip : public ::testing::TestWithParam<Config> {};
@@ -272,7 +272,7 @@ INSTANTIATE_TEST_SUITE_P(
                       Config{PtexDataType::kHalf, 3, -1, PtexMeshType::kTriangle}),
     [](const ::testing::TestParamInfo<Config>& p) {
       std::ostringstream name;
-      name << PtexName(p.param.type) << "_" << p.param.channels << "ch";
+      name << PtexDataTypeName(p.param.type) << "_" << p.param.channels << "ch";
       if (p.param.alpha >= 0) name << "_alpha" << p.param.alpha;
       name << (p.param.mesh == PtexMeshType::kTriangle ? "_triangle" : "_quad");
       return name.str();

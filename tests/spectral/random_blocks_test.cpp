@@ -13,6 +13,7 @@
 #include "block_generators.h"
 #include "dct_reference.h"
 #include "dispex/spectral.h"
+#include "spectral/analyzer_steps.h"
 
 namespace dispex {
 namespace {
@@ -118,8 +119,7 @@ TEST(RandomBlocksTest, BoundHoldsForTheBandLimitedSeries) {
     if (face->constant) continue;
     const std::vector<float> texels(face->texels.begin(), face->texels.end());
     std::vector<float> series(block.size());
-    ASSERT_TRUE(analyzer
-                    .Resample(texels, 1 << face->ulog2, 1 << face->vlog2,
+    ASSERT_TRUE(spectral::AnalyzerSteps::Resample(analyzer, texels, 1 << face->ulog2, 1 << face->vlog2,
                               std::countr_zero(static_cast<unsigned>(d.nx)),
                               std::countr_zero(static_cast<unsigned>(d.ny)), series)
                     .ok());

@@ -7,6 +7,7 @@
 #include "block_generators.h"
 #include "dct_reference.h"
 #include "dispex/spectral.h"
+#include "spectral/analyzer_steps.h"
 
 namespace dispex {
 namespace {
@@ -24,7 +25,7 @@ TEST(ResampleTest, BandLimitedBlockIsExactAtNewTexelCentres) {
     for (int lv = 3; lv <= 7; ++lv) {
       const int rx = 1 << lu, ry = 1 << lv;
       std::vector<float> texels(rx * ry);
-      ASSERT_TRUE(analyzer.Resample(block, 64, 32, lu, lv, texels).ok());
+      ASSERT_TRUE(spectral::AnalyzerSteps::Resample(analyzer, block, 64, 32, lu, lv, texels).ok());
       for (int j = 0; j < ry; ++j) {
         for (int i = 0; i < rx; ++i) {
           ASSERT_NEAR(texels[j * rx + i], CosineValue(terms, (i + 0.5) / rx, (j + 0.5) / ry), 1e-6)
@@ -45,7 +46,7 @@ TEST(ResampleTest, TruncationMatchesTheTruncatedSeries) {
   for (auto [lu, lv] : {std::pair{2, 3}, std::pair{4, 4}, std::pair{0, 5}, std::pair{1, 1}}) {
     const int rx = 1 << lu, ry = 1 << lv;
     std::vector<float> texels(rx * ry);
-    ASSERT_TRUE(analyzer.Resample(block, 32, 32, lu, lv, texels).ok());
+    ASSERT_TRUE(spectral::AnalyzerSteps::Resample(analyzer, block, 32, 32, lu, lv, texels).ok());
     for (int j = 0; j < ry; ++j) {
       for (int i = 0; i < rx; ++i) {
         ASSERT_NEAR(
@@ -60,10 +61,10 @@ TEST(ResampleTest, FullResolutionIsTheSamplesAndOneTexelIsTheMean) {
   const std::vector<float> block = spectral_test::UniformNoise(16 * 64, 3.0f, 4);
   SpectralAnalyzer analyzer;
   std::vector<float> same(block.size());
-  ASSERT_TRUE(analyzer.Resample(block, 16, 64, 4, 6, same).ok());
+  ASSERT_TRUE(spectral::AnalyzerSteps::Resample(analyzer, block, 16, 64, 4, 6, same).ok());
   EXPECT_EQ(same, block);
   std::vector<float> one(1);
-  ASSERT_TRUE(analyzer.Resample(block, 16, 64, 0, 0, one).ok());
+  ASSERT_TRUE(spectral::AnalyzerSteps::Resample(analyzer, block, 16, 64, 0, 0, one).ok());
   double mean = 0;
   for (float v : block) mean += v;
   EXPECT_FLOAT_EQ(one[0], static_cast<float>(mean / block.size()));
@@ -72,9 +73,9 @@ TEST(ResampleTest, FullResolutionIsTheSamplesAndOneTexelIsTheMean) {
 TEST(ResampleTest, RejectsBadResolutions) {
   SpectralAnalyzer analyzer;
   std::vector<float> block(64), texels(4);
-  EXPECT_EQ(analyzer.Resample(block, 8, 8, 10, 0, texels).message(),
+  EXPECT_EQ(spectral::AnalyzerSteps::Resample(analyzer, block, 8, 8, 10, 0, texels).message(),
             "resolution log2 10 x 0: 10 is outside 0..9");
-  EXPECT_EQ(analyzer.Resample(block, 8, 8, 1, 2, texels).message(),
+  EXPECT_EQ(spectral::AnalyzerSteps::Resample(analyzer, block, 8, 8, 1, 2, texels).message(),
             "texels holds 4 values, a 2 x 4 block needs 8");
 }
 

@@ -11,6 +11,8 @@
 #include "block_generators.h"
 #include "dct_reference.h"
 #include "dispex/spectral.h"
+#include "spectral/analyzer_steps.h"
+#include "spectral/bilinear_readback.h"
 
 namespace dispex {
 namespace {
@@ -113,11 +115,11 @@ TEST(ResolutionTest, VerificationStepsUpUntilTheReadBackIsWithinTolerance) {
   // The texels are the DCT-domain resampling at the final resolution, and the bound's own
   // choice did fail the read-back check.
   std::vector<float> again(texels.size());
-  ASSERT_TRUE(analyzer.Resample(block, 64, 64, face->ulog2, face->vlog2, again).ok());
+  ASSERT_TRUE(spectral::AnalyzerSteps::Resample(analyzer, block, 64, 64, face->ulog2, face->vlog2, again).ok());
   EXPECT_EQ(again, texels);
   std::vector<float> bound_choice(32);
-  ASSERT_TRUE(analyzer.Resample(block, 64, 64, 3, 2, bound_choice).ok());
-  EXPECT_GT(*MaxBilinearError(bound_choice, 3, 2, block, 64, 64), tolerance);
+  ASSERT_TRUE(spectral::AnalyzerSteps::Resample(analyzer, block, 64, 64, 3, 2, bound_choice).ok());
+  EXPECT_GT(*spectral::MaxBilinearError(bound_choice, 3, 2, block, 64, 64), tolerance);
 }
 
 TEST(ResolutionTest, ConstantBlockBecomesConstantFace) {
@@ -304,9 +306,9 @@ TEST(ResolutionTest, FixedRuleResamplesToTheGivenResolution) {
     EXPECT_EQ(face->constant, lu == 0 && lv == 0);
     const std::vector<float> got(face->texels.begin(), face->texels.end());
     std::vector<float> want(std::size_t{1} << (lu + lv));
-    ASSERT_TRUE(analyzer.Resample(block, 64, 64, lu, lv, want).ok());
+    ASSERT_TRUE(spectral::AnalyzerSteps::Resample(analyzer, block, 64, 64, lu, lv, want).ok());
     EXPECT_EQ(got, want);
-    auto err = MaxBilinearError(want, lu, lv, block, 64, 64);
+    auto err = spectral::MaxBilinearError(want, lu, lv, block, 64, 64);
     EXPECT_EQ(face->stats.measured_error, *err);
   }
 }

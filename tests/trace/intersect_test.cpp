@@ -100,7 +100,7 @@ TEST(IntersectTest, WindowEndsAreClosedOnDispexT) {
     std::vector<RayHit> hits(rays.size());
     TraceCounters counters;
     (*tracer)->Intersect(rays, hits, counters);
-    const char* name = ToString(mode).data();
+    const char* name = RayModeName(mode).data();
     EXPECT_EQ(hits[0].t, t_a) << name;
     EXPECT_EQ(hits[0].prim.value, 0) << name;
     EXPECT_EQ(hits[1].t, t_b) << name;

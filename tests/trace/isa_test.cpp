@@ -184,14 +184,14 @@ TEST(IsaTest, SameHitsUnderEveryIsa) {
           same = same_t(a.t[i], first->t[i], a.prim[i] == first->prim[i]);
         }
         if (!same && ++differ <= 5) {
-          ADD_FAILURE() << ToString(mode) << " " << isa << " vs " << first_isa << ", ray " << i
+          ADD_FAILURE() << RayModeName(mode) << " " << isa << " vs " << first_isa << ", ray " << i
                         << ": t " << h.t << " vs " << h0.t << ", normal t " << a.t[i] << " vs "
                         << first->t[i];
         }
       }
-      EXPECT_EQ(differ, 0) << ToString(mode) << " " << isa << " vs " << first_isa;
+      EXPECT_EQ(differ, 0) << RayModeName(mode) << " " << isa << " vs " << first_isa;
       // Another face is the exception: at vertices and edges only.
-      EXPECT_LE(other_face, 40) << ToString(mode) << " " << isa << " vs " << first_isa;
+      EXPECT_LE(other_face, 40) << RayModeName(mode) << " " << isa << " vs " << first_isa;
     }
   }
 }

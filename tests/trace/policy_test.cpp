@@ -104,8 +104,8 @@ TEST(PolicyTest, OnlyOneSideWithinTheSearchDistance) {
   for (const HitPolicy policy :
        {HitPolicy::kNearest, HitPolicy::kOutsideFirst, HitPolicy::kInsideFirst}) {
     const Result r = Query(*tracer, 0.4f, policy);
-    EXPECT_FLOAT_EQ(r.t, -0.3f) << ToString(policy);
-    EXPECT_EQ(r.flags, kHit | kNeg) << ToString(policy);
+    EXPECT_FLOAT_EQ(r.t, -0.3f) << HitPolicyName(policy);
+    EXPECT_EQ(r.flags, kHit | kNeg) << HitPolicyName(policy);
   }
 }
 
@@ -115,9 +115,9 @@ TEST(PolicyTest, MissesBeyondTheSearchDistance) {
   for (const HitPolicy policy :
        {HitPolicy::kNearest, HitPolicy::kOutsideFirst, HitPolicy::kInsideFirst}) {
     const Result r = Query(*tracer, 0.299f, policy);
-    EXPECT_TRUE(std::isnan(r.t)) << ToString(policy);
-    EXPECT_EQ(r.flags, 0) << ToString(policy);
-    EXPECT_FALSE(r.prim.valid()) << ToString(policy);
+    EXPECT_TRUE(std::isnan(r.t)) << HitPolicyName(policy);
+    EXPECT_EQ(r.flags, 0) << HitPolicyName(policy);
+    EXPECT_FALSE(r.prim.valid()) << HitPolicyName(policy);
     EXPECT_EQ(r.counters.hits, 0u);
     // Both rays, then both again from sideways (TracerOptions::retry_misses).
     EXPECT_EQ(r.counters.rays_cast, 4u);
@@ -257,16 +257,16 @@ TEST(PolicyTest, PrimitiveIdsMapBackToFacesInMixedMeshes) {
 TEST(PolicyTest, Names) {
   for (const HitPolicy p :
        {HitPolicy::kNearest, HitPolicy::kOutsideFirst, HitPolicy::kInsideFirst}) {
-    EXPECT_EQ(ParseHitPolicy(ToString(p)).value(), p);
+    EXPECT_EQ(ParseHitPolicy(HitPolicyName(p)).value(), p);
   }
   for (const BuildQuality q : {BuildQuality::kLow, BuildQuality::kMedium, BuildQuality::kHigh}) {
-    EXPECT_EQ(ParseBuildQuality(ToString(q)).value(), q);
+    EXPECT_EQ(ParseBuildQuality(BuildQualityName(q)).value(), q);
   }
   for (const RayMode m : {RayMode::kSingle, RayMode::kPacket4, RayMode::kPacket8,
                           RayMode::kPacket16, RayMode::kStream}) {
-    EXPECT_EQ(ParseRayMode(ToString(m)).value(), m);
+    EXPECT_EQ(ParseRayMode(RayModeName(m)).value(), m);
   }
-  EXPECT_EQ(ToString(HitPolicy::kOutsideFirst), "outside-first");
+  EXPECT_EQ(HitPolicyName(HitPolicy::kOutsideFirst), "outside-first");
   const auto bad = ParseHitPolicy("closest");
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.status().message(),

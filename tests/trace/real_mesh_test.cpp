@@ -53,7 +53,7 @@ TEST(RealMeshTest, CageToRefinedSpot) {
   }
   for (const HitPolicy policy :
        {HitPolicy::kNearest, HitPolicy::kOutsideFirst, HitPolicy::kInsideFirst}) {
-    SCOPED_TRACE(std::string(ToString(policy)));
+    SCOPED_TRACE(std::string(HitPolicyName(policy)));
     std::vector<float> t(n);
     std::vector<SculptPrimId> prim(n);
     std::vector<std::uint8_t> flags(n);

@@ -75,7 +75,7 @@ TEST(ThreadsTest, SameAnswersForAnyThreadCountAndBatching) {
     normals.push_back(trace_test::ToFloat3(d));
   }
   for (const BuildQuality quality : {BuildQuality::kLow, BuildQuality::kMedium}) {
-    SCOPED_TRACE(std::string(ToString(quality)));
+    SCOPED_TRACE(std::string(BuildQualityName(quality)));
     const Results one = TraceIn(1, 40000, mesh, origins, normals, quality);
     const Results two = TraceIn(2, 333, mesh, origins, normals, quality);
     const Results two_big = TraceIn(2, 4096, mesh, origins, normals, quality);

@@ -73,11 +73,11 @@ TEST(TinyDirectionTest, NormalQueriesHitInEveryRayMode) {
     TraceCounters counters;
     (*tracer)->TraceNormals(c.origins, c.directions, NormalQuery{1e-3f}, NormalHits{t, {}, flags},
                             counters);
-    EXPECT_EQ(counters.hits, n) << ToString(mode);
+    EXPECT_EQ(counters.hits, n) << RayModeName(mode);
     if (mode == RayMode::kSingle) single_t = t;
     int differ = 0;
     for (std::size_t i = 0; i < n; ++i) differ += t[i] == single_t[i] ? 0 : 1;
-    EXPECT_EQ(differ, 0) << ToString(mode);
+    EXPECT_EQ(differ, 0) << RayModeName(mode);
   }
 }
 
@@ -97,11 +97,11 @@ TEST(TinyDirectionTest, RaysHitInEveryRayMode) {
     std::vector<RayHit> hits(rays.size());
     TraceCounters counters;
     (*tracer)->Intersect(rays, hits, counters);
-    EXPECT_EQ(counters.hits, rays.size()) << ToString(mode);
+    EXPECT_EQ(counters.hits, rays.size()) << RayModeName(mode);
     if (mode == RayMode::kSingle) single = hits;
     int differ = 0;
     for (std::size_t i = 0; i < rays.size(); ++i) differ += hits[i].t == single[i].t ? 0 : 1;
-    EXPECT_EQ(differ, 0) << ToString(mode);
+    EXPECT_EQ(differ, 0) << RayModeName(mode);
   }
 }
 

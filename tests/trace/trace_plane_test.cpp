@@ -103,7 +103,7 @@ INSTANTIATE_TEST_SUITE_P(AllModes, PlaneTest,
                          ::testing::Values(RayMode::kSingle, RayMode::kPacket4, RayMode::kPacket8,
                                            RayMode::kPacket16, RayMode::kStream),
                          [](const auto& param_info) {
-                           return std::string(ToString(param_info.param));
+                           return std::string(RayModeName(param_info.param));
                          });
 
 }  // namespace

@@ -1,5 +1,6 @@
-// Cooperative cancellation: a signal handler (or any thread) requests it, long loops poll it
-// between units of work and stop with a Status. Requesting is async-signal-safe.
+// Cooperative cancellation: a signal handler (or any thread) requests it, the library's long
+// loops poll it between units of work and stop with a Status. Requesting is async-signal-safe.
+// The command line installs the handlers; a program embedding dispex may request it itself.
 #pragma once
 
 namespace dispex {

@@ -1,11 +1,11 @@
-#include "verify/obj_writer.h"
-
+// WriteObj (dispex/mesh.h): v and f lines formatted in parallel chunks, written atomically.
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
 #include <vector>
 
 #include "core/atomic_output.h"
+#include "dispex/mesh.h"
 
 namespace dispex {
 
