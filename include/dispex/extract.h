@@ -167,7 +167,8 @@ struct ExtractReport {
   // Held edges still over the tolerance: the samples are too coarse, or the displacement jumps
   // there (another sheet, a filled hole), so raising the resolution did not bring them down.
   std::int64_t edges_over = 0;
-  double edge_step_per_face = 0, edge_step_across_faces = 0;  // largest over held edges
+  // Largest over held edges; per face only with WatertightEdges::kAll (0 otherwise).
+  double edge_step_per_face = 0, edge_step_across_faces = 0;
   double displacement_min = 0, displacement_max = 0, displacement_rms = 0;
 
   // Output.

@@ -99,9 +99,16 @@ std::size_t CountEdgesTouching(std::span<const PtexFaceInfo> faces,
                                std::span<const std::uint8_t> touching,
                                std::span<const std::uint8_t> skip_faces);
 
+struct PtexEdgeMeasure {
+  bool per_face = true;     // also the per-face reader (0 steps reported for it otherwise)
+  bool keep_points = true;  // fill PtexEdgeSteps::per_face / across_faces
+  // Empty: every edge. Else only the edges with a flagged face on either side (one per face).
+  std::span<const std::uint8_t> only_faces;
+};
 PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
                                    std::span<const std::vector<float>> texels,
                                    std::span<const std::uint8_t> skip_edges,
-                                   std::span<const std::uint8_t> skip_faces);
+                                   std::span<const std::uint8_t> skip_faces,
+                                   const PtexEdgeMeasure& measure = {});
 
 }  // namespace dispex

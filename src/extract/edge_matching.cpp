@@ -30,14 +30,15 @@ struct MapView {
   std::vector<std::uint8_t> skip_faces;  // holes, and faces that missed entirely
 };
 
-MapView ViewOf(const ExtractInputs& inputs, const ProcessedFaces& processed) {
+// Moves the kept texels into the view (ReturnTexels moves them back).
+MapView TakeView(const ExtractInputs& inputs, ProcessedFaces& processed) {
   MapView view;
   view.faces = inputs.faces;
   const std::size_t n = view.faces.size();
   view.texels.resize(n);
   view.skip_faces.resize(n);
   for (std::size_t f = 0; f < n; ++f) {
-    const KeptFace& kept = processed.kept[f];
+    KeptFace& kept = processed.kept[f];
     view.skip_faces[f] = !kept.kept || inputs.surface.is_hole(PtexFaceId(static_cast<int>(f))) ||
                          Discontinuous(processed.stats[f]);
     if (!kept.kept) {
@@ -46,9 +47,15 @@ MapView ViewOf(const ExtractInputs& inputs, const ProcessedFaces& processed) {
     }
     view.faces[f].ulog2 = kept.ulog2;
     view.faces[f].vlog2 = kept.vlog2;
-    view.texels[f] = kept.texels;
+    view.texels[f].swap(kept.texels);
   }
   return view;
+}
+
+void ReturnTexels(MapView& view, ProcessedFaces& processed) {
+  for (std::size_t f = 0; f < view.texels.size(); ++f) {
+    if (processed.kept[f].kept) processed.kept[f].texels.swap(view.texels[f]);
+  }
 }
 
 // log2 texels of face f along its edge e and across it; a quad next to sub-faces counts one
@@ -87,14 +94,24 @@ Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
   report.texels_before_edges = Texels(faces, inputs);
 
   std::vector<std::array<int, 2>> least(n, {0, 0});
-  std::vector<std::uint8_t> raised(n, 0);
+  std::vector<std::uint8_t> raised(n, 0), redone;
   std::map<std::pair<int, int>, double> last_step;  // (face, edge) -> step when last raised
   std::map<std::pair<int, int>, int> futile;        // raises that did not bring it down
-  PtexEdgeSteps steps;
-  MapView view;
+  std::map<std::pair<int, int>, PtexEdgeStep> current;  // every measured edge, as it stands
+  MapView view = TakeView(inputs, faces);
+  PtexEdgeMeasure measure;
+  measure.per_face = per_face;
+  measure.keep_points = false;
   for (int round = 0;; ++round) {
-    view = ViewOf(inputs, faces);
-    steps = MeasurePtexEdgeSteps(view.faces, view.texels, sharp, view.skip_faces);
+    // The first round measures every edge, later ones the edges of the faces just redone.
+    measure.only_faces = redone;
+    const PtexEdgeSteps steps =
+        MeasurePtexEdgeSteps(view.faces, view.texels, sharp, view.skip_faces, measure);
+    if (round == 0) {
+      report.edges_shared = static_cast<std::int64_t>(steps.edges);
+      report.edges_sharp = static_cast<std::int64_t>(steps.skipped_edges);
+    }
+    for (const PtexEdgeStep& s : steps.edge_max) current[{s.face, s.edge}] = s;
     if (round == kMaxRounds) break;
     std::vector<std::array<int, 2>> want = least;
     auto raise = [&](int f, int dim) {
@@ -141,22 +158,24 @@ Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
       if (any) last_step[key] = step;
     }
     std::vector<int> redo;
+    redone.assign(n, 0);
     for (std::size_t f = 0; f < n; ++f) {
       if (want[f] == least[f]) continue;
       least[f] = want[f];
       redo.push_back(static_cast<int>(f));
-      raised[f] = 1;
+      raised[f] = redone[f] = 1;
     }
     if (redo.empty()) break;
     ++report.edge_rounds;
+    ReturnTexels(view, faces);
     DISPEX_RETURN_IF_ERROR(ReprocessFaces(inputs, settings, redo, least, faces));
+    view = TakeView(inputs, faces);
   }
+  ReturnTexels(view, faces);
 
-  report.edges_shared = static_cast<std::int64_t>(steps.edges);
-  report.edges_sharp = static_cast<std::int64_t>(steps.skipped_edges);
   for (std::size_t f = 0; f < n; ++f) report.edge_raised_faces += raised[f];
   ListDiscontinuousFaces(inputs, faces, report);
-  for (const PtexEdgeStep& s : steps.edge_max) {
+  for (const auto& [key, s] : current) {
     report.edge_step_per_face = std::max(report.edge_step_per_face, s.per_face);
     report.edge_step_across_faces = std::max(report.edge_step_across_faces, s.across_faces);
     report.edges_over += s.across_faces > budget || (per_face && s.per_face > budget);

@@ -66,13 +66,16 @@ std::string ExtractReportSummary(const ExtractReport& r) {
                      s.texels_before ? 100.0 * double(s.texels_after) / double(s.texels_before) : 0,
                      s.constant_faces, s.max_measured_error);
   if (r.watertight != WatertightEdges::kOff) {
-    out += fmt::format(
-        "  edges ({}): {} shared, largest step {:.3g} across faces, {:.3g} per face ({:.2g} / "
-        "{:.2g} tolerances); {} faces raised in {} rounds, texels {} -> {}",
-        WatertightEdgesName(r.watertight), r.edges_shared, r.edge_step_across_faces,
-        r.edge_step_per_face, r.edge_step_across_faces / r.tolerance,
-        r.edge_step_per_face / r.tolerance, r.edge_raised_faces, r.edge_rounds,
-        r.texels_before_edges, s.texels_after);
+    out += fmt::format("  edges ({}): {} shared, largest step {:.3g} across faces ({:.2g} "
+                       "tolerances)",
+                       WatertightEdgesName(r.watertight), r.edges_shared,
+                       r.edge_step_across_faces, r.edge_step_across_faces / r.tolerance);
+    if (r.watertight == WatertightEdges::kAll) {
+      out += fmt::format(", {:.3g} per face ({:.2g} tolerances)", r.edge_step_per_face,
+                         r.edge_step_per_face / r.tolerance);
+    }
+    out += fmt::format("; {} faces raised in {} rounds, texels {} -> {}", r.edge_raised_faces,
+                       r.edge_rounds, r.texels_before_edges, s.texels_after);
     if (r.edges_over + r.edges_sharp + r.edges_discontinuous > 0) {
       out += fmt::format("; not held: {} over the tolerance, {} on sharp creases, {} beside "
                          "filled holes or other sheets",

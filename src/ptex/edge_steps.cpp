@@ -12,7 +12,8 @@ namespace dispex {
 PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
                                    std::span<const std::vector<float>> texels,
                                    std::span<const std::uint8_t> skip_edges,
-                                   std::span<const std::uint8_t> skip_faces) {
+                                   std::span<const std::uint8_t> skip_faces,
+                                   const PtexEdgeMeasure& measure) {
   const PtexMapSampler sampler(faces, texels);
   const std::size_t n = faces.size();
   struct FaceSteps {
@@ -38,6 +39,10 @@ PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
       if (faces[fi].subface == faces[std::size_t(a)].subface && (a < f || (a == f && first.edge < e))) {
         continue;
       }
+      if (!measure.only_faces.empty() && !measure.only_faces[fi] &&
+          !measure.only_faces[std::size_t(a)]) {
+        continue;
+      }
       ++out.edges;
       if (skip_edges[fi] & (1u << e)) {
         ++out.skipped_edges;
@@ -53,11 +58,15 @@ PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
         PtexEdgePoint(e, t, u, v);
         PtexEdgePoint(other.edge, other.t, ou, ov);
         const double face_step =
-            std::abs(sampler.SampleFace(PtexFaceId(f), u, v) - sampler.SampleFace(other.face, ou, ov));
+            measure.per_face ? std::abs(sampler.SampleFace(PtexFaceId(f), u, v) -
+                                        sampler.SampleFace(other.face, ou, ov))
+                             : 0.0;
         const double filter_step = std::abs(sampler.SampleAcrossFaces(PtexFaceId(f), u, v) -
                                             sampler.SampleAcrossFaces(other.face, ou, ov));
-        out.per_face.push_back(static_cast<float>(face_step));
-        out.across_faces.push_back(static_cast<float>(filter_step));
+        if (measure.keep_points) {
+          out.per_face.push_back(static_cast<float>(face_step));
+          out.across_faces.push_back(static_cast<float>(filter_step));
+        }
         if (face_step > worst.per_face) worst.per_face = face_step, worst.t_per_face = t;
         if (filter_step > worst.across_faces) {
           worst.across_faces = filter_step, worst.t_across_faces = t;
