@@ -34,8 +34,9 @@ class Watertight : public ::testing::Test {
   }
 
   Extracted Run(const std::string& base, const std::string& sculpt, WatertightEdges mode,
-                const std::string& name, int threads = 0) {
+                const std::string& name, int threads = 0, int max_oversample = 128) {
     ExtractOptions options;
+    options.max_oversample = max_oversample;
     options.base_path = base;
     options.sculpt_path = sculpt;
     options.output_path = dir_ / name;
@@ -98,10 +99,10 @@ TEST_F(Watertight, RidgesMeetUnderBothReaders) {
 }
 
 // The bunny scan (tests/data/README.md): holes filled and folds are not held; the rest meets
-// through the Ptex filter. Faces read on their own meet at p99 with --watertight all; their
-// largest step stays above 2 tolerances at a few tens of edges where 128 samples per side do not
-// resolve the scan (docs/ACCURACY.md), so only the p99 is checked for that reader.
-TEST_F(Watertight, RealScanMeetsThroughTheFilter) {
+// through the Ptex filter. Faces read on their own need up to 512 samples per side to resolve
+// the scan at their edges (with the default 128, a few tens of edges stay at 2-3.5 tolerances:
+// docs/ACCURACY.md).
+TEST_F(Watertight, RealScanMeetsUnderBothReaders) {
   const std::string cage = DataPath("meshes/stanford_bunny/bun_zipper_quadriflow_1000.obj");
   const std::string scan = DataPath("meshes/stanford_bunny/bun_zipper.ply");
   const Extracted filter = Run(cage, scan, WatertightEdges::kFilter, "filter.ptx");
@@ -111,9 +112,9 @@ TEST_F(Watertight, RealScanMeetsThroughTheFilter) {
   EXPECT_EQ(static_cast<std::size_t>(filter.report.edges_discontinuous),
             filter.edges.discontinuous_edges);
 
-  const Extracted all = Run(cage, scan, WatertightEdges::kAll, "all.ptx");
+  const Extracted all = Run(cage, scan, WatertightEdges::kAll, "all.ptx", 0, 512);
   ExpectHeld(all.edges.edge_across_faces, tau, "all map, across faces");
-  EXPECT_LE(all.edges.edge_per_face.p99, tau);
+  ExpectHeld(all.edges.edge_per_face, tau, "all map, per face");
 }
 
 // Raising faces again is part of the map: the same bytes at any thread count.
