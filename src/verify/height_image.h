@@ -8,7 +8,7 @@
 #include "core/png_io.h"
 #include "dispex/status.h"
 
-namespace dispex {
+namespace dispex::verify {
 
 class HeightImage {
  public:
@@ -34,4 +34,4 @@ class HeightImage {
   std::vector<float> luminance_;  // rows from the bottom, i fastest
 };
 
-}  // namespace dispex
+}  // namespace dispex::verify

@@ -29,6 +29,7 @@
 namespace dispex {
 namespace {
 
+using namespace verify;
 using testing::DataPath;
 using testing::TempDir;
 
