@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
   // The samples extract takes: per face the automatic oversampling.
   const int n = surface.num_ptex_faces();
   std::vector<double> areas(static_cast<std::size_t>(n), 1.0);
-  OversamplingPlan plan = PlanOversampling(surface, sculpt, areas, 0, 4, 128);
+  extract::OversamplingPlan plan = extract::PlanOversampling(surface, sculpt, areas, 0, 4, 128);
   std::vector<std::size_t> start(static_cast<std::size_t>(n) + 1, 0);
   for (int f = 0; f < n; ++f) start[f + 1] = start[f] + (std::size_t(1) << (2 * plan.log2[f]));
   std::vector<Float3> points(start[n]), normals(start[n]);

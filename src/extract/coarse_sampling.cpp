@@ -11,7 +11,7 @@
 #include "core/vec3.h"
 #include "extract/parallel_errors.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 StatusOr<CoarseSampling> SampleCoarsely(const LimitSurface& surface) {
   const int n = surface.num_ptex_faces();
@@ -60,4 +60,4 @@ StatusOr<CoarseSampling> SampleCoarsely(const LimitSurface& surface) {
   return out;
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -7,7 +7,7 @@
 #include "dispex/status.h"
 #include "dispex/subdiv.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 struct CoarseSampling {
   std::vector<double> face_areas;  // per Ptex face (0 for holes)
@@ -16,4 +16,4 @@ struct CoarseSampling {
 
 StatusOr<CoarseSampling> SampleCoarsely(const LimitSurface& surface);
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -8,7 +8,7 @@
 
 #include "dispex/ptex_sampler.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 namespace {
 
@@ -197,4 +197,4 @@ void ListDiscontinuousFaces(const ExtractInputs& inputs, const ProcessedFaces& f
       static_cast<std::int64_t>(CountEdgesTouching(inputs.faces, discontinuous, holes));
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

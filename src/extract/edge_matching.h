@@ -9,7 +9,7 @@
 #include "extract/extract_settings.h"
 #include "extract/process_faces.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 // In rounds: measure every shared edge (MeasurePtexEdgeSteps); for each edge over
 // settings.edge_step_budget, raise the resolution that causes it -- through the cross-face
@@ -28,4 +28,4 @@ Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
 void ListDiscontinuousFaces(const ExtractInputs& inputs, const ProcessedFaces& faces,
                             ExtractReport& report);
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -21,7 +21,7 @@
 #include "extract/parallel_errors.h"
 #include "extract/process_faces.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 namespace {
 
@@ -87,6 +87,10 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
 
 }  // namespace
 
+}  // namespace dispex::extract
+
+namespace dispex {
+
 StatusOr<ExtractReport> Extract(const ExtractOptions& options) {
   DISPEX_RETURN_IF_ERROR(ValidateExtractOptions(options));
   // threads = N runs every parallel loop (Embree's BVH build included) in an arena of N
@@ -102,7 +106,7 @@ StatusOr<ExtractReport> Extract(const ExtractOptions& options) {
       arena.max_concurrency(),
       static_cast<int>(
           tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
-  return arena.execute([&] { return ExtractInArena(options, threads); });
+  return arena.execute([&] { return extract::ExtractInArena(options, threads); });
 }
 
 }  // namespace dispex

@@ -13,7 +13,7 @@
 #include "extract/parallel_errors.h"
 #include "extract/ptex_face_table.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 namespace {
 
@@ -113,4 +113,4 @@ StatusOr<ExtractInputs> LoadInputs(const ExtractOptions& options, std::uint64_t 
                        std::move(meshes.surface), std::move(faces), std::move(tracer)};
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -12,7 +12,7 @@
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 struct ExtractInputs {
   Mesh base;
@@ -29,4 +29,4 @@ struct ExtractInputs {
 StatusOr<ExtractInputs> LoadInputs(const ExtractOptions& options, std::uint64_t memory_limit,
                                    ExtractReport& report);
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-namespace dispex {
+namespace dispex::extract {
 
 namespace {
 std::string FileName(const std::string& path) {
@@ -133,4 +133,4 @@ Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractRep
   return Status::Ok();
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

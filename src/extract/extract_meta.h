@@ -9,7 +9,7 @@
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 // Every option that affects the output (not threads, progress or paths).
 nlohmann::json ExtractOptionsJson(const ExtractOptions& options);
@@ -23,4 +23,4 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& report);
 // ids whose data may jump at their edges; when there are any).
 Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractReport& report);
 
-}  // namespace dispex
+}  // namespace dispex::extract

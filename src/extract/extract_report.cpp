@@ -13,9 +13,9 @@ std::string ExtractReportJson(const ExtractReport& r) {
                  {"sculpt", r.sculpt_path},
                  {"sculpt_fingerprint", r.sculpt_fingerprint}};
   j["output"] = {{"path", r.output_path}, {"bytes", r.bytes_written}};
-  j["options"] = ExtractOptionsJson(r.options);
+  j["options"] = extract::ExtractOptionsJson(r.options);
   j["threads"] = r.threads;
-  j["statistics"] = ExtractStatisticsJson(r);
+  j["statistics"] = extract::ExtractStatisticsJson(r);
   if (r.search_distance_auto) {
     const SearchDistanceEstimate& e = r.search_estimate;
     j["search_estimate"] = {{"samples", e.samples},

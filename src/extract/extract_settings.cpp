@@ -8,7 +8,7 @@
 #include "core/system.h"
 #include "extract/coarse_sampling.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 namespace {
 
@@ -102,4 +102,4 @@ StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
   return settings;
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -8,7 +8,7 @@
 #include "extract/extract_inputs.h"
 #include "extract/oversampling.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 struct ExtractSettings {
   OversamplingPlan plan;  // samples per side of each Ptex face
@@ -34,4 +34,4 @@ struct ExtractSettings {
 StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
                                           const ExtractInputs& inputs, ExtractReport& report);
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -7,7 +7,7 @@
 
 #include "core/system.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 namespace {
 
@@ -125,4 +125,4 @@ StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
   return result;
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -15,7 +15,7 @@
 #include "extract/extract_settings.h"
 #include "extract/hole_fill.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 // What a face contributes to the report, kept for every face until the totals.
 struct FaceStats {
@@ -68,4 +68,4 @@ StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
                                  const ExtractSettings& settings, FaceScratch& scratch,
                                  std::array<int, 2> least_log2 = {0, 0});
 
-}  // namespace dispex
+}  // namespace dispex::extract

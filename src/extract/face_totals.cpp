@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace dispex {
+namespace dispex::extract {
 
 namespace {
 
@@ -75,4 +75,4 @@ Status AddFaceTotals(const ExtractOptions& options, const ExtractInputs& inputs,
   return inputs.tracer->status();
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -7,7 +7,7 @@
 #include "extract/extract_settings.h"
 #include "extract/process_faces.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 // Fails when more than options.max_miss_fraction of the samples missed, or when the tracer
 // reported an error.
@@ -15,4 +15,4 @@ Status AddFaceTotals(const ExtractOptions& options, const ExtractInputs& inputs,
                      const ExtractSettings& settings, const ProcessedFaces& faces,
                      ExtractReport& report);
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstddef>
 
-namespace dispex {
+namespace dispex::extract {
 
 namespace {
 
@@ -159,4 +159,4 @@ CrossFaceFill FillEmptyFaces(std::vector<std::uint8_t>& filled, std::vector<Edge
   return result;
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -14,7 +14,7 @@
 
 #include "dispex/ptex.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 // Reusable buffers, so filling allocates nothing once warmed up.
 struct PullPushScratch {
@@ -47,4 +47,4 @@ struct CrossFaceFill {
 CrossFaceFill FillEmptyFaces(std::vector<std::uint8_t>& filled, std::vector<EdgeMeans>& edges,
                              std::span<const PtexFaceInfo> faces);
 
-}  // namespace dispex
+}  // namespace dispex::extract

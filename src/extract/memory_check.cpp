@@ -7,7 +7,7 @@
 
 #include "dispex/extract.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 namespace {
 
@@ -64,4 +64,4 @@ Status CheckMemoryForSculpt(std::size_t sculpt_vertices, std::size_t sculpt_face
   return Status::Ok();
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -7,7 +7,7 @@
 #include "dispex/extract.h"
 #include "dispex/status.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 // Memory an extraction is estimated to need, in bytes: before reading, from the input file
 // sizes (mesh arrays take about half an OBJ's bytes); after reading, from the sculpt's
@@ -18,4 +18,4 @@ Status CheckMemoryForSculpt(std::size_t sculpt_vertices, std::size_t sculpt_face
                             std::size_t sculpt_indices, std::uint64_t base_texels,
                             std::uint64_t limit);
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -4,7 +4,7 @@
 
 #include "extract/hole_fill.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 Status FillMissedFaces(const ExtractOptions& options, const ExtractInputs& inputs,
                        ProcessedFaces& faces, PtexWriter& writer, ExtractReport& report) {
@@ -43,4 +43,4 @@ Status FillMissedFaces(const ExtractOptions& options, const ExtractInputs& input
   return Status::Ok();
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -8,10 +8,10 @@
 #include "extract/extract_inputs.h"
 #include "extract/process_faces.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 // Fails when no ray of any face hit the sculpt. Completes the filled faces' statistics.
 Status FillMissedFaces(const ExtractOptions& options, const ExtractInputs& inputs,
                        ProcessedFaces& faces, PtexWriter& writer, ExtractReport& report);
 
-}  // namespace dispex
+}  // namespace dispex::extract

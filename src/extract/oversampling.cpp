@@ -7,7 +7,7 @@
 #include <bit>
 #include <cmath>
 
-namespace dispex {
+namespace dispex::extract {
 
 namespace {
 
@@ -74,4 +74,4 @@ OversamplingPlan PlanOversampling(const LimitSurface& surface, const Mesh& sculp
   return plan;
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -14,7 +14,7 @@
 #include "dispex/mesh.h"
 #include "dispex/subdiv.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 struct OversamplingPlan {
   std::vector<std::uint8_t> log2;  // per Ptex face: samples per side = 1 << log2 (0 for holes)
@@ -29,4 +29,4 @@ OversamplingPlan PlanOversampling(const LimitSurface& surface, const Mesh& sculp
                                   const std::vector<double>& face_areas, int fixed,
                                   int min_samples, int max_samples);
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -8,11 +8,11 @@
 #include "dispex/cancel.h"
 #include "dispex/status.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 inline Status Cancelled() {
   int sig = CancelSignal();
   return Status::Error(sig ? fmt::format("interrupted by signal {}", sig) : "interrupted");
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

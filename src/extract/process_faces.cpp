@@ -8,7 +8,7 @@
 #include "core/system.h"
 #include "extract/parallel_errors.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 namespace {
 
@@ -164,4 +164,4 @@ Status WriteKeptFaces(PtexWriter& writer, const ExtractInputs& inputs,
   return error.failed() ? error.status() : Status::Ok();
 }
 
-}  // namespace dispex
+}  // namespace dispex::extract

@@ -12,7 +12,7 @@
 #include "extract/extract_settings.h"
 #include "extract/face_pipeline.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 // The worker threads' counters, summed.
 struct WorkerTotals {
@@ -55,4 +55,4 @@ Status WriteKeptFaces(PtexWriter& writer, const ExtractInputs& inputs,
 Status WriteConstantFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFaceId face,
                          float value);
 
-}  // namespace dispex
+}  // namespace dispex::extract

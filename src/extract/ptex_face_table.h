@@ -7,11 +7,11 @@
 #include "dispex/ptex.h"
 #include "dispex/subdiv.h"
 
-namespace dispex {
+namespace dispex::extract {
 
 // One PtexFaceInfo per Ptex face: neighbours and shared edges as Far::PtexIndices gives them
 // (-1 / 0 where there is none), `subface` for the quads an n-gon is split into, resolution 1x1
 // (each face's own is set when it is written).
 std::vector<PtexFaceInfo> PtexFaceTable(const LimitSurface& surface);
 
-}  // namespace dispex
+}  // namespace dispex::extract

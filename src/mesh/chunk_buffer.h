@@ -13,7 +13,7 @@
 #include <type_traits>
 #include <utility>
 
-namespace dispex {
+namespace dispex::mesh {
 
 template <class T>
 class ChunkBuffer {
@@ -76,4 +76,4 @@ class ChunkBuffer {
   std::size_t capacity_ = 0;
 };
 
-}  // namespace dispex
+}  // namespace dispex::mesh

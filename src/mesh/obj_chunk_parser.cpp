@@ -10,7 +10,7 @@
 #include "mesh/obj_tags.h"
 #include "mesh/text_scan.h"
 
-namespace dispex::obj {
+namespace dispex::mesh {
 namespace {
 
 class ChunkParser {
@@ -25,7 +25,7 @@ class ChunkParser {
 
   void Run() {
     while (p_ < end_) {
-      text::SkipBlanks(p_, end_, line_);
+      SkipBlanks(p_, end_, line_);
       const LineKind kind = ReadKeyword(p_, end_);
       bool ok = true;
       switch (kind) {
@@ -48,10 +48,10 @@ class ChunkParser {
         case LineKind::kIgnored:
           break;
         case LineKind::kNotKeyword:
-          ok = Fail(text::IsDanglingContinuation(p_, end_)
+          ok = Fail(IsDanglingContinuation(p_, end_)
                         ? std::string("line continued with '\\' at the end of the file")
                         : fmt::format("line does not start with an OBJ keyword ('{}')",
-                                      text::TokenForMessage(p_, end_)));
+                                      TokenForMessage(p_, end_)));
           break;
       }
       if (!ok) return;
@@ -61,7 +61,7 @@ class ChunkParser {
         ++p_;
         ++line_;
       } else {
-        text::SkipLogicalLine(in_.file_begin, p_, end_, line_);
+        SkipLogicalLine(in_.file_begin, p_, end_, line_);
       }
     }
   }
@@ -76,10 +76,10 @@ class ChunkParser {
 
   // A byte where an argument should end or start that is neither: name it.
   bool FailUnexpected(const char* what) {
-    if (text::IsDanglingContinuation(p_, end_)) {
+    if (IsDanglingContinuation(p_, end_)) {
       return Fail("line continued with '\\' at the end of the file");
     }
-    return Fail(fmt::format("unexpected '{}' {}", text::TokenForMessage(p_, end_), what));
+    return Fail(fmt::format("unexpected '{}' {}", TokenForMessage(p_, end_), what));
   }
 
   // The numbers of a `v` or `vt` line: `needed` floats, then up to `stored` - `needed`
@@ -91,33 +91,33 @@ class ChunkParser {
   // "bad vertex coordinate 'x'", "vertex coordinate 'nan' is not a finite number".
   [[gnu::noinline]] bool ParseNumbers(float* out, int needed, int stored, const char* what) {
     for (int k = 0; k < stored; ++k) {
-      text::SkipBlanks(p_, end_, line_);
+      SkipBlanks(p_, end_, line_);
       if (AtStatementEnd()) {
         if (k >= needed) return true;
         return Fail(fmt::format("{} has {} coordinate{} ({} needed)", what, k,
                                 k == 1 ? "" : "s", needed));
       }
       const char* token = p_;
-      const text::NumberResult r = text::ParseReal(p_, end_, out[k]);
-      if (r == text::NumberResult::kOk && text::EndsToken(p_, end_)) continue;
+      const NumberResult r = ParseReal(p_, end_, out[k]);
+      if (r == NumberResult::kOk && EndsToken(p_, end_)) continue;
       p_ = token;
-      if (r == text::NumberResult::kNotFinite) {
+      if (r == NumberResult::kNotFinite) {
         return Fail(fmt::format("{} coordinate '{}' is not a finite number", what,
-                                text::TokenForMessage(p_, end_)));
+                                TokenForMessage(p_, end_)));
       }
-      if (text::IsDanglingContinuation(p_, end_)) {
+      if (IsDanglingContinuation(p_, end_)) {
         return Fail("line continued with '\\' at the end of the file");
       }
-      return Fail(fmt::format("bad {} coordinate '{}'", what, text::TokenForMessage(p_, end_)));
+      return Fail(fmt::format("bad {} coordinate '{}'", what, TokenForMessage(p_, end_)));
     }
     // Optional w or per-vertex colour values: must be numbers, otherwise ignored.
     for (;;) {
-      text::SkipBlanks(p_, end_, line_);
+      SkipBlanks(p_, end_, line_);
       if (AtStatementEnd()) return true;
       const char* token = p_;
       double extra = 0;
-      if (text::ParseReal(p_, end_, extra) != text::NumberResult::kOk ||
-          !text::EndsToken(p_, end_)) {
+      if (ParseReal(p_, end_, extra) != NumberResult::kOk ||
+          !EndsToken(p_, end_)) {
         p_ = token;
         return FailUnexpected(fmt::format("after the {} coordinates", what).c_str());
       }
@@ -174,7 +174,7 @@ class ChunkParser {
     std::uint32_t count = 0;
     std::uint32_t textured = 0;  // corners that named a texture coordinate
     for (;;) {
-      text::SkipBlanks(p_, end_, line_);
+      SkipBlanks(p_, end_, line_);
       if (AtStatementEnd()) break;
       const char* token = p_;
       std::int64_t index = 0;
@@ -193,27 +193,27 @@ class ChunkParser {
         ++count;
         continue;
       }
-      text::NumberResult r = text::ParseInt(p_, end_, index);
+      NumberResult r = ParseInt(p_, end_, index);
       bool has_texture = false;
       std::int64_t texture = 0;
-      if (r == text::NumberResult::kOk && p_ < end_ && *p_ == '/') {
+      if (r == NumberResult::kOk && p_ < end_ && *p_ == '/') {
         ++p_;
         if (p_ < end_ && *p_ != '/') {
-          r = text::ParseInt(p_, end_, texture);
+          r = ParseInt(p_, end_, texture);
           has_texture = true;
         }
-        if (r == text::NumberResult::kOk && p_ < end_ && *p_ == '/') {
+        if (r == NumberResult::kOk && p_ < end_ && *p_ == '/') {
           std::int64_t unused = 0;
           ++p_;
-          r = text::ParseInt(p_, end_, unused);  // normal index
+          r = ParseInt(p_, end_, unused);  // normal index
         }
       }
-      if (r != text::NumberResult::kOk || !text::EndsToken(p_, end_)) {
+      if (r != NumberResult::kOk || !EndsToken(p_, end_)) {
         p_ = token;
-        if (text::IsDanglingContinuation(p_, end_)) {
+        if (IsDanglingContinuation(p_, end_)) {
           return Fail("line continued with '\\' at the end of the file");
         }
-        return Fail(fmt::format("bad face vertex '{}'", text::TokenForMessage(p_, end_)));
+        return Fail(fmt::format("bad face vertex '{}'", TokenForMessage(p_, end_)));
       }
       std::int64_t vertex = 0;
       if (index > 0) {
@@ -268,15 +268,15 @@ class ChunkParser {
   bool ParseGroup() {
     std::string name;
     for (;;) {
-      text::SkipBlanks(p_, end_, line_);
+      SkipBlanks(p_, end_, line_);
       if (AtStatementEnd()) break;
-      if (text::IsDanglingContinuation(p_, end_)) {
+      if (IsDanglingContinuation(p_, end_)) {
         return Fail("line continued with '\\' at the end of the file");
       }
       int length = 0;
       const char* start = p_;
-      while (p_ < end_ && !text::IsBlank(*p_) && *p_ != '\n' &&
-             !text::IsContinuation(p_, end_, length) && !text::IsDanglingContinuation(p_, end_)) {
+      while (p_ < end_ && !IsBlank(*p_) && *p_ != '\n' &&
+             !IsContinuation(p_, end_, length) && !IsDanglingContinuation(p_, end_)) {
         ++p_;
       }
       if (!name.empty()) name.push_back(' ');
@@ -314,4 +314,4 @@ bool ParseChunk(const ChunkInput& in, ChunkOutput& out) {
   return true;
 }
 
-}  // namespace dispex::obj
+}  // namespace dispex::mesh

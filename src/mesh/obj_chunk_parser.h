@@ -15,7 +15,7 @@
 #include "dispex/mesh.h"
 #include "mesh/chunk_buffer.h"
 
-namespace dispex::obj {
+namespace dispex::mesh {
 
 struct ChunkInput {
   const char* file_begin = nullptr;     // start of the whole buffer (for look-back)
@@ -62,4 +62,4 @@ struct ChunkOutput {
 // Returns false only when an index buffer cannot be mapped (out of memory).
 bool ParseChunk(const ChunkInput& in, ChunkOutput& out);
 
-}  // namespace dispex::obj
+}  // namespace dispex::mesh

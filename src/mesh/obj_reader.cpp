@@ -60,7 +60,7 @@ std::vector<Chunk> CutIntoChunks(std::string_view bytes, std::size_t chunk_bytes
   while (start < end) {
     const char* stop = end;
     if (static_cast<std::size_t>(end - start) > chunk_bytes) {
-      stop = obj::NextLineStart(begin, start + chunk_bytes - 1, end);
+      stop = mesh::NextLineStart(begin, start + chunk_bytes - 1, end);
     }
     chunks.push_back({start, stop});
     start = stop;
@@ -74,16 +74,16 @@ ChunkCounts CountChunk(const char* file_begin, const Chunk& chunk) {
   ChunkCounts counts;
   auto classify = [&](const char* p) {
     std::int64_t crossed = 0;  // continuations at the line start: counted below, as newlines
-    text::SkipBlanks(p, chunk.end, crossed);
-    const obj::LineKind kind = obj::ReadKeyword(p, chunk.end);
-    counts.vertices += kind == obj::LineKind::kVertex;
-    counts.texcoords += kind == obj::LineKind::kTexCoord;
-    counts.faces += kind == obj::LineKind::kFace;
+    mesh::SkipBlanks(p, chunk.end, crossed);
+    const mesh::LineKind kind = mesh::ReadKeyword(p, chunk.end);
+    counts.vertices += kind == mesh::LineKind::kVertex;
+    counts.texcoords += kind == mesh::LineKind::kTexCoord;
+    counts.faces += kind == mesh::LineKind::kFace;
   };
   classify(chunk.begin);
-  text::ForEachNewline(chunk.begin, chunk.end, [&](const char* newline) {
+  mesh::ForEachNewline(chunk.begin, chunk.end, [&](const char* newline) {
     ++counts.lines;
-    if (newline + 1 < chunk.end && !text::IsContinuedNewline(file_begin, newline)) {
+    if (newline + 1 < chunk.end && !mesh::IsContinuedNewline(file_begin, newline)) {
       classify(newline + 1);
     }
   });
@@ -106,8 +106,8 @@ Status LineError(const std::string& name, std::int64_t line, const std::string& 
 }
 
 // Assigns group ids in order of first appearance, keeping only groups that own faces.
-void MergeGroups(const std::vector<obj::ChunkOutput>& outputs, Mesh& mesh) {
-  std::vector<const obj::GroupStart*> starts;
+void MergeGroups(const std::vector<mesh::ChunkOutput>& outputs, Mesh& mesh) {
+  std::vector<const mesh::GroupStart*> starts;
   for (const auto& out : outputs) {
     for (const auto& g : out.groups) starts.push_back(&g);
   }
@@ -143,13 +143,13 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   const char* file_begin = bytes.data();
 
   std::vector<ChunkCounts> counts(n);
-  std::vector<obj::ChunkOutput> outputs(n);
+  std::vector<mesh::ChunkOutput> outputs(n);
   Mesh mesh;
   mesh.source = name;
-  std::vector<obj::ChunkInput> inputs(n);
+  std::vector<mesh::ChunkInput> inputs(n);
   std::atomic<bool> out_of_memory{false};
 
-  RunWithThreads(options.threads, [&] {
+  mesh::RunWithThreads(options.threads, [&] {
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
       counts[i] = CountChunk(file_begin, chunks[i]);
       if (release_mapped_pages) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
@@ -196,9 +196,9 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     in.face_sizes = mesh.face_offsets.data() + 1;
   }
 
-  RunWithThreads(options.threads, [&] {
+  mesh::RunWithThreads(options.threads, [&] {
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      if (!obj::ParseChunk(inputs[i], outputs[i])) out_of_memory.store(true);
+      if (!mesh::ParseChunk(inputs[i], outputs[i])) out_of_memory.store(true);
       if (release_mapped_pages) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
     });
   });
@@ -207,7 +207,7 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   std::uint64_t corners = 0;
   std::int64_t faces_without_uvs = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const obj::ChunkOutput& out = outputs[i];
+    const mesh::ChunkOutput& out = outputs[i];
     if (out.error) return LineError(name, out.error->line, out.error->message);
     DISPEX_CHECK_EQ(out.vertices, counts[i].vertices);
     DISPEX_CHECK_EQ(out.texcoords, counts[i].texcoords);

@@ -10,7 +10,7 @@
 
 #include "mesh/text_scan.h"
 
-namespace dispex::obj {
+namespace dispex::mesh {
 
 enum class LineKind : std::uint8_t {
   kEmpty,       // blank line or comment
@@ -30,7 +30,7 @@ inline bool IsKeywordChar(char c) {
   return IsKeywordStart(c) || (c >= '0' && c <= '9');
 }
 
-// Classifies the logical line whose first non-blank byte is at `p` (after text::SkipBlanks)
+// Classifies the logical line whose first non-blank byte is at `p` (after SkipBlanks)
 // and moves `p` past the keyword. On kEmpty and kNotKeyword `p` does not move.
 inline LineKind ReadKeyword(const char*& p, const char* end) {
   if (p == end || *p == '\n' || *p == '#') return LineKind::kEmpty;
@@ -48,7 +48,7 @@ inline LineKind ReadKeyword(const char*& p, const char* end) {
   if (!IsKeywordStart(*p)) return LineKind::kNotKeyword;
   const char* q = p + 1;
   while (q < end && IsKeywordChar(*q)) ++q;
-  if (!text::EndsToken(q, end)) return LineKind::kNotKeyword;
+  if (!EndsToken(q, end)) return LineKind::kNotKeyword;
   const auto length = q - p;
   LineKind kind = LineKind::kIgnored;
   if (length == 1) {
@@ -80,8 +80,8 @@ inline LineKind ReadKeyword(const char*& p, const char* end) {
 // of the whole buffer, for looking back at a continuation before a newline.
 inline const char* NextLineStart(const char* begin, const char* p, const char* end) {
   std::int64_t unused_lines = 0;
-  text::SkipLogicalLine(begin, p, end, unused_lines);
+  SkipLogicalLine(begin, p, end, unused_lines);
   return p;
 }
 
-}  // namespace dispex::obj
+}  // namespace dispex::mesh

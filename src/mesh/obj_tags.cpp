@@ -11,7 +11,7 @@
 
 #include "mesh/text_scan.h"
 
-namespace dispex::obj {
+namespace dispex::mesh {
 namespace {
 
 bool AtLineEnd(const char* p, const char* end) {
@@ -20,12 +20,12 @@ bool AtLineEnd(const char* p, const char* end) {
 
 // Reads one blank-separated token; false at the end of the line.
 bool NextToken(const char*& p, const char* end, std::int64_t& line, std::string_view& token) {
-  text::SkipBlanks(p, end, line);
+  SkipBlanks(p, end, line);
   if (AtLineEnd(p, end)) return false;
   const char* start = p;
-  while (p < end && !text::IsBlank(*p) && *p != '\n') {
+  while (p < end && !IsBlank(*p) && *p != '\n') {
     int length = 0;
-    if (text::IsContinuation(p, end, length)) break;
+    if (IsContinuation(p, end, length)) break;
     ++p;
   }
   token = std::string_view(start, static_cast<std::size_t>(p - start));
@@ -35,11 +35,11 @@ bool NextToken(const char*& p, const char* end, std::int64_t& line, std::string_
 bool ParseTagInt(std::string_view token, std::int64_t& value) {
   const char* p = token.data();
   const char* end = p + token.size();
-  return text::ParseInt(p, end, value) == text::NumberResult::kOk && p == end;
+  return ParseInt(p, end, value) == NumberResult::kOk && p == end;
 }
 
 std::string Quoted(std::string_view token) {
-  return fmt::format("'{}'", text::TokenForMessage(token.data(), token.data() + token.size()));
+  return fmt::format("'{}'", TokenForMessage(token.data(), token.data() + token.size()));
 }
 
 // A tag line read but not yet interpreted: "t <name> <nint>/<nfloat>/<nstring> <args>".
@@ -63,7 +63,7 @@ bool ParseCounts(std::string_view token, std::int64_t counts[3]) {
       ok = q < q_end && *q == '/';
       ++q;
     }
-    ok = ok && text::ParseInt(q, q_end, counts[k]) == text::NumberResult::kOk && counts[k] >= 0;
+    ok = ok && ParseInt(q, q_end, counts[k]) == NumberResult::kOk && counts[k] >= 0;
   }
   return ok && q == q_end;
 }
@@ -97,12 +97,12 @@ bool ReadFloats(const char*& p, const char* end, std::int64_t& line, TagArgument
     const char* q = token.data();
     const char* q_end = q + token.size();
     float value = 0;
-    const text::NumberResult r = text::ParseReal(q, q_end, value);
-    if (r == text::NumberResult::kNotFinite) {
+    const NumberResult r = ParseReal(q, q_end, value);
+    if (r == NumberResult::kNotFinite) {
       error = fmt::format("tag '{}': value {} is not a finite number", tag.shown, Quoted(token));
       return false;
     }
-    if (r != text::NumberResult::kOk || q != q_end) {
+    if (r != NumberResult::kOk || q != q_end) {
       error = fmt::format("tag '{}': bad number {}", tag.shown, Quoted(token));
       return false;
     }
@@ -132,7 +132,7 @@ bool ReadTagArguments(const char*& p, const char* end, std::int64_t& line, TagAr
     return false;
   }
   tag.name = std::string(tag.name_token);
-  tag.shown = text::TokenForMessage(tag.name_token.data(),
+  tag.shown = TokenForMessage(tag.name_token.data(),
                                     tag.name_token.data() + tag.name_token.size());
   std::string_view counts_token;
   if (!NextToken(p, end, line, counts_token)) {
@@ -148,9 +148,9 @@ bool ReadTagArguments(const char*& p, const char* end, std::int64_t& line, TagAr
       !ReadStrings(p, end, line, tag, error)) {
     return false;
   }
-  text::SkipBlanks(p, end, line);
+  SkipBlanks(p, end, line);
   if (!AtLineEnd(p, end)) {
-    error = text::IsDanglingContinuation(p, end)
+    error = IsDanglingContinuation(p, end)
                 ? std::string("line continued with '\\' at the end of the file")
                 : fmt::format("tag '{}': unexpected {} after its {}/{}/{} arguments", tag.shown,
                               Quoted(std::string_view(p, static_cast<std::size_t>(end - p))),
@@ -329,12 +329,12 @@ bool ParseTag(const char*& p, const char* end, std::int64_t& line, const TagLimi
   if (tag.name == "creasemethod") return ApplyCreaseMethod(tag, tags, error);
   if (tag.name == "smoothtriangles") return ApplySmoothTriangles(tag, tags, error);
   // Printable and at most 64 bytes, so that warnings stay one line.
-  tags.ignored_tag_names.push_back(text::TokenForMessage(
+  tags.ignored_tag_names.push_back(TokenForMessage(
       tag.name_token.data(), tag.name_token.data() + tag.name_token.size(), 64));
   return true;
 }
 
-}  // namespace dispex::obj
+}  // namespace dispex::mesh
 
 namespace dispex {
 

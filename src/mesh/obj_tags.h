@@ -7,7 +7,7 @@
 
 #include "dispex/mesh.h"
 
-namespace dispex::obj {
+namespace dispex::mesh {
 
 // Sizes the tag's indices are checked against (vertex and face counts of the whole file).
 struct TagLimits {
@@ -35,4 +35,4 @@ struct TagLimits {
 bool ParseTag(const char*& p, const char* end, std::int64_t& line, const TagLimits& limits,
               SubdivTags& tags, std::string& error);
 
-}  // namespace dispex::obj
+}  // namespace dispex::mesh

@@ -5,7 +5,7 @@
 
 #include <utility>
 
-namespace dispex {
+namespace dispex::mesh {
 
 // Runs `work` in a TBB arena of `threads` workers, or in the current arena when threads <= 0
 // (TBB's default: all available cores).
@@ -19,4 +19,4 @@ void RunWithThreads(int threads, Work&& work) {
   }
 }
 
-}  // namespace dispex
+}  // namespace dispex::mesh

@@ -8,7 +8,7 @@
 
 #include "mesh/text_scan.h"
 
-namespace dispex::ply {
+namespace dispex::mesh {
 namespace {
 
 struct TypeInfo {
@@ -39,16 +39,16 @@ std::vector<std::string_view> SplitBlanks(std::string_view line) {
   std::vector<std::string_view> tokens;
   std::size_t i = 0;
   while (i < line.size()) {
-    while (i < line.size() && text::IsBlank(line[i])) ++i;
+    while (i < line.size() && IsBlank(line[i])) ++i;
     const std::size_t start = i;
-    while (i < line.size() && !text::IsBlank(line[i])) ++i;
+    while (i < line.size() && !IsBlank(line[i])) ++i;
     if (i > start) tokens.push_back(line.substr(start, i - start));
   }
   return tokens;
 }
 
 std::string Shown(std::string_view token) {
-  return text::TokenForMessage(token.data(), token.data() + token.size(), 32);
+  return TokenForMessage(token.data(), token.data() + token.size(), 32);
 }
 
 // Element and property names end up in error messages: a control byte in one (binary bytes
@@ -240,4 +240,4 @@ StatusOr<Header> ParseHeader(std::string_view bytes, const std::string& name) {
   return header;
 }
 
-}  // namespace dispex::ply
+}  // namespace dispex::mesh

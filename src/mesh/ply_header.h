@@ -19,7 +19,7 @@
 
 #include "dispex/status.h"
 
-namespace dispex::ply {
+namespace dispex::mesh {
 
 enum class Format : std::uint8_t { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
 
@@ -70,4 +70,4 @@ struct Header {
 // allocated for them.
 StatusOr<Header> ParseHeader(std::string_view bytes, const std::string& name);
 
-}  // namespace dispex::ply
+}  // namespace dispex::mesh

@@ -30,11 +30,11 @@
 namespace dispex {
 namespace {
 
-using ply::Element;
-using ply::Format;
-using ply::Header;
-using ply::Property;
-using ply::Type;
+using mesh::Element;
+using mesh::Format;
+using mesh::Header;
+using mesh::Property;
+using mesh::Type;
 
 constexpr std::size_t kBlock = 1 << 16;  // vertices or faces per parallel task
 
@@ -141,9 +141,9 @@ StatusOr<Layout> FindLayout(const Header& header, const std::string& name) {
   if (!list.is_list) {
     return Status::Error(fmt::format("{}: PLY face property '{}' is not a list", name, list.name));
   }
-  if (!ply::IsInteger(list.type)) {
+  if (!mesh::IsInteger(list.type)) {
     return Status::Error(fmt::format("{}: PLY face index type '{}' is not an integer type", name,
-                                     ply::TypeName(list.type)));
+                                     mesh::TypeName(list.type)));
   }
   layout.num_faces = face.count;
   if (layout.num_faces == 0) return Status::Error(name + ": PLY has no faces");
@@ -197,18 +197,18 @@ class BinaryReader {
   // Steps over one record's property; false if the file ends inside it.
   bool StepProperty(const Property& property, std::size_t& pos, std::int64_t* list_size) const {
     if (!property.is_list) {
-      const std::size_t size = static_cast<std::size_t>(ply::SizeOf(property.type));
+      const std::size_t size = static_cast<std::size_t>(mesh::SizeOf(property.type));
       if (size_ - pos < size) return false;
       pos += size;
       return true;
     }
-    const std::size_t count_size = static_cast<std::size_t>(ply::SizeOf(property.count_type));
+    const std::size_t count_size = static_cast<std::size_t>(mesh::SizeOf(property.count_type));
     if (size_ - pos < count_size) return false;
     const std::int64_t count = LoadInt(data_ + pos, property.count_type, swap_);
     pos += count_size;
     *list_size = count;
     if (count < 0) return true;  // the caller reports it
-    const std::size_t item = static_cast<std::size_t>(ply::SizeOf(property.type));
+    const std::size_t item = static_cast<std::size_t>(mesh::SizeOf(property.type));
     if (static_cast<std::uint64_t>(count) > (size_ - pos) / item) return false;
     pos += static_cast<std::size_t>(count) * item;
     return true;
@@ -278,7 +278,7 @@ class BinaryReader {
     for (int k = 0; k < 3 && fixed > 0; ++k) {
       for (int j = 0; j < axes[k]; ++j) {
         offsets[k] += static_cast<std::size_t>(
-            ply::SizeOf(element.properties[static_cast<std::size_t>(j)].type));
+            mesh::SizeOf(element.properties[static_cast<std::size_t>(j)].type));
       }
     }
     // Converts vertex v whose x, y, z values start at the byte offsets `at`.
@@ -296,7 +296,7 @@ class BinaryReader {
     };
     FirstError error;
     if (fixed > 0) {
-      RunWithThreads(threads_, [&] {
+      mesh::RunWithThreads(threads_, [&] {
         tbb::parallel_for(std::size_t{0}, (n + kBlock - 1) / kBlock, [&](std::size_t b) {
           for (std::size_t v = b * kBlock; v < std::min(n, (b + 1) * kBlock); ++v) {
             const std::size_t record = start + v * fixed;
@@ -330,11 +330,11 @@ class BinaryReader {
     const std::size_t n = static_cast<std::size_t>(element.count);
     mesh.face_indices.resize(mesh.face_offsets.back());
     const Property& list = element.properties[static_cast<std::size_t>(layout_.indices)];
-    const std::size_t count_size = static_cast<std::size_t>(ply::SizeOf(list.count_type));
-    const std::size_t item_size = static_cast<std::size_t>(ply::SizeOf(list.type));
+    const std::size_t count_size = static_cast<std::size_t>(mesh::SizeOf(list.count_type));
+    const std::size_t item_size = static_cast<std::size_t>(mesh::SizeOf(list.type));
     const std::int64_t num_vertices = static_cast<std::int64_t>(layout_.num_vertices);
     FirstError error;
-    RunWithThreads(threads_, [&] {
+    mesh::RunWithThreads(threads_, [&] {
       tbb::parallel_for(std::size_t{0}, face_block_starts_.size(), [&](std::size_t b) {
         std::size_t pos = face_block_starts_[b];
         for (std::size_t f = b * kBlock; f < std::min(n, (b + 1) * kBlock); ++f) {
@@ -454,7 +454,7 @@ class AsciiReader {
     SkipSpace();
     if (p_ != end_) {
       return Status::Error(fmt::format("{}:{}: unexpected '{}' after the last element", name_,
-                                       line_, text::TokenForMessage(p_, end_)));
+                                       line_, mesh::TokenForMessage(p_, end_)));
     }
     return mesh;
   }
@@ -466,7 +466,7 @@ class AsciiReader {
   }
 
   void SkipSpace() {
-    while (p_ < end_ && (text::IsBlank(*p_) || *p_ == '\n')) {
+    while (p_ < end_ && (mesh::IsBlank(*p_) || *p_ == '\n')) {
       if (*p_ == '\n') ++line_;
       ++p_;
     }
@@ -481,16 +481,16 @@ class AsciiReader {
       return Fail(element, index, fmt::format("file ends before its '{}' value", property.name));
     }
     const char* token = p_;
-    if (ply::IsInteger(type)) {
+    if (mesh::IsInteger(type)) {
       std::int64_t v = 0;
-      const text::NumberResult r = text::ParseInt(p_, end_, v);
-      if (r != text::NumberResult::kOk || !EndsValue()) {
+      const mesh::NumberResult r = mesh::ParseInt(p_, end_, v);
+      if (r != mesh::NumberResult::kOk || !EndsValue()) {
         p_ = token;
         return Fail(element, index,
-                    fmt::format("bad {} value '{}' for '{}'", ply::TypeName(type),
-                                text::TokenForMessage(p_, end_), property.name));
+                    fmt::format("bad {} value '{}' for '{}'", mesh::TypeName(type),
+                                mesh::TokenForMessage(p_, end_), property.name));
       }
-      const int bits = ply::SizeOf(type) * 8;
+      const int bits = mesh::SizeOf(type) * 8;
       const bool is_signed = type == Type::kInt8 || type == Type::kInt16 || type == Type::kInt32;
       const std::int64_t lo = is_signed ? -(std::int64_t{1} << (bits - 1)) : 0;
       const std::int64_t hi =
@@ -499,32 +499,32 @@ class AsciiReader {
         p_ = token;
         return Fail(element, index,
                     fmt::format("value {} of '{}' does not fit its type {}", v, property.name,
-                                ply::TypeName(type)));
+                                mesh::TypeName(type)));
       }
       value = static_cast<double>(v);
       return Status::Ok();
     }
-    text::NumberResult r;
+    mesh::NumberResult r;
     if (type == Type::kFloat32) {
       float f = 0;
-      r = text::ParseReal(p_, end_, f);
+      r = mesh::ParseReal(p_, end_, f);
       value = f;
     } else {
-      r = text::ParseReal(p_, end_, value);
+      r = mesh::ParseReal(p_, end_, value);
     }
-    if (r == text::NumberResult::kOk && EndsValue()) return Status::Ok();
+    if (r == mesh::NumberResult::kOk && EndsValue()) return Status::Ok();
     p_ = token;
-    if (r == text::NumberResult::kNotFinite) {
+    if (r == mesh::NumberResult::kNotFinite) {
       return Fail(element, index,
                   fmt::format("'{}' value '{}' is not a finite number", property.name,
-                              text::TokenForMessage(p_, end_)));
+                              mesh::TokenForMessage(p_, end_)));
     }
     return Fail(element, index,
-                fmt::format("bad {} value '{}' for '{}'", ply::TypeName(type),
-                            text::TokenForMessage(p_, end_), property.name));
+                fmt::format("bad {} value '{}' for '{}'", mesh::TypeName(type),
+                            mesh::TokenForMessage(p_, end_), property.name));
   }
 
-  bool EndsValue() const { return p_ == end_ || text::IsBlank(*p_) || *p_ == '\n'; }
+  bool EndsValue() const { return p_ == end_ || mesh::IsBlank(*p_) || *p_ == '\n'; }
 
   const char* p_;
   const char* end_;
@@ -538,7 +538,7 @@ class AsciiReader {
 
 StatusOr<Mesh> ParsePly(std::string_view bytes, const std::string& name,
                         const ReadOptions& options) {
-  DISPEX_ASSIGN_OR_RETURN(const Header header, ply::ParseHeader(bytes, name));
+  DISPEX_ASSIGN_OR_RETURN(const Header header, mesh::ParseHeader(bytes, name));
   DISPEX_ASSIGN_OR_RETURN(const Layout layout, FindLayout(header, name));
   if (header.format == Format::kAscii) return AsciiReader(bytes, name, header, layout).Read();
   return BinaryReader(bytes, name, header, layout, options.threads).Read();

@@ -20,7 +20,7 @@
 #include <string>
 #include <string_view>
 
-namespace dispex::text {
+namespace dispex::mesh {
 
 inline bool IsBlank(char c) {
   return c == ' ' || c == '\t' || c == '\r';
@@ -175,4 +175,4 @@ inline NumberResult ParseReal(const char*& p, const char* end, T& value) {
   return NumberResult::kOk;
 }
 
-}  // namespace dispex::text
+}  // namespace dispex::mesh

@@ -33,7 +33,9 @@ void Image::set(int x, int y, std::array<std::uint8_t, 3> colour) {
   rgb[i + 2] = colour[2];
 }
 
-namespace render {
+}  // namespace dispex
+
+namespace dispex::render {
 
 void FillRect(Image& image, int x, int y, int w, int h, Rgb colour) {
   const int x0 = std::max(x, 0), x1 = std::min(x + w, image.width);
@@ -56,5 +58,4 @@ void Blit(Image& target, const Image& source, int x, int y) {
   }
 }
 
-}  // namespace render
-}  // namespace dispex
+}  // namespace dispex::render

@@ -705,6 +705,8 @@ class Tessellation {
       const Float3& b = mesh.positions[static_cast<std::size_t>(mesh.face_indices[3 * t + 1])];
       const Float3& c = mesh.positions[static_cast<std::size_t>(mesh.face_indices[3 * t + 2])];
       const Float3 e1 = Sub(b, a), e2 = Sub(c, a);
+      // A float cross product, not Vec3d's Cross: in double a third of the components round
+      // differently, and the normals (and pixels) would change.
       triangle_normals[t] = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z,
                              e1.x * e2.y - e1.y * e2.x};
     });

@@ -13,8 +13,7 @@
 
 #include "dispex/spectral.h"
 
-namespace dispex {
-namespace spectral {
+namespace dispex::spectral {
 namespace {
 
 // Per output position: the two texels read and the weight of the second.
@@ -161,5 +160,4 @@ StatusOr<double> MaxBilinearError(std::span<const float> texels, int ulog2, int 
                                     std::numeric_limits<double>::infinity());
 }
 
-}  // namespace spectral
-}  // namespace dispex
+}  // namespace dispex::spectral

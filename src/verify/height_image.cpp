@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-namespace dispex {
+namespace dispex::verify {
 
 HeightImage HeightImage::FromPixels(const PngPixels& pixels) {
   HeightImage image;
@@ -50,4 +50,4 @@ double HeightImage::Sample(double s, double t) const {
   return (1 - ay) * bottom + ay * top;
 }
 
-}  // namespace dispex
+}  // namespace dispex::verify

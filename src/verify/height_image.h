@@ -5,14 +5,14 @@
 #include <string>
 #include <vector>
 
-#include "core/png_read.h"
+#include "core/png_io.h"
 #include "dispex/status.h"
 
-namespace dispex {
+namespace dispex::verify {
 
 class HeightImage {
  public:
-  // Reads the PNG at `path` (errors name it, see core/png_read.h) and converts it.
+  // Reads the PNG at `path` (errors name it, see core/png_io.h) and converts it.
   static StatusOr<HeightImage> Read(const std::string& path);
   // Luminance of decoded pixels (PngConversion::kNative): grey / max, or Rec. 709 weights
   // 0.2126 R + 0.7152 G + 0.0722 B on the stored values / max (max 255 or 65535); alpha is
@@ -34,4 +34,4 @@ class HeightImage {
   std::vector<float> luminance_;  // rows from the bottom, i fastest
 };
 
-}  // namespace dispex
+}  // namespace dispex::verify

@@ -267,7 +267,7 @@ struct SculptQuality {
 // See MakeSculptReport::linear_error and folded_faces. `layout.mesh` already holds the
 // displaced positions.
 StatusOr<SculptQuality> MeasureSculpt(const LimitSurface& surface, const SculptLayoutMesh& layout,
-                                      const PatternField& pattern) {
+                                      const verify::PatternField& pattern) {
   const Mesh& mesh = layout.mesh;
   const std::size_t faces = mesh.num_faces();
   SculptQuality quality;
@@ -451,8 +451,8 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   frame.seed = options.seed;
   // Before the refinement, so that a bad image or a cage without UVs fails at once.
   DISPEX_ASSIGN_OR_RETURN(
-      PatternField pattern,
-      PatternField::Create(options.pattern, options.image_path, frame, cage, surface));
+      verify::PatternField pattern,
+      verify::PatternField::Create(options.pattern, options.image_path, frame, cage, surface));
 
   SculptLayoutMesh layout;
   if (jittered) {

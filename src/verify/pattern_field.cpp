@@ -1,7 +1,7 @@
 // See pattern_field.h.
 #include "verify/pattern_field.h"
 
-namespace dispex {
+namespace dispex::verify {
 
 StatusOr<PatternField> PatternField::Create(Pattern pattern, const std::string& image_path,
                                             const PatternFrame& frame, const Mesh& cage,
@@ -16,4 +16,4 @@ StatusOr<PatternField> PatternField::Create(Pattern pattern, const std::string& 
   return field;
 }
 
-}  // namespace dispex
+}  // namespace dispex::verify

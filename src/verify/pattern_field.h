@@ -12,7 +12,7 @@
 #include "verify/height_image.h"
 #include "verify/uv_charts.h"
 
-namespace dispex {
+namespace dispex::verify {
 
 class PatternField {
  public:
@@ -38,4 +38,4 @@ class PatternField {
   std::optional<HeightImage> image_;
 };
 
-}  // namespace dispex
+}  // namespace dispex::verify

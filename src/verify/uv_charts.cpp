@@ -3,7 +3,7 @@
 
 #include <fmt/format.h>
 
-namespace dispex {
+namespace dispex::verify {
 
 StatusOr<PtexUvCharts> PtexUvCharts::Build(const Mesh& cage, const LimitSurface& surface) {
   if (!cage.has_uvs()) {
@@ -62,4 +62,4 @@ StatusOr<PtexUvCharts> PtexUvCharts::Build(const Mesh& cage, const LimitSurface&
   return charts;
 }
 
-}  // namespace dispex
+}  // namespace dispex::verify

@@ -16,7 +16,7 @@
 #include "dispex/status.h"
 #include "dispex/subdiv.h"
 
-namespace dispex {
+namespace dispex::verify {
 
 class PtexUvCharts {
  public:
@@ -38,4 +38,4 @@ class PtexUvCharts {
   std::vector<double> corners_;  // per Ptex face: UVs at (0,0), (1,0), (1,1), (0,1)
 };
 
-}  // namespace dispex
+}  // namespace dispex::verify

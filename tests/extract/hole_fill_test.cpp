@@ -9,6 +9,8 @@
 namespace dispex {
 namespace {
 
+using namespace extract;
+
 TEST(PullPush, NothingToFillAndNothingValid) {
   PullPushScratch scratch;
   std::vector<float> v = {1, 2, 3, 4};

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "../extract/e2e_support.h"
-#include "core/png_read.h"
+#include "core/png_io.h"
 #include "dispex/mesh.h"
 #include "dispex/subdiv.h"
 #include "dispex/verify.h"
@@ -29,6 +29,7 @@
 namespace dispex {
 namespace {
 
+using namespace verify;
 using testing::DataPath;
 using testing::TempDir;
 

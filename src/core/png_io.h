@@ -1,6 +1,7 @@
-// Reading PNG images (libpng) for every module that takes one as input: dispex::render's
-// ReadPng (8-bit RGB pictures) and dispex::verify's height images (grey or colour, 8 or 16
-// bits). libpng is linked PRIVATE to dispex_core; no libpng type appears here.
+// PNG images (libpng), read and written, for every module that takes or makes one: reading
+// for dispex::render's ReadPng (8-bit RGB pictures) and dispex::verify's height images (grey
+// or colour, 8 or 16 bits), writing of 8-bit RGB or grey pixels for render's EncodePng and
+// WritePng. libpng is linked PRIVATE to dispex_core; no libpng type appears here.
 //
 // Hostile files give a Status, never a crash or an unbounded allocation: libpng's errors are
 // caught (setjmp), widths and heights above 2^20 and images above 2^28 pixels are refused, and
@@ -53,5 +54,17 @@ StatusOr<PngPixels> DecodePngPixels(const std::uint8_t* data, std::size_t size,
 
 // The same for a file (memory-mapped); errors name `path`.
 StatusOr<PngPixels> ReadPngPixels(const std::string& path, PngConversion conversion);
+
+// Encodes width x height 8-bit pixels of `channels` samples (1 grey, 3 RGB), rows from the
+// top, samples interleaved, `size` bytes at `data`, as a PNG in memory (zlib level 6, no
+// interlacing, default filters). Fails for an empty image, other channel counts, more than
+// 2^31 - 1 bytes of pixels, or a `size` other than width * height * channels.
+StatusOr<std::vector<std::uint8_t>> EncodePngPixels(const std::uint8_t* data, std::size_t size,
+                                                    int width, int height, int channels);
+
+// Encodes as EncodePngPixels does and writes the PNG to `path` atomically (AtomicOutput: the
+// file appears whole or not at all). Encoding errors are prefixed with `path`.
+Status WritePngPixels(const std::string& path, const std::uint8_t* data, std::size_t size,
+                      int width, int height, int channels);
 
 }  // namespace dispex
