@@ -54,8 +54,8 @@ struct PtexExerciseLimits {
 // Parses `bytes` with ParsePtex and, for a file that opens, reads everything the API
 // offers: the header, every face record, every face at every stored level (as floats and
 // raw), its constant value and block info, Sample at texel centres, corners and midpoints of
-// the first and last channel, Validate, and every meta data item in every type. Checks that sizes agree
-// with the resolutions, that a read over max_values_per_read fails and every other read of a
+// the first and last channel, Validate, and every meta data item in every type. Checks that sizes
+// agree with the resolutions, that a read over max_values_per_read fails and every other read of a
 // constant face succeeds, that a quad face's Sample at a texel centre returns that texel, that
 // Sample is NaN exactly where the face cannot be decoded, that Validate fails exactly when a
 // face read failed, and that every failed Status keeps CheckErrorMessage.

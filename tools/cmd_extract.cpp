@@ -4,11 +4,11 @@
 #include <cstdio>
 
 #include "command.h"
-#include "flag_names.h"
 #include "dispex/cancel.h"
 #include "dispex/extract.h"
 #include "dispex/files.h"
 #include "dispex/render.h"
+#include "flag_names.h"
 
 namespace dispex::cli {
 namespace {
@@ -60,13 +60,28 @@ StatusOr<std::uint64_t> ParseBytes(const std::string& text) {
   }
   double scale = 1;
   switch (n == 2 ? unit : 'B') {
-    case 'B': case 'b': break;
-    case 'K': case 'k': scale = 1024.0; break;
-    case 'M': case 'm': scale = 1024.0 * 1024; break;
-    case 'G': case 'g': scale = 1024.0 * 1024 * 1024; break;
-    case 'T': case 't': scale = 1024.0 * 1024 * 1024 * 1024; break;
+    case 'B':
+    case 'b':
+      break;
+    case 'K':
+    case 'k':
+      scale = 1024.0;
+      break;
+    case 'M':
+    case 'm':
+      scale = 1024.0 * 1024;
+      break;
+    case 'G':
+    case 'g':
+      scale = 1024.0 * 1024 * 1024;
+      break;
+    case 'T':
+    case 't':
+      scale = 1024.0 * 1024 * 1024 * 1024;
+      break;
     default:
-      return Status::Error(fmt::format("--max-memory {}: unknown unit '{}' (K, M, G, T)", text, unit));
+      return Status::Error(
+          fmt::format("--max-memory {}: unknown unit '{}' (K, M, G, T)", text, unit));
   }
   return static_cast<std::uint64_t>(value * scale);
 }
@@ -79,8 +94,8 @@ Status Resolve(ExtractArgs& a) {
       o.oversample = std::stoi(a.oversample, &used);
       if (used != a.oversample.size() || o.oversample <= 0) throw std::invalid_argument("");
     } catch (...) {
-      return Status::Error(fmt::format("--oversample {}: expected 'auto' or a power of two",
-                                       a.oversample));
+      return Status::Error(
+          fmt::format("--oversample {}: expected 'auto' or a power of two", a.oversample));
     }
   }
   if (a.search_distance_rel != 0) {
@@ -130,11 +145,10 @@ Status Resolve(ExtractArgs& a) {
     if (!bytes.ok()) return bytes.status();
     o.max_memory = *bytes;
   }
-  if (!a.report_path.empty() &&
-      (a.report_path == o.base_path || a.report_path == o.sculpt_path ||
-       a.report_path == o.output_path)) {
-    return Status::Error(fmt::format("--report {}: must differ from the inputs and the output",
-                                     a.report_path));
+  if (!a.report_path.empty() && (a.report_path == o.base_path || a.report_path == o.sculpt_path ||
+                                 a.report_path == o.output_path)) {
+    return Status::Error(
+        fmt::format("--report {}: must differ from the inputs and the output", a.report_path));
   }
   return ValidateExtractOptions(o);
 }
@@ -155,8 +169,8 @@ int RunExtract(ExtractArgs& args) {
   }
   if (!args.quiet) std::fputs(ExtractReportSummary(*report).c_str(), stderr);
   if (!args.preview_dir.empty()) {
-    Status previews = WritePreviews(args.options.base_path, args.options.output_path,
-                                    args.preview_dir);
+    Status previews =
+        WritePreviews(args.options.base_path, args.options.output_path, args.preview_dir);
     if (!previews.ok()) return ReportFailure(previews.WithPrefix("--preview"));
   }
   return 0;
@@ -206,8 +220,7 @@ void SetupExtract(CLI::App& app, int& exit_code) {
   cmd->add_option("--nonzero-threshold", o.nonzero_threshold,
                   "|DCT coefficient| counted as non-zero by --resolution-rule nonzero")
       ->capture_default_str();
-  cmd->add_option("--fixed-resolution", args->fixed_resolution,
-                  "WxH for --resolution-rule fixed")
+  cmd->add_option("--fixed-resolution", args->fixed_resolution, "WxH for --resolution-rule fixed")
       ->capture_default_str();
   cmd->add_option("--data-type", args->data_type, "texel type: float or half")
       ->capture_default_str();
@@ -230,8 +243,7 @@ void SetupExtract(CLI::App& app, int& exit_code) {
   cmd->add_option("--embree-isa", o.embree_isa,
                   "Embree kernels: sse2, sse4.2, avx, avx2, avx512 (default: $DISPEX_EMBREE_ISA, "
                   "else the widest this CPU runs)");
-  cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
-      ->capture_default_str();
+  cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")->capture_default_str();
   cmd->add_option("--max-memory", args->max_memory,
                   "refuse work estimated to need more memory than this (e.g. 8G; default: the "
                   "memory available)");

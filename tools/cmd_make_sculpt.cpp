@@ -3,14 +3,14 @@
 #include <fmt/format.h>
 
 #include "command.h"
-#include "flag_names.h"
 #include "dispex/verify.h"
+#include "flag_names.h"
 
 namespace dispex::cli {
 namespace {
 
 constexpr FlagName kMakeSculptFlags[] = {
-    {"output_path", "-o"}, {"levels", "--levels"}, {"density", "--density"},
+    {"output_path", "-o"},        {"levels", "--levels"},   {"density", "--density"},
     {"amplitude", "--amplitude"}, {"threads", "--threads"},
 };
 

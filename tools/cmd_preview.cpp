@@ -5,16 +5,16 @@
 #include <cmath>
 
 #include "command.h"
-#include "flag_names.h"
 #include "dispex/ptex.h"
 #include "dispex/render.h"
+#include "flag_names.h"
 
 namespace dispex::cli {
 namespace {
 
 constexpr FlagName kPreviewFlags[] = {
-    {"range", "--range"},   {"channel", "--channel"}, {"min_tile", "--tile"},
-    {"max_tile", "--max-tile"}, {"width", "--width"}, {"threads", "--threads"},
+    {"range", "--range"},       {"channel", "--channel"}, {"min_tile", "--tile"},
+    {"max_tile", "--max-tile"}, {"width", "--width"},     {"threads", "--threads"},
 };
 
 struct PreviewArgs {

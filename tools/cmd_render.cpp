@@ -7,21 +7,21 @@
 #include <optional>
 
 #include "command.h"
-#include "flag_names.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
 #include "dispex/render.h"
+#include "flag_names.h"
 
 namespace dispex::cli {
 namespace {
 
 constexpr FlagName kRenderFlags[] = {
-    {"width x height", "--size"}, {"density", "--density"},
+    {"width x height", "--size"},     {"density", "--density"},
     {"min_density", "--min-density"}, {"max_density", "--max-density"},
     {"supersample", "--supersample"}, {"ao_samples", "--ao"},
     {"ao_distance", "--ao-distance"}, {"channel", "--channel"},
-    {"threads", "--threads"}, {"azimuth", "--azimuth"},
-    {"elevation", "--elevation"}, {"fov_degrees", "--fov"},
+    {"threads", "--threads"},         {"azimuth", "--azimuth"},
+    {"elevation", "--elevation"},     {"fov_degrees", "--fov"},
 };
 
 struct RenderArgs {

@@ -5,16 +5,16 @@
 #include <cstdio>
 
 #include "command.h"
-#include "flag_names.h"
 #include "dispex/files.h"
 #include "dispex/verify.h"
+#include "flag_names.h"
 
 namespace dispex::cli {
 namespace {
 
 constexpr FlagName kVerifyFlags[] = {
-    {"sculpt_path", "a SCULPT"},     {"truth_path", "--truth"},
-    {"samples_per_face", "--samples"}, {"max_error", "--max-error"},
+    {"sculpt_path", "a SCULPT"},          {"truth_path", "--truth"},
+    {"samples_per_face", "--samples"},    {"max_error", "--max-error"},
     {"max_error_rel", "--max-error-rel"}, {"max_rms", "--max-rms"},
 };
 

@@ -6,7 +6,6 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-
 #include <functional>
 #include <string>
 
@@ -37,5 +36,6 @@ CLI::Validator NonNegative();
 #define DISPEX_CLI_CONCAT_INNER(a, b) a##b
 #define DISPEX_CLI_CONCAT(a, b) DISPEX_CLI_CONCAT_INNER(a, b)
 // Registers `setup`; `order` sets the position in `dispex --help`.
-#define DISPEX_REGISTER_COMMAND(order, setup) \
-  static const ::dispex::cli::CommandRegistration DISPEX_CLI_CONCAT(dispex_command_, __LINE__)(order, setup)
+#define DISPEX_REGISTER_COMMAND(order, setup)                                                   \
+  static const ::dispex::cli::CommandRegistration DISPEX_CLI_CONCAT(dispex_command_, __LINE__)( \
+      order, setup)

@@ -53,11 +53,13 @@ CLI::Validator NumberCheck(const char* name, bool (*accept)(double), const char*
 }  // namespace
 
 CLI::Validator Positive() {
-  return NumberCheck("> 0", [](double v) { return v > 0; },
-                     "must be greater than 0 (leave the option out for the automatic value)");
+  return NumberCheck(
+      "> 0", [](double v) { return v > 0; },
+      "must be greater than 0 (leave the option out for the automatic value)");
 }
 CLI::Validator NonNegative() {
-  return NumberCheck(">= 0", [](double v) { return v >= 0; }, "must be 0 or more");
+  return NumberCheck(
+      ">= 0", [](double v) { return v >= 0; }, "must be 0 or more");
 }
 
 }  // namespace dispex::cli

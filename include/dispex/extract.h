@@ -139,10 +139,10 @@ struct ExtractReport {
   // With an automatic search distance, samples that miss are searched again this far (0 when
   // the distance was given).
   double retry_search_distance = 0;
-  std::int64_t misses_recovered = 0;   // samples that hit on that second search
-  std::int64_t misses = 0;             // samples whose rays found nothing
-  double miss_fraction = 0;            // misses / samples
-  std::int64_t holes_filled = 0;       // of those, filled within their face
+  std::int64_t misses_recovered = 0;  // samples that hit on that second search
+  std::int64_t misses = 0;            // samples whose rays found nothing
+  double miss_fraction = 0;           // misses / samples
+  std::int64_t holes_filled = 0;      // of those, filled within their face
   std::int64_t faces_with_misses = 0;
   std::int64_t faces_filled_from_neighbours = 0;
   std::int64_t faces_unreachable = 0;  // missed entirely, no neighbour to fill from: 0 written
@@ -154,8 +154,8 @@ struct ExtractReport {
   // the largest over every texel breakpoint of every shared edge (MeasurePtexEdgeSteps) once
   // the map is final, in object units.
   WatertightEdges watertight = WatertightEdges::kOff;
-  std::int64_t edge_rounds = 0;        // rounds of raising resolutions
-  std::int64_t edge_raised_faces = 0;  // faces whose resolution the edges raised
+  std::int64_t edge_rounds = 0;          // rounds of raising resolutions
+  std::int64_t edge_raised_faces = 0;    // faces whose resolution the edges raised
   std::int64_t texels_before_edges = 0;  // texels written had no edge been raised
   std::int64_t edges_shared = 0;         // between two faces with a surface
   std::int64_t edges_sharp = 0;          // on infinitely sharp creases: not held

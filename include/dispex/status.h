@@ -41,7 +41,7 @@ class [[nodiscard]] Status {
 template <class T>
 class [[nodiscard]] StatusOr {
  public:
-  StatusOr(T value) : value_(std::move(value)) {}  // NOLINT: implicit by design
+  StatusOr(T value) : value_(std::move(value)) {}         // NOLINT: implicit by design
   StatusOr(Status status) : status_(std::move(status)) {  // NOLINT: implicit by design
     assert(!status_.ok() && "StatusOr built from an OK status without a value");
   }
@@ -77,9 +77,9 @@ class [[nodiscard]] StatusOr {
 #define DISPEX_STATUS_CONCAT(a, b) DISPEX_STATUS_CONCAT_INNER(a, b)
 
 // Returns the Status of `expr` from the enclosing function if it failed.
-#define DISPEX_RETURN_IF_ERROR(expr)              \
-  do {                                            \
-    ::dispex::Status dispex_status_ = (expr);     \
+#define DISPEX_RETURN_IF_ERROR(expr)                 \
+  do {                                               \
+    ::dispex::Status dispex_status_ = (expr);        \
     if (!dispex_status_.ok()) return dispex_status_; \
   } while (0)
 

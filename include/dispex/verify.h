@@ -234,8 +234,8 @@ struct VerifyReport {
   double edge_max_limit = 0, edge_p99_limit = 0;  // object units; 0: not checked
   struct WorstEdge {
     int face = -1, edge = 0, neighbour = -1;
-    double t = 0;     // along the face's edge, counter-clockwise
-    double step = 0;  // object units
+    double t = 0;             // along the face's edge, counter-clockwise
+    double step = 0;          // object units
     const char* reader = "";  // "per-face" or "across-faces"
   };
   std::vector<WorstEdge> worst_edges;  // largest step first, at most 10

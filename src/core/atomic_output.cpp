@@ -45,7 +45,9 @@ void UnregisterLive(int slot) {
   g_live[slot].used.store(false);
 }
 
-std::string ErrnoText(int err) { return std::strerror(err); }
+std::string ErrnoText(int err) {
+  return std::strerror(err);
+}
 
 }  // namespace
 
@@ -76,11 +78,12 @@ StatusOr<AtomicOutput> AtomicOutput::Create(const std::string& target) {
     return Status::Error(target + ": cannot create output in " + dir.string() + ": " +
                          ErrnoText(errno));
   }
-  ::fchmod(fd, 0644 & ~[] {
-    mode_t m = ::umask(0);
-    ::umask(m);
-    return m;
-  }());
+  ::fchmod(
+      fd, 0644 & ~[] {
+        mode_t m = ::umask(0);
+        ::umask(m);
+        return m;
+      }());
   AtomicOutput out;
   out.target_ = target;
   out.temp_ = buffer;
@@ -108,7 +111,9 @@ AtomicOutput& AtomicOutput::operator=(AtomicOutput&& other) noexcept {
   return *this;
 }
 
-AtomicOutput::~AtomicOutput() { Abandon(); }
+AtomicOutput::~AtomicOutput() {
+  Abandon();
+}
 
 Status AtomicOutput::Write(const void* data, std::size_t size) {
   if (fd_ < 0) return Status::Error(target_ + ": output is closed");

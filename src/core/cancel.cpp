@@ -39,9 +39,15 @@ extern "C" void HandleCancelSignal(int sig) {
 }
 }  // namespace
 
-void RequestCancel() noexcept { g_cancel.store(true); }
-bool CancelRequested() noexcept { return g_cancel.load(std::memory_order_relaxed); }
-int CancelSignal() noexcept { return g_signal.load(); }
+void RequestCancel() noexcept {
+  g_cancel.store(true);
+}
+bool CancelRequested() noexcept {
+  return g_cancel.load(std::memory_order_relaxed);
+}
+int CancelSignal() noexcept {
+  return g_signal.load();
+}
 
 void ResetCancel() noexcept {
   g_cancel.store(false);

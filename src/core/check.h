@@ -16,19 +16,19 @@ namespace dispex::detail {
 }
 }  // namespace dispex::detail
 
-#define DISPEX_CHECK(cond)                                                            \
-  do {                                                                                \
-    if (!(cond)) [[unlikely]]                                                         \
-      ::dispex::detail::CheckFailed(__FILE__, __LINE__, "CHECK(" #cond ") failed");   \
+#define DISPEX_CHECK(cond)                                                          \
+  do {                                                                              \
+    if (!(cond)) [[unlikely]]                                                       \
+      ::dispex::detail::CheckFailed(__FILE__, __LINE__, "CHECK(" #cond ") failed"); \
   } while (0)
 
-#define DISPEX_CHECK_OP(a, op, b)                                                     \
-  do {                                                                                \
-    const auto& dispex_a_ = (a);                                                      \
-    const auto& dispex_b_ = (b);                                                      \
-    if (!(dispex_a_ op dispex_b_)) [[unlikely]]                                       \
-      ::dispex::detail::CheckFailed(                                                  \
-          __FILE__, __LINE__,                                                         \
+#define DISPEX_CHECK_OP(a, op, b)                                                              \
+  do {                                                                                         \
+    const auto& dispex_a_ = (a);                                                               \
+    const auto& dispex_b_ = (b);                                                               \
+    if (!(dispex_a_ op dispex_b_)) [[unlikely]]                                                \
+      ::dispex::detail::CheckFailed(                                                           \
+          __FILE__, __LINE__,                                                                  \
           fmt::format("CHECK({} " #op " {}) failed: {} vs {}", #a, #b, dispex_a_, dispex_b_)); \
   } while (0)
 

@@ -12,7 +12,9 @@
 namespace dispex {
 
 namespace {
-std::string ErrnoText(int err) { return std::strerror(err); }
+std::string ErrnoText(int err) {
+  return std::strerror(err);
+}
 }  // namespace
 
 Status CheckReadableFile(const std::string& path) {

@@ -194,8 +194,7 @@ StatusOr<PngPixels> ReadPngPixels(const std::string& path, PngConversion convers
 StatusOr<std::vector<std::uint8_t>> EncodePngPixels(const std::uint8_t* data, std::size_t size,
                                                     int width, int height, int channels) {
   if (width <= 0 || height <= 0) {
-    return Status::Error(
-        fmt::format("cannot encode an empty {}x{} image as PNG", width, height));
+    return Status::Error(fmt::format("cannot encode an empty {}x{} image as PNG", width, height));
   }
   if (channels != 1 && channels != 3) {
     return Status::Error(

@@ -17,7 +17,8 @@ std::string FormatDuration(double s) {
 
 std::string Progress::Format(const std::string& label, std::uint64_t done, std::uint64_t total,
                              const std::string& unit, double seconds, int width) {
-  double fraction = total ? std::min(1.0, static_cast<double>(done) / static_cast<double>(total)) : 1;
+  double fraction =
+      total ? std::min(1.0, static_cast<double>(done) / static_cast<double>(total)) : 1;
   int filled = static_cast<int>(fraction * width + 0.5);
   std::string bar(static_cast<std::size_t>(filled), '#');
   bar.resize(static_cast<std::size_t>(width), ' ');
@@ -45,7 +46,9 @@ Progress::Progress(std::string label, std::uint64_t total, std::string unit, boo
   });
 }
 
-Progress::~Progress() { Finish(); }
+Progress::~Progress() {
+  Finish();
+}
 
 void Progress::Finish() {
   if (!enabled_ || finished_) return;
@@ -60,8 +63,7 @@ void Progress::Finish() {
 }
 
 void Progress::Draw(bool final_line) {
-  double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   std::string line = Format(label_, done(), total_, unit_, seconds);
   std::fprintf(stderr, "\r\033[2K%s%s", line.c_str(), final_line ? "\n" : "");
   std::fflush(stderr);

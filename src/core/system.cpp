@@ -25,8 +25,8 @@ std::uint64_t ReadProcKb(const char* file, const std::string& key) {
 }
 
 std::uint64_t CgroupLimitBytes() {
-  for (const char* file : {"/sys/fs/cgroup/memory.max",
-                           "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+  for (const char* file :
+       {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
     std::ifstream in(file);
     std::string value;
     if (in >> value && value != "max") {
@@ -40,7 +40,9 @@ std::uint64_t CgroupLimitBytes() {
 }
 }  // namespace
 
-std::uint64_t PeakResidentBytes() { return ReadProcKb("/proc/self/status", "VmHWM"); }
+std::uint64_t PeakResidentBytes() {
+  return ReadProcKb("/proc/self/status", "VmHWM");
+}
 
 std::uint64_t AvailableMemoryBytes() {
   std::uint64_t available = ReadProcKb("/proc/meminfo", "MemAvailable");

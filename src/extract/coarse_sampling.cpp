@@ -28,8 +28,10 @@ StatusOr<CoarseSampling> SampleCoarsely(const LimitSurface& surface) {
     if (surface.is_hole(face) || error.failed()) return;
     auto& evaluator = evaluators.local();
     if (!evaluator) evaluator.emplace(surface);
-    std::span<float> p(pos.data() + static_cast<std::size_t>(f) * kGrid * kGrid * 3, kGrid * kGrid * 3);
-    std::span<float> q(nrm.data() + static_cast<std::size_t>(f) * kGrid * kGrid * 3, kGrid * kGrid * 3);
+    std::span<float> p(pos.data() + static_cast<std::size_t>(f) * kGrid * kGrid * 3,
+                       kGrid * kGrid * 3);
+    std::span<float> q(nrm.data() + static_cast<std::size_t>(f) * kGrid * kGrid * 3,
+                       kGrid * kGrid * 3);
     Status s = evaluator->EvaluateGrid(face, kGrid, kGrid, p, q);
     if (!s.ok()) return error.Record(f, s);
     // The 3x3 cells between sample centres cover (3/4)^2 of the face's parameter square.

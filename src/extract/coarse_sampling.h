@@ -10,7 +10,7 @@
 namespace dispex::extract {
 
 struct CoarseSampling {
-  std::vector<double> face_areas;  // per Ptex face (0 for holes)
+  std::vector<double> face_areas;       // per Ptex face (0 for holes)
   std::vector<Float3> points, normals;  // at most ~64K, spread over all faces
 };
 

@@ -95,8 +95,8 @@ Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
 
   std::vector<std::array<int, 2>> least(n, {0, 0});
   std::vector<std::uint8_t> raised(n, 0), redone;
-  std::map<std::pair<int, int>, double> last_step;  // (face, edge) -> step when last raised
-  std::map<std::pair<int, int>, int> futile;        // raises that did not bring it down
+  std::map<std::pair<int, int>, double> last_step;      // (face, edge) -> step when last raised
+  std::map<std::pair<int, int>, int> futile;            // raises that did not bring it down
   std::map<std::pair<int, int>, PtexEdgeStep> current;  // every measured edge, as it stands
   MapView view = TakeView(inputs, faces);
   PtexEdgeMeasure measure;
@@ -117,8 +117,8 @@ Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
     auto raise = [&](int f, int dim) {
       const PtexFaceInfo& info = view.faces[static_cast<std::size_t>(f)];
       const int now = dim == 0 ? info.ulog2 : info.vlog2;
-      const int cap = std::max<int>(settings.plan.log2[static_cast<std::size_t>(f)],
-                                    settings.max_samples_log2);
+      const int cap =
+          std::max<int>(settings.plan.log2[static_cast<std::size_t>(f)], settings.max_samples_log2);
       if (now + 1 > cap) return false;
       int& w = want[static_cast<std::size_t>(f)][static_cast<std::size_t>(dim)];
       w = std::max(w, now + 1);
@@ -128,7 +128,8 @@ Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
       const bool over_filter = s.across_faces > budget;
       const bool over_face = per_face && s.per_face > budget;
       if (!over_filter && !over_face) continue;
-      const double step = std::max(over_filter ? s.across_faces : 0.0, over_face ? s.per_face : 0.0);
+      const double step =
+          std::max(over_filter ? s.across_faces : 0.0, over_face ? s.per_face : 0.0);
       const auto key = std::make_pair(s.face, s.edge);
       if (auto it = last_step.find(key); it != last_step.end() && step > kProgress * it->second) {
         // The last raise did not help; after two such the displacement itself steps here.
@@ -142,7 +143,8 @@ Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
       bool any = false;
       if (over_filter) {
         if (ra.along != rb.along) {
-          any |= ra.along < rb.along ? raise(s.face, ra.along_dim) : raise(s.neighbour, rb.along_dim);
+          any |=
+              ra.along < rb.along ? raise(s.face, ra.along_dim) : raise(s.neighbour, rb.along_dim);
         } else if (ra.across != rb.across) {
           any |= ra.across < rb.across ? raise(s.face, 1 - ra.along_dim)
                                        : raise(s.neighbour, 1 - rb.along_dim);

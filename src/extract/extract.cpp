@@ -1,6 +1,8 @@
 // Extract, read top-down: load the inputs -> resolve the automatic settings -> process every
 // Ptex face -> fill the faces that missed entirely -> make shared edges meet (watertight) ->
 // add up the totals -> write the map. Each stage is in its own file of src/extract.
+#include "dispex/extract.h"
+
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
@@ -10,11 +12,10 @@
 
 #include "core/system.h"
 #include "dispex/cancel.h"
-#include "dispex/extract.h"
 #include "dispex/version.h"
+#include "extract/edge_matching.h"
 #include "extract/extract_inputs.h"
 #include "extract/extract_meta.h"
-#include "extract/edge_matching.h"
 #include "extract/extract_settings.h"
 #include "extract/face_totals.h"
 #include "extract/missed_faces.h"
@@ -102,10 +103,9 @@ StatusOr<ExtractReport> Extract(const ExtractOptions& options) {
   }
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.initialize();
-  const int threads = std::min(
-      arena.max_concurrency(),
-      static_cast<int>(
-          tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+  const int threads =
+      std::min(arena.max_concurrency(), static_cast<int>(tbb::global_control::active_value(
+                                            tbb::global_control::max_allowed_parallelism)));
   return arena.execute([&] { return extract::ExtractInArena(options, threads); });
 }
 

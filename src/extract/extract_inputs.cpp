@@ -72,7 +72,8 @@ void ReportMeshes(const ExtractOptions& options, const MeshesRead& meshes, Extra
   if (surface_stats.inf_sharp_edges > 0) {
     report.warnings.push_back(fmt::format(
         "{}: {} infinitely sharp edges: the limit normal has two values there, so the map "
-        "opens a gap or an overlap along them", options.base_path, surface_stats.inf_sharp_edges));
+        "opens a gap or an overlap along them",
+        options.base_path, surface_stats.inf_sharp_edges));
   }
   report.base_diagonal = ComputeBounds(meshes.base).diagonal();
 }
@@ -84,8 +85,7 @@ Status CheckMemoryForInputs(const ExtractOptions& options, const MeshesRead& mes
                                    static_cast<std::uint64_t>(options.max_oversample) *
                                    static_cast<std::uint64_t>(options.max_oversample);
   const Mesh& sculpt = meshes.sculpt;
-  return CheckMemoryForSculpt(sculpt.num_vertices(), sculpt.num_faces(),
-                              sculpt.face_indices.size(),
+  return CheckMemoryForSculpt(sculpt.num_vertices(), sculpt.num_faces(), sculpt.face_indices.size(),
                               std::min<std::uint64_t>(max_texels, 1ull << 31), memory_limit);
 }
 
@@ -109,8 +109,8 @@ StatusOr<ExtractInputs> LoadInputs(const ExtractOptions& options, std::uint64_t 
   if (CancelRequested()) return Cancelled();
 
   std::vector<PtexFaceInfo> faces = PtexFaceTable(meshes.surface);
-  return ExtractInputs{std::move(meshes.base), std::move(meshes.sculpt),
-                       std::move(meshes.surface), std::move(faces), std::move(tracer)};
+  return ExtractInputs{std::move(meshes.base), std::move(meshes.sculpt), std::move(meshes.surface),
+                       std::move(faces), std::move(tracer)};
 }
 
 }  // namespace dispex::extract

@@ -17,9 +17,9 @@ namespace dispex::extract {
 struct ExtractInputs {
   Mesh base;
   Mesh sculpt;
-  LimitSurface surface;                 // of the base
-  std::vector<PtexFaceInfo> faces;      // the map's face table, from `surface`
-  std::unique_ptr<Tracer> tracer;       // the sculpt's BVH; reads the sculpt's arrays
+  LimitSurface surface;             // of the base
+  std::vector<PtexFaceInfo> faces;  // the map's face table, from `surface`
+  std::unique_ptr<Tracer> tracer;   // the sculpt's BVH; reads the sculpt's arrays
 };
 
 // Reads the sculpt while the base is read and its limit surface built, fingerprints both

@@ -13,9 +13,12 @@ std::string FileName(const std::string& path) {
 
 std::string_view SearchKindName(SearchDistanceSpec::Kind kind) {
   switch (kind) {
-    case SearchDistanceSpec::Kind::kAuto: return "auto";
-    case SearchDistanceSpec::Kind::kAbsolute: return "absolute";
-    case SearchDistanceSpec::Kind::kRelative: return "relative";
+    case SearchDistanceSpec::Kind::kAuto:
+      return "auto";
+    case SearchDistanceSpec::Kind::kAbsolute:
+      return "absolute";
+    case SearchDistanceSpec::Kind::kRelative:
+      return "relative";
   }
   return "auto";
 }
@@ -51,8 +54,10 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
   j["search_distance"] = r.search_distance;
   j["search_distance_auto"] = r.search_distance_auto;
   j["base_diagonal"] = r.base_diagonal;
-  j["base"] = {{"vertices", r.base_vertices}, {"faces", r.base_faces},
-               {"ptex_faces", r.ptex_faces}, {"hole_faces", r.hole_faces},
+  j["base"] = {{"vertices", r.base_vertices},
+               {"faces", r.base_faces},
+               {"ptex_faces", r.ptex_faces},
+               {"hole_faces", r.hole_faces},
                {"inf_sharp_edges", r.inf_sharp_edges}};
   j["sculpt"] = {{"vertices", r.sculpt_vertices}, {"faces", r.sculpt_faces}};
   nlohmann::json oversample = nlohmann::json::object();
@@ -60,13 +65,13 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
     if (r.oversample_faces[k]) oversample[std::to_string(1 << k)] = r.oversample_faces[k];
   }
   j["oversample_faces"] = oversample;
-  j["oversample_rule"] = r.options.oversample > 0                 ? "fixed"
+  j["oversample_rule"] = r.options.oversample > 0              ? "fixed"
                          : r.oversample_subdivision_level >= 0 ? "subdivision level"
                                                                : "sculpt density";
   j["samples"] = r.samples;
   j["rays_cast"] = r.rays_cast;
-  j["hits"] = {{"positive", r.hits_positive}, {"negative", r.hits_negative},
-               {"opposed", r.hits_opposed}};
+  j["hits"] = {
+      {"positive", r.hits_positive}, {"negative", r.hits_negative}, {"opposed", r.hits_opposed}};
   j["retry_search_distance"] = r.retry_search_distance;
   j["misses_recovered"] = r.misses_recovered;
   j["misses"] = r.misses;
@@ -93,8 +98,8 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
                    {"max_bound", s.max_bound},
                    {"max_measured_error", s.max_measured_error},
                    {"faces_by_resolution", resolutions}};
-  j["displacement"] = {{"min", r.displacement_min}, {"max", r.displacement_max},
-                       {"rms", r.displacement_rms}};
+  j["displacement"] = {
+      {"min", r.displacement_min}, {"max", r.displacement_max}, {"rms", r.displacement_rms}};
   j["edges"] = {{"watertight", std::string(WatertightEdgesName(r.watertight))},
                 {"rounds", r.edge_rounds},
                 {"raised_faces", r.edge_raised_faces},
@@ -126,9 +131,8 @@ Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractRep
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:tolerance", std::span(&tolerance, 1)));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:search_distance", std::span(&distance, 1)));
   if (!report.discontinuous_faces.empty()) {
-    DISPEX_RETURN_IF_ERROR(
-        writer.AddMetaData("dispex:discontinuous_faces",
-                           std::span<const std::int32_t>(report.discontinuous_faces)));
+    DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
+        "dispex:discontinuous_faces", std::span<const std::int32_t>(report.discontinuous_faces)));
   }
   return Status::Ok();
 }

@@ -9,9 +9,12 @@ namespace dispex {
 
 std::string_view HolePolicyName(HolePolicy policy) {
   switch (policy) {
-    case HolePolicy::kFill: return "fill";
-    case HolePolicy::kFail: return "fail";
-    case HolePolicy::kZero: return "zero";
+    case HolePolicy::kFill:
+      return "fill";
+    case HolePolicy::kFail:
+      return "fail";
+    case HolePolicy::kZero:
+      return "zero";
   }
   return "fill";
 }
@@ -25,15 +28,19 @@ StatusOr<HolePolicy> ParseHolePolicy(std::string_view name) {
 
 std::string_view WatertightEdgesName(WatertightEdges mode) {
   switch (mode) {
-    case WatertightEdges::kAll: return "all";
-    case WatertightEdges::kFilter: return "filter";
-    case WatertightEdges::kOff: return "off";
+    case WatertightEdges::kAll:
+      return "all";
+    case WatertightEdges::kFilter:
+      return "filter";
+    case WatertightEdges::kOff:
+      return "off";
   }
   return "all";
 }
 
 StatusOr<WatertightEdges> ParseWatertightEdges(std::string_view name) {
-  for (WatertightEdges m : {WatertightEdges::kAll, WatertightEdges::kFilter, WatertightEdges::kOff}) {
+  for (WatertightEdges m :
+       {WatertightEdges::kAll, WatertightEdges::kFilter, WatertightEdges::kOff}) {
     if (name == WatertightEdgesName(m)) return m;
   }
   return Status::Error(
@@ -51,22 +58,22 @@ Status ValidateExtractOptions(const ExtractOptions& o) {
   if (o.sculpt_path.empty()) return Status::Error("no sculpt mesh given");
   if (o.output_path.empty()) return Status::Error("no output file given (output_path)");
   if (o.output_path == o.base_path || o.output_path == o.sculpt_path) {
-    return Status::Error(fmt::format("output {} is also an input; refusing to overwrite it",
-                                     o.output_path));
+    return Status::Error(
+        fmt::format("output {} is also an input; refusing to overwrite it", o.output_path));
   }
   if (o.oversample != 0 && !IsPowerOfTwoIn(o.oversample, 1, kMaxSpectralSize)) {
-    return Status::Error(fmt::format(
-        "oversample = {}: must be 0 (automatic) or a power of two from 1 to {}", o.oversample,
-        kMaxSpectralSize));
+    return Status::Error(
+        fmt::format("oversample = {}: must be 0 (automatic) or a power of two from 1 to {}",
+                    o.oversample, kMaxSpectralSize));
   }
   if (!IsPowerOfTwoIn(o.max_oversample, 1, kMaxSpectralSize)) {
     return Status::Error(fmt::format("max_oversample = {}: must be a power of two from 1 to {}",
                                      o.max_oversample, kMaxSpectralSize));
   }
   if (!IsPowerOfTwoIn(o.min_oversample, 1, o.max_oversample)) {
-    return Status::Error(fmt::format(
-        "min_oversample = {}: must be a power of two from 1 to max_oversample ({})",
-        o.min_oversample, o.max_oversample));
+    return Status::Error(
+        fmt::format("min_oversample = {}: must be a power of two from 1 to max_oversample ({})",
+                    o.min_oversample, o.max_oversample));
   }
   if (!(std::isfinite(o.tolerance) && o.tolerance >= 0)) {
     return Status::Error(fmt::format("tolerance = {}: must be a finite length > 0", o.tolerance));

@@ -28,16 +28,15 @@ std::string ExtractReportJson(const ExtractReport& r) {
                             {"floored", e.floored},
                             {"capped", e.capped}};
   }
-  j["phases_seconds"] = {{"read_base", r.t_read_base},   {"read_sculpt", r.t_read_sculpt},
-                         {"topology", r.t_topology},     {"bvh", r.t_bvh},
-                         {"auto_settings", r.t_search},  {"sample_trace", r.t_sample_trace},
-                         {"write", r.t_write},           {"total", r.t_total}};
+  j["phases_seconds"] = {{"read_base", r.t_read_base},  {"read_sculpt", r.t_read_sculpt},
+                         {"topology", r.t_topology},    {"bvh", r.t_bvh},
+                         {"auto_settings", r.t_search}, {"sample_trace", r.t_sample_trace},
+                         {"write", r.t_write},          {"total", r.t_total}};
   j["cpu_seconds"] = {{"limit", r.cpu_limit},
                       {"trace", r.cpu_trace},
                       {"spectral", r.cpu_spectral},
                       {"compress", r.cpu_compress}};
-  j["mrays_per_second"] =
-      r.t_sample_trace > 0 ? double(r.rays_cast) / r.t_sample_trace / 1e6 : 0.0;
+  j["mrays_per_second"] = r.t_sample_trace > 0 ? double(r.rays_cast) / r.t_sample_trace / 1e6 : 0.0;
   j["peak_rss_bytes"] = r.peak_rss_bytes;
   j["tracer"] = r.tracer;
   j["warnings"] = r.warnings;
@@ -52,24 +51,27 @@ std::string ExtractReportSummary(const ExtractReport& r) {
   out += fmt::format("  tolerance {:.4g}{}  search distance {:.4g}{}\n", r.tolerance,
                      r.tolerance_auto ? " (auto)" : "", r.search_distance,
                      r.search_distance_auto ? " (auto)" : "");
-  out += fmt::format("  samples {}  rays {}  misses {} ({} filled in-face, {} faces from "
-                     "neighbours; {} more found by the {:.4g} search)\n",
-                     r.samples, r.rays_cast, r.misses, r.holes_filled,
-                     r.faces_filled_from_neighbours, r.misses_recovered,
-                     r.retry_search_distance);
+  out += fmt::format(
+      "  samples {}  rays {}  misses {} ({} filled in-face, {} faces from "
+      "neighbours; {} more found by the {:.4g} search)\n",
+      r.samples, r.rays_cast, r.misses, r.holes_filled, r.faces_filled_from_neighbours,
+      r.misses_recovered, r.retry_search_distance);
   if (r.hits_opposed > 0) {
-    out += fmt::format("  {} hits on sculpt faces facing against the normal (folds or other "
-                       "sheets)\n", r.hits_opposed);
+    out += fmt::format(
+        "  {} hits on sculpt faces facing against the normal (folds or other "
+        "sheets)\n",
+        r.hits_opposed);
   }
   out += fmt::format("  texels {} -> {} ({:.1f}%)  constant faces {}  max error {:.3g}\n",
                      s.texels_before, s.texels_after,
                      s.texels_before ? 100.0 * double(s.texels_after) / double(s.texels_before) : 0,
                      s.constant_faces, s.max_measured_error);
   if (r.watertight != WatertightEdges::kOff) {
-    out += fmt::format("  edges ({}): {} shared, largest step {:.3g} across faces ({:.2g} "
-                       "tolerances)",
-                       WatertightEdgesName(r.watertight), r.edges_shared,
-                       r.edge_step_across_faces, r.edge_step_across_faces / r.tolerance);
+    out += fmt::format(
+        "  edges ({}): {} shared, largest step {:.3g} across faces ({:.2g} "
+        "tolerances)",
+        WatertightEdgesName(r.watertight), r.edges_shared, r.edge_step_across_faces,
+        r.edge_step_across_faces / r.tolerance);
     if (r.watertight == WatertightEdges::kAll) {
       out += fmt::format(", {:.3g} per face ({:.2g} tolerances)", r.edge_step_per_face,
                          r.edge_step_per_face / r.tolerance);
@@ -77,18 +79,20 @@ std::string ExtractReportSummary(const ExtractReport& r) {
     out += fmt::format("; {} faces raised in {} rounds, texels {} -> {}", r.edge_raised_faces,
                        r.edge_rounds, r.texels_before_edges, s.texels_after);
     if (r.edges_over + r.edges_sharp + r.edges_discontinuous > 0) {
-      out += fmt::format("; not held: {} over the tolerance, {} on sharp creases, {} beside "
-                         "filled holes or other sheets",
-                         r.edges_over, r.edges_sharp, r.edges_discontinuous);
+      out += fmt::format(
+          "; not held: {} over the tolerance, {} on sharp creases, {} beside "
+          "filled holes or other sheets",
+          r.edges_over, r.edges_sharp, r.edges_discontinuous);
     }
     out += "\n";
   }
   out += fmt::format("  displacement [{:.4g}, {:.4g}] rms {:.4g}\n", r.displacement_min,
                      r.displacement_max, r.displacement_rms);
-  out += fmt::format("  time {:.2f}s (read {:.2f}+{:.2f}, bvh {:.2f}, sample+trace {:.2f}, "
-                     "write {:.2f})  {:.1f} MB  peak {:.0f} MB\n",
-                     r.t_total, r.t_read_base, r.t_read_sculpt, r.t_bvh, r.t_sample_trace,
-                     r.t_write, double(r.bytes_written) / 1e6, double(r.peak_rss_bytes) / 1e6);
+  out += fmt::format(
+      "  time {:.2f}s (read {:.2f}+{:.2f}, bvh {:.2f}, sample+trace {:.2f}, "
+      "write {:.2f})  {:.1f} MB  peak {:.0f} MB\n",
+      r.t_total, r.t_read_base, r.t_read_sculpt, r.t_bvh, r.t_sample_trace, r.t_write,
+      double(r.bytes_written) / 1e6, double(r.peak_rss_bytes) / 1e6);
   for (const std::string& w : r.warnings) out += "  warning: " + w + "\n";
   return out;
 }

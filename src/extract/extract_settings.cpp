@@ -18,13 +18,13 @@ constexpr double kRetryFactor = 4.0;
 Status ResolveTolerance(const ExtractOptions& options, const Mesh& sculpt, ExtractReport& report) {
   report.sculpt_median_edge = MedianEdgeLength(sculpt);
   report.tolerance_auto = options.tolerance <= 0;
-  report.tolerance = report.tolerance_auto
-                         ? options.tolerance_fraction * report.sculpt_median_edge
-                         : options.tolerance;
+  report.tolerance = report.tolerance_auto ? options.tolerance_fraction * report.sculpt_median_edge
+                                           : options.tolerance;
   if (!(report.tolerance > 0)) {
-    return Status::Error(fmt::format("{}: cannot derive a tolerance (median edge length {}); "
-                                     "set tolerance", options.sculpt_path,
-                                     report.sculpt_median_edge));
+    return Status::Error(
+        fmt::format("{}: cannot derive a tolerance (median edge length {}); "
+                    "set tolerance",
+                    options.sculpt_path, report.sculpt_median_edge));
   }
   return Status::Ok();
 }
@@ -33,8 +33,8 @@ Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs
                               const CoarseSampling& coarse, ExtractReport& report) {
   report.search_distance_auto = options.search_distance.kind == SearchDistanceSpec::Kind::kAuto;
   if (report.search_distance_auto) {
-    auto estimate = EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals,
-                                           report.base_diagonal);
+    auto estimate =
+        EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals, report.base_diagonal);
     if (!estimate.ok()) {
       return Status::Error(fmt::format("{} and {} do not overlap: {}", options.base_path,
                                        options.sculpt_path, estimate.status().message()));
@@ -50,9 +50,8 @@ Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs
   // the limit surface than almost everywhere else.
   report.retry_search_distance =
       report.search_distance_auto
-          ? std::max(report.search_distance,
-                     std::min(kRetryFactor * report.search_distance,
-                              report.search_estimate.ray_length))
+          ? std::max(report.search_distance, std::min(kRetryFactor * report.search_distance,
+                                                      report.search_estimate.ray_length))
           : 0.0;
   return Status::Ok();
 }
@@ -67,9 +66,9 @@ StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
   {
     DISPEX_ASSIGN_OR_RETURN(CoarseSampling coarse, SampleCoarsely(inputs.surface));
     DISPEX_RETURN_IF_ERROR(ResolveSearchDistances(options, inputs, coarse, report));
-    settings.plan = PlanOversampling(inputs.surface, inputs.sculpt, coarse.face_areas,
-                                     options.oversample, options.min_oversample,
-                                     options.max_oversample);
+    settings.plan =
+        PlanOversampling(inputs.surface, inputs.sculpt, coarse.face_areas, options.oversample,
+                         options.min_oversample, options.max_oversample);
   }
   report.oversample_subdivision_level = settings.plan.subdivision_level;
   report.t_search = clock.seconds();

@@ -11,7 +11,7 @@
 namespace dispex::extract {
 
 struct ExtractSettings {
-  OversamplingPlan plan;  // samples per side of each Ptex face
+  OversamplingPlan plan;       // samples per side of each Ptex face
   double search_distance = 0;  // as resolved; `query` holds it as a float
   NormalQuery query;           // the rays along +-n
   // The longer second search for samples that missed; its distance is 0 when there is none

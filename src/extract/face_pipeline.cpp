@@ -96,7 +96,8 @@ StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
     if (settings.holes == HolePolicy::kFail) {
       return Status::Error(fmt::format(
           "Ptex face {}: {} of {} rays missed the sculpt within the search distance {:.6g} "
-          "(holes = fail)", face.value, r.misses, count, settings.search_distance));
+          "(holes = fail)",
+          face.value, r.misses, count, settings.search_distance));
     }
     if (r.misses == static_cast<std::int32_t>(count) && settings.holes == HolePolicy::kFill) {
       r.all_missed = true;

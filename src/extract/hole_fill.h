@@ -35,10 +35,11 @@ struct EdgeMeans {
 EdgeMeans ComputeEdgeMeans(const float* values, int nx, int ny);
 
 // Faces whose rays all missed, filled from their neighbours. `filled[f]` is true for faces with
-// values; `edges[f]` their edge means; `faces` the Ptex face table (its adjacency: -1 = none). For each empty face the value across each edge is the neighbour's mean along
-// the shared edge; the face becomes the constant mean of those. Faces reached only through
-// other empty faces are filled in later rounds (breadth-first, deterministic). Returns, per
-// face, the constant value, and marks it filled; faces no filled face can reach stay unfilled.
+// values; `edges[f]` their edge means; `faces` the Ptex face table (its adjacency: -1 = none). For
+// each empty face the value across each edge is the neighbour's mean along the shared edge; the
+// face becomes the constant mean of those. Faces reached only through other empty faces are filled
+// in later rounds (breadth-first, deterministic). Returns, per face, the constant value, and marks
+// it filled; faces no filled face can reach stay unfilled.
 struct CrossFaceFill {
   std::vector<std::int32_t> faces;  // faces filled this way, in order
   std::vector<float> values;        // their constant values

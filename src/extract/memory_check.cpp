@@ -26,10 +26,10 @@ std::string Gib(std::uint64_t bytes) {
 }
 
 Status TooBig(std::uint64_t need, std::uint64_t limit, const std::string& what) {
-  return Status::Error(fmt::format(
-      "{} needs an estimated {} but the limit is {} (max_memory); free memory, use a "
-      "machine with more, or raise max_memory if the estimate is too high",
-      what, Gib(need), Gib(limit)));
+  return Status::Error(
+      fmt::format("{} needs an estimated {} but the limit is {} (max_memory); free memory, use a "
+                  "machine with more, or raise max_memory if the estimate is too high",
+                  what, Gib(need), Gib(limit)));
 }
 
 }  // namespace
@@ -41,8 +41,8 @@ Status CheckMemoryBeforeReading(const ExtractOptions& options, std::uint64_t lim
   if (ec) base = 0;
   std::uint64_t sculpt = std::filesystem::file_size(options.sculpt_path, ec);
   if (ec) sculpt = 0;
-  auto need = static_cast<std::uint64_t>(double(base + sculpt) * kArraysPerFileByte *
-                                         kReadPeakFactor);
+  auto need =
+      static_cast<std::uint64_t>(double(base + sculpt) * kArraysPerFileByte * kReadPeakFactor);
   if (need > limit) return TooBig(need, limit, "reading " + options.sculpt_path);
   return Status::Ok();
 }

@@ -38,7 +38,8 @@ Status FillMissedFaces(const ExtractOptions& options, const ExtractInputs& input
   if (cross.unreachable > 0) {
     report.warnings.push_back(fmt::format(
         "{} Ptex faces missed the sculpt entirely and have no neighbour with values: written "
-        "as 0", cross.unreachable));
+        "as 0",
+        cross.unreachable));
   }
   return Status::Ok();
 }

@@ -11,7 +11,9 @@ namespace dispex::extract {
 
 namespace {
 
-int Log2Of(int power_of_two) { return std::countr_zero(static_cast<unsigned>(power_of_two)); }
+int Log2Of(int power_of_two) {
+  return std::countr_zero(static_cast<unsigned>(power_of_two));
+}
 
 // The L for which `sculpt_faces` equals the face count of the base subdivided L times, or -1.
 int SubdivisionLevel(const LimitSurface& surface, const Mesh& sculpt) {
@@ -38,8 +40,8 @@ int SubdivisionLevel(const LimitSurface& surface, const Mesh& sculpt) {
 }  // namespace
 
 OversamplingPlan PlanOversampling(const LimitSurface& surface, const Mesh& sculpt,
-                                  const std::vector<double>& face_areas, int fixed,
-                                  int min_samples, int max_samples) {
+                                  const std::vector<double>& face_areas, int fixed, int min_samples,
+                                  int max_samples) {
   OversamplingPlan plan;
   const int num_faces = surface.num_ptex_faces();
   plan.log2.assign(static_cast<std::size_t>(num_faces), 0);

@@ -26,7 +26,7 @@ struct OversamplingPlan {
 
 // `face_areas`: the limit-surface area of each Ptex face (0 for holes).
 OversamplingPlan PlanOversampling(const LimitSurface& surface, const Mesh& sculpt,
-                                  const std::vector<double>& face_areas, int fixed,
-                                  int min_samples, int max_samples);
+                                  const std::vector<double>& face_areas, int fixed, int min_samples,
+                                  int max_samples);
 
 }  // namespace dispex::extract

@@ -23,9 +23,12 @@ PtexFaceInfo FaceInfo(const ExtractInputs& inputs, PtexFaceId face, int ulog2, i
 Status WriteFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFaceId face,
                  const FaceResult& result) {
   switch (result.kind) {
-    case FaceResult::Kind::kHole: return WriteConstantFace(writer, inputs, face, 0.0f);
-    case FaceResult::Kind::kAllMissed: return Status::Ok();
-    case FaceResult::Kind::kAnalysed: break;
+    case FaceResult::Kind::kHole:
+      return WriteConstantFace(writer, inputs, face, 0.0f);
+    case FaceResult::Kind::kAllMissed:
+      return Status::Ok();
+    case FaceResult::Kind::kAnalysed:
+      break;
   }
   const SpectralFace& analysed = result.analysed;
   const PtexFaceInfo info = FaceInfo(inputs, face, analysed.ulog2, analysed.vlog2);
@@ -69,17 +72,18 @@ Status ForEachFace(int count, FaceOf face_of,
                    tbb::enumerable_thread_specific<FaceScratch>& scratches, Progress* bar,
                    Work work) {
   FirstError error;
-  tbb::parallel_for(tbb::blocked_range<int>(0, count, 1), [&](const tbb::blocked_range<int>& range) {
-    FaceScratch& w = scratches.local();
-    for (int k = range.begin(); k != range.end(); ++k) {
-      const int f = face_of(k);
-      if (error.failed()) return;
-      if (CancelRequested()) return error.Record(-1, Cancelled());
-      Status s = work(PtexFaceId(f), w);
-      if (!s.ok()) return error.Record(f, s);
-      if (bar) bar->Advance();
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<int>(0, count, 1),
+                    [&](const tbb::blocked_range<int>& range) {
+                      FaceScratch& w = scratches.local();
+                      for (int k = range.begin(); k != range.end(); ++k) {
+                        const int f = face_of(k);
+                        if (error.failed()) return;
+                        if (CancelRequested()) return error.Record(-1, Cancelled());
+                        Status s = work(PtexFaceId(f), w);
+                        if (!s.ok()) return error.Record(f, s);
+                        if (bar) bar->Advance();
+                      }
+                    });
   return error.failed() ? error.status() : Status::Ok();
 }
 
@@ -116,7 +120,8 @@ StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const Extract
     if (result.kind == FaceResult::Kind::kAnalysed) w.cpu_write += step.seconds();
     return written;
   };
-  Status status = ForEachFace(num_faces, [](int k) { return k; }, scratches, &bar, process);
+  Status status = ForEachFace(
+      num_faces, [](int k) { return k; }, scratches, &bar, process);
   bar.Finish();
   DISPEX_RETURN_IF_ERROR(status);
   AddWorkers(scratches, out.workers);

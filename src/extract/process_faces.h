@@ -29,9 +29,9 @@ struct KeptFace {
 };
 
 struct ProcessedFaces {
-  std::vector<FaceStats> stats;          // per Ptex face
-  std::vector<EdgeMeans> edge_means;     // per Ptex face
-  std::vector<KeptFace> kept;            // per Ptex face, when settings.watertight is on
+  std::vector<FaceStats> stats;       // per Ptex face
+  std::vector<EdgeMeans> edge_means;  // per Ptex face
+  std::vector<KeptFace> kept;         // per Ptex face, when settings.watertight is on
   WorkerTotals workers;
 };
 

@@ -94,8 +94,8 @@ class ChunkParser {
       SkipBlanks(p_, end_, line_);
       if (AtStatementEnd()) {
         if (k >= needed) return true;
-        return Fail(fmt::format("{} has {} coordinate{} ({} needed)", what, k,
-                                k == 1 ? "" : "s", needed));
+        return Fail(
+            fmt::format("{} has {} coordinate{} ({} needed)", what, k, k == 1 ? "" : "s", needed));
       }
       const char* token = p_;
       const NumberResult r = ParseReal(p_, end_, out[k]);
@@ -116,8 +116,7 @@ class ChunkParser {
       if (AtStatementEnd()) return true;
       const char* token = p_;
       double extra = 0;
-      if (ParseReal(p_, end_, extra) != NumberResult::kOk ||
-          !EndsToken(p_, end_)) {
+      if (ParseReal(p_, end_, extra) != NumberResult::kOk || !EndsToken(p_, end_)) {
         p_ = token;
         return FailUnexpected(fmt::format("after the {} coordinates", what).c_str());
       }
@@ -150,8 +149,8 @@ class ChunkParser {
       texcoord = index - 1;
       if (texcoord < in_.num_texcoords) return true;
       p_ = token;
-      return Fail(fmt::format("face texture index {} out of range ({} texture coordinates)",
-                              index, in_.num_texcoords));
+      return Fail(fmt::format("face texture index {} out of range ({} texture coordinates)", index,
+                              in_.num_texcoords));
     }
     if (index < 0) {
       const std::int64_t before = in_.texcoord_base + out_.texcoords;
@@ -159,8 +158,8 @@ class ChunkParser {
       if (texcoord >= 0) return true;
       p_ = token;
       return Fail(fmt::format(
-          "relative face texture index {} out of range ({} texture coordinates before it)",
-          index, before));
+          "relative face texture index {} out of range ({} texture coordinates before it)", index,
+          before));
     }
     p_ = token;
     return Fail("face texture index 0 (OBJ indices start at 1)");
@@ -275,8 +274,8 @@ class ChunkParser {
       }
       int length = 0;
       const char* start = p_;
-      while (p_ < end_ && !IsBlank(*p_) && *p_ != '\n' &&
-             !IsContinuation(p_, end_, length) && !IsDanglingContinuation(p_, end_)) {
+      while (p_ < end_ && !IsBlank(*p_) && *p_ != '\n' && !IsContinuation(p_, end_, length) &&
+             !IsDanglingContinuation(p_, end_)) {
         ++p_;
       }
       if (!name.empty()) name.push_back(' ');

@@ -49,9 +49,9 @@ struct ChunkOutput {
   // so far names one at every corner (unused when the file has no vt line, and no longer
   // filled after a face without: the file then has no UVs).
   ChunkBuffer<std::int32_t> uv_indices;
-  std::vector<GroupStart> groups;     // in file order
-  SubdivTags tags;                    // this chunk's tags, in file order
-  std::int64_t vertices = 0;          // parsed (equals the counting pass unless error)
+  std::vector<GroupStart> groups;  // in file order
+  SubdivTags tags;                 // this chunk's tags, in file order
+  std::int64_t vertices = 0;       // parsed (equals the counting pass unless error)
   std::int64_t texcoords = 0;
   std::int64_t faces = 0;
   std::int64_t faces_with_uvs = 0;  // faces that name a texture coordinate at every corner

@@ -132,8 +132,7 @@ bool ReadTagArguments(const char*& p, const char* end, std::int64_t& line, TagAr
     return false;
   }
   tag.name = std::string(tag.name_token);
-  tag.shown = TokenForMessage(tag.name_token.data(),
-                                    tag.name_token.data() + tag.name_token.size());
+  tag.shown = TokenForMessage(tag.name_token.data(), tag.name_token.data() + tag.name_token.size());
   std::string_view counts_token;
   if (!NextToken(p, end, line, counts_token)) {
     error = fmt::format("tag '{}' without its <nint>/<nfloat>/<nstring> counts", tag.shown);
@@ -329,8 +328,8 @@ bool ParseTag(const char*& p, const char* end, std::int64_t& line, const TagLimi
   if (tag.name == "creasemethod") return ApplyCreaseMethod(tag, tags, error);
   if (tag.name == "smoothtriangles") return ApplySmoothTriangles(tag, tags, error);
   // Printable and at most 64 bytes, so that warnings stay one line.
-  tags.ignored_tag_names.push_back(TokenForMessage(
-      tag.name_token.data(), tag.name_token.data() + tag.name_token.size(), 64));
+  tags.ignored_tag_names.push_back(
+      TokenForMessage(tag.name_token.data(), tag.name_token.data() + tag.name_token.size(), 64));
   return true;
 }
 

@@ -29,21 +29,21 @@ Status WriteObj(const std::string& path, const Mesh& mesh, const std::string& he
     }
     return Status::Ok();
   };
-  DISPEX_RETURN_IF_ERROR(emit(mesh.num_vertices(), [&](fmt::memory_buffer& b, std::size_t begin,
-                                                       std::size_t end) {
-    for (std::size_t v = begin; v < end; ++v) {
-      const Float3& p = mesh.positions[v];
-      fmt::format_to(std::back_inserter(b), "v {} {} {}\n", p.x, p.y, p.z);
-    }
-  }));
-  DISPEX_RETURN_IF_ERROR(emit(mesh.num_faces(), [&](fmt::memory_buffer& b, std::size_t begin,
-                                                    std::size_t end) {
-    for (std::size_t f = begin; f < end; ++f) {
-      b.push_back('f');
-      for (std::int32_t v : mesh.face(f)) fmt::format_to(std::back_inserter(b), " {}", v + 1);
-      b.push_back('\n');
-    }
-  }));
+  DISPEX_RETURN_IF_ERROR(
+      emit(mesh.num_vertices(), [&](fmt::memory_buffer& b, std::size_t begin, std::size_t end) {
+        for (std::size_t v = begin; v < end; ++v) {
+          const Float3& p = mesh.positions[v];
+          fmt::format_to(std::back_inserter(b), "v {} {} {}\n", p.x, p.y, p.z);
+        }
+      }));
+  DISPEX_RETURN_IF_ERROR(
+      emit(mesh.num_faces(), [&](fmt::memory_buffer& b, std::size_t begin, std::size_t end) {
+        for (std::size_t f = begin; f < end; ++f) {
+          b.push_back('f');
+          for (std::int32_t v : mesh.face(f)) fmt::format_to(std::back_inserter(b), " {}", v + 1);
+          b.push_back('\n');
+        }
+      }));
   return out.Commit();
 }
 

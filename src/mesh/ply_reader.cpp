@@ -287,7 +287,8 @@ class BinaryReader {
       for (int k = 0; k < 3; ++k) {
         const Type type = element.properties[static_cast<std::size_t>(axes[k])].type;
         if (auto message = ToCoordinate(LoadReal(data_ + at[k], type, swap_), xyz[k])) {
-          error.Record(std::int64_t(v), Status::Error(fmt::format("{}: vertex {}: {}", name_, v, *message)));
+          error.Record(std::int64_t(v),
+                       Status::Error(fmt::format("{}: vertex {}: {}", name_, v, *message)));
           return false;
         }
       }

@@ -137,7 +137,8 @@ std::string FormatPtexSummary(const PtexFile& file, std::size_t max_values) {
   s += fmt::format("levels        {} (entries:", h.num_levels);
   for (const PtexLevelInfo& l : file.levels()) s += fmt::format(" {}", l.num_entries);
   s += ")\n";
-  s += fmt::format("border modes  u {}, v {}\n", PtexBorderModeName(h.u_border), PtexBorderModeName(h.v_border));
+  s += fmt::format("border modes  u {}, v {}\n", PtexBorderModeName(h.u_border),
+                   PtexBorderModeName(h.v_border));
   s += fmt::format("edge filter   {}\n", PtexEdgeFilterModeName(h.edge_filter));
   s += fmt::format("texels        {} at level 0 in non-constant faces, {} in reductions\n",
                    level0_texels, reduced_texels);
@@ -209,8 +210,8 @@ Status FormatPtexStructure(const PtexFile& file, std::string& out) {
   out += fmt::format(
       "header: mesh {} data {} channels {} alpha {} faces {} levels {} minor {} borders {} {} "
       "edgefilter {}\n",
-      PtexMeshTypeName(h.mesh_type), PtexDataTypeName(h.data_type), h.num_channels,
-      h.alpha_channel, h.num_faces, h.num_levels, h.minor_version, PtexBorderModeName(h.u_border),
+      PtexMeshTypeName(h.mesh_type), PtexDataTypeName(h.data_type), h.num_channels, h.alpha_channel,
+      h.num_faces, h.num_levels, h.minor_version, PtexBorderModeName(h.u_border),
       PtexBorderModeName(h.v_border), PtexEdgeFilterModeName(h.edge_filter));
   for (int f = 0; f < h.num_faces; ++f) {
     const PtexFaceInfo& info = file.face_info(PtexFaceId(f));

@@ -1,11 +1,11 @@
 // Edge steps of a map under both readers (include/dispex/ptex_sampler.h).
-#include "dispex/ptex_sampler.h"
-
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 #include <utility>
+
+#include "dispex/ptex_sampler.h"
 
 namespace dispex {
 
@@ -36,7 +36,8 @@ PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
       const int a = first.face.value;
       if (skip_faces[std::size_t(a)]) continue;
       // Between faces of one kind, each edge once: from the lower id (or lower edge on itself).
-      if (faces[fi].subface == faces[std::size_t(a)].subface && (a < f || (a == f && first.edge < e))) {
+      if (faces[fi].subface == faces[std::size_t(a)].subface &&
+          (a < f || (a == f && first.edge < e))) {
         continue;
       }
       if (!measure.only_faces.empty() && !measure.only_faces[fi] &&
@@ -57,10 +58,10 @@ PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
         double u = 0, v = 0, ou = 0, ov = 0;
         PtexEdgePoint(e, t, u, v);
         PtexEdgePoint(other.edge, other.t, ou, ov);
-        const double face_step =
-            measure.per_face ? std::abs(sampler.SampleFace(PtexFaceId(f), u, v) -
-                                        sampler.SampleFace(other.face, ou, ov))
-                             : 0.0;
+        const double face_step = measure.per_face
+                                     ? std::abs(sampler.SampleFace(PtexFaceId(f), u, v) -
+                                                sampler.SampleFace(other.face, ou, ov))
+                                     : 0.0;
         const double filter_step = std::abs(sampler.SampleAcrossFaces(PtexFaceId(f), u, v) -
                                             sampler.SampleAcrossFaces(other.face, ou, ov));
         if (measure.keep_points) {
@@ -80,7 +81,8 @@ PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
     steps.edges += p.edges;
     steps.skipped_edges += p.skipped_edges;
     steps.per_face.insert(steps.per_face.end(), p.per_face.begin(), p.per_face.end());
-    steps.across_faces.insert(steps.across_faces.end(), p.across_faces.begin(), p.across_faces.end());
+    steps.across_faces.insert(steps.across_faces.end(), p.across_faces.begin(),
+                              p.across_faces.end());
     steps.edge_max.insert(steps.edge_max.end(), p.edge_max.begin(), p.edge_max.end());
   }
   return steps;

@@ -90,7 +90,8 @@ Status PtexFile::Impl::DecodeBlock(const Block& block, const std::string& where,
   } else {
     const TileTable& table = tile_tables[std::size_t(block.tiles)];
     for (std::size_t t = 0; t < table.headers.size(); ++t) {
-      std::string why = CheckInflatable(table.headers[t], 1 << table.ulog2, 1 << table.vlog2, header);
+      std::string why =
+          CheckInflatable(table.headers[t], 1 << table.ulog2, 1 << table.vlog2, header);
       if (!why.empty()) {
         return Status::Error(name + ": " + where + " tile " + std::to_string(t) + ": " + why);
       }

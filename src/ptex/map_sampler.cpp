@@ -2,8 +2,6 @@
 // follows the reference library's PtexSeparableFilter / PtexSeparableKernel semantics step by
 // step (kernel construction, splitting at edges and corners, rotation into the neighbour,
 // sub-face transitions, resolution matching), written anew in double precision.
-#include "dispex/ptex_sampler.h"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -11,6 +9,7 @@
 #include <numeric>
 
 #include "core/check.h"
+#include "dispex/ptex_sampler.h"
 
 namespace dispex {
 
@@ -306,7 +305,9 @@ class BoxReductions {
   }
 
  private:
-  double& At(int i, int j) { return sums_[std::size_t(j) * std::size_t(ures_ + 1) + std::size_t(i)]; }
+  double& At(int i, int j) {
+    return sums_[std::size_t(j) * std::size_t(ures_ + 1) + std::size_t(i)];
+  }
   double Get(int i, int j) const {
     return sums_[std::size_t(j) * std::size_t(ures_ + 1) + std::size_t(i)];
   }
@@ -489,7 +490,8 @@ struct PtexMapSampler::Impl {
       corner_face[std::size_t(i)] = af;
       corner_edge[std::size_t(i)] = aedge;
       const bool subface = a->subface;
-      if (previous_subface && !subface && a->adjfaces[std::size_t((aedge + 3) % 4)] == previous_face) {
+      if (previous_subface && !subface &&
+          a->adjfaces[std::size_t((aedge + 3) % 4)] == previous_face) {
         // A T-junction where a quad meets two sub-faces: continue on the quad.
         const bool primary = i == 1;
         k.SubfaceToMain(edge + int(primary) * 2);
@@ -547,7 +549,9 @@ PtexMapSampler::~PtexMapSampler() = default;
 PtexMapSampler::PtexMapSampler(PtexMapSampler&&) noexcept = default;
 PtexMapSampler& PtexMapSampler::operator=(PtexMapSampler&&) noexcept = default;
 
-int PtexMapSampler::num_faces() const { return static_cast<int>(impl_->faces.size()); }
+int PtexMapSampler::num_faces() const {
+  return static_cast<int>(impl_->faces.size());
+}
 
 double PtexMapSampler::SampleFace(PtexFaceId face, double u, double v) const {
   const int f = face.value;

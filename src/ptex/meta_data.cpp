@@ -65,8 +65,8 @@ std::string ParseMetaRecords(std::span<const std::uint8_t> bytes, bool large_hea
     rec.datasize = Load<std::uint32_t>(bytes.data() + pos);
     pos += 4;
     if (rec.datasize % MetaElementSize(rec.item.type) != 0) {
-      return where_key + ": data size " + std::to_string(rec.datasize) + " is not a multiple of the " +
-             std::string(PtexMetaTypeName(rec.item.type)) + " size";
+      return where_key + ": data size " + std::to_string(rec.datasize) +
+             " is not a multiple of the " + std::string(PtexMetaTypeName(rec.item.type)) + " size";
     }
     if (large_header) {
       rec.zipsize = Load<std::uint32_t>(bytes.data() + pos);

@@ -108,7 +108,8 @@ void DrawLegend(Image& image, const AtlasLayout& layout, AtlasMode mode) {
 
 Status ValidateAtlasOptions(const AtlasOptions& o) {
   if (!(o.range >= 0) || !std::isfinite(o.range)) {
-    return Status::Error(fmt::format("range = {}: expected 0 (automatic) or a number > 0", o.range));
+    return Status::Error(
+        fmt::format("range = {}: expected 0 (automatic) or a number > 0", o.range));
   }
   if (o.channel < 0) return Status::Error(fmt::format("channel = {}: must be >= 0", o.channel));
   if (o.min_tile < 2 || o.min_tile > 256) {

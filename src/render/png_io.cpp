@@ -1,9 +1,10 @@
 // Image to and from PNG through dispex::core's PNG module (core/png_io.h): images are written
 // as 8-bit RGB and read converted to 8-bit RGB.
+#include "core/png_io.h"
+
 #include <utility>
 #include <vector>
 
-#include "core/png_io.h"
 #include "dispex/render.h"
 
 namespace dispex {

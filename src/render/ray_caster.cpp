@@ -65,11 +65,12 @@ StatusOr<Image> CastPanel(const ShadedMesh& mesh, const Tracer& tracer, const Ca
   const int w = camera.width, h = camera.height, ss = options.supersample;
   const int per_pixel = ss * ss;
   Image image(w, h, kPanelBackground);
-  const Vec3d right = ToVec3d(camera.right), up = ToVec3d(camera.up), back = ToVec3d(camera.forward) * -1.0;
+  const Vec3d right = ToVec3d(camera.right), up = ToVec3d(camera.up),
+              back = ToVec3d(camera.forward) * -1.0;
   const Rig rig{Normalize(right * -0.7 + up * 0.6 + back * 0.4),
                 Normalize(right * 0.7 + up * 0.05 + back * 0.7)};
   const Vec3d background = {ToLinear(kPanelBackground[0]), ToLinear(kPanelBackground[1]),
-                         ToLinear(kPanelBackground[2])};
+                            ToLinear(kPanelBackground[2])};
   const auto& P = mesh.mesh.positions;
   const auto& I = mesh.mesh.face_indices;
 
@@ -114,8 +115,8 @@ StatusOr<Image> CastPanel(const ShadedMesh& mesh, const Tracer& tracer, const Ca
         bu = std::clamp(bu, 0.0, 1.0);
         bv = std::clamp(bv, 0.0, 1.0 - bu);
       }
-      Vec3d n = Normalize(ToVec3d(mesh.normals[i0]) * (1.0 - bu - bv) + ToVec3d(mesh.normals[i1]) * bu +
-                       ToVec3d(mesh.normals[i2]) * bv);
+      Vec3d n = Normalize(ToVec3d(mesh.normals[i0]) * (1.0 - bu - bv) +
+                          ToVec3d(mesh.normals[i1]) * bu + ToVec3d(mesh.normals[i2]) * bv);
       Vec3d g = ToVec3d(hit.normal);
       if (Dot(g, d) > 0) {  // the back side: shade the side we see
         g = g * -1.0;
@@ -139,9 +140,11 @@ StatusOr<Image> CastPanel(const ShadedMesh& mesh, const Tracer& tracer, const Ca
       for (std::size_t r = 0; r < count; ++r) {
         if (!s.hits[r].hit()) continue;
         const Vec3d g = s.geometric[r];
-        const Vec3d t1 = Normalize(std::fabs(g.x) > 0.5 ? Cross(g, {0, 1, 0}) : Cross(g, {1, 0, 0}));
+        const Vec3d t1 =
+            Normalize(std::fabs(g.x) > 0.5 ? Cross(g, {0, 1, 0}) : Cross(g, {1, 0, 0}));
         const Vec3d t2 = Cross(g, t1);
-        const Vec3d hit_point = ToVec3d(s.rays[r].origin) + ToVec3d(s.rays[r].direction) * s.hits[r].t;
+        const Vec3d hit_point =
+            ToVec3d(s.rays[r].origin) + ToVec3d(s.rays[r].direction) * s.hits[r].t;
         const Vec3d origin = hit_point + g * (1e-3 * options.ao_distance);
         const std::uint32_t pixel =
             Mix(static_cast<std::uint32_t>(y) * 0x9e3779b9u ^ static_cast<std::uint32_t>(r)) ^
@@ -151,7 +154,7 @@ StatusOr<Image> CastPanel(const ShadedMesh& mesh, const Tracer& tracer, const Ca
           const double u1 = Uniform(bits), u2 = Uniform(Mix(bits ^ 0x5bd1e995u));
           const double radius = std::sqrt(u2), phi = 2.0 * std::numbers::pi * u1;
           const Vec3d dir = t1 * (radius * std::cos(phi)) + t2 * (radius * std::sin(phi)) +
-                         g * std::sqrt(std::max(0.0, 1.0 - u2));
+                            g * std::sqrt(std::max(0.0, 1.0 - u2));
           Ray ray;
           ray.origin = FromVec3d<Float3>(origin);
           ray.direction = FromVec3d<Float3>(Normalize(dir));

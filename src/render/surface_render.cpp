@@ -164,16 +164,18 @@ StatusOr<Image> RenderComparison(const Mesh& base, const PtexFile& map, const Me
   const int panels = sculpt ? 3 : 2;
   const int panel_width = options.width / panels;
   if (panel_width < 16) {
-    return Status::Error(fmt::format("width x height = {}x{}: {} panels need at least {} pixels of width",
-                                     options.width, options.height, panels, 16 * panels));
+    return Status::Error(
+        fmt::format("width x height = {}x{}: {} panels need at least {} pixels of width",
+                    options.width, options.height, panels, 16 * panels));
   }
   // Label size: 2x the font from 240 rows, growing with the image (4x at 720 rows).
   const int scale = options.height >= 240 ? std::clamp(options.height / 180, 2, 4) : 1;
   const int strip = render::TextHeight(render::FontSize::kSmall, scale) + 6 * scale;
   const int panel_height = options.height - strip;
   if (panel_height < 16) {
-    return Status::Error(fmt::format("width x height = {}x{}: too low for labelled panels (at least {})",
-                                     options.width, options.height, strip + 16));
+    return Status::Error(
+        fmt::format("width x height = {}x{}: too low for labelled panels (at least {})",
+                    options.width, options.height, strip + 16));
   }
   return InArena(options.threads, [&]() -> StatusOr<Image> {
     DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));

@@ -241,8 +241,13 @@ class Tessellation {
   Tessellation(const Mesh& cage, const LimitSurface& surface,
                std::span<const std::array<int, 2>> density, const PtexFile* map, int channel,
                BoundaryDisplacement boundary)
-      : cage_(cage), surface_(surface), density_(density), map_(map), channel_(channel),
-        per_face_(boundary == BoundaryDisplacement::kPerFace), n_(surface.num_ptex_faces()) {}
+      : cage_(cage),
+        surface_(surface),
+        density_(density),
+        map_(map),
+        channel_(channel),
+        per_face_(boundary == BoundaryDisplacement::kPerFace),
+        n_(surface.num_ptex_faces()) {}
 
   StatusOr<ShadedMesh> Run() {
     DISPEX_CHECK_EQ(density_.size(), static_cast<std::size_t>(n_));
@@ -278,7 +283,8 @@ class Tessellation {
   // The merged line point of grid point i along side `side` of face f.
   std::int64_t GridPoint(int f, int side, int i) const {
     const std::int64_t e = entry_of_[4 * static_cast<std::size_t>(f) + side];
-    return entry_grid_point_[static_cast<std::size_t>(grid_offset_[static_cast<std::size_t>(e)] + i)];
+    return entry_grid_point_[static_cast<std::size_t>(grid_offset_[static_cast<std::size_t>(e)] +
+                                                      i)];
   }
   // The lowest line point an entry covers (its line points are consecutive from there).
   std::int64_t EntryFirstPoint(std::size_t e) const {
@@ -329,11 +335,12 @@ class Tessellation {
     entries_.erase(std::remove_if(entries_.begin(), entries_.end(),
                                   [](const SideEntry& e) { return e.face < 0; }),
                    entries_.end());
-    tbb::parallel_sort(entries_.begin(), entries_.end(), [](const SideEntry& x, const SideEntry& y) {
-      if (x.line != y.line) return x.line < y.line;
-      if (x.face != y.face) return x.face < y.face;
-      return x.side < y.side;
-    });
+    tbb::parallel_sort(entries_.begin(), entries_.end(),
+                       [](const SideEntry& x, const SideEntry& y) {
+                         if (x.line != y.line) return x.line < y.line;
+                         if (x.face != y.face) return x.face < y.face;
+                         return x.side < y.side;
+                       });
     const std::size_t num_entries = entries_.size();
     entry_of_.assign(4 * static_cast<std::size_t>(n_), -1);
     grid_offset_.assign(num_entries + 1, 0);
@@ -499,8 +506,7 @@ class Tessellation {
           surface_.source(), num_triangles));
     }
     Mesh& mesh = out_.mesh;
-    mesh.source =
-        surface_.source() + (map_ ? " displaced by " + map_->name() : " (limit surface)");
+    mesh.source = surface_.source() + (map_ ? " displaced by " + map_->name() : " (limit surface)");
     mesh.positions.reserve(static_cast<std::size_t>(num_vertices) + 1);
     mesh.positions.resize(static_cast<std::size_t>(num_vertices));
     limit_normals_.resize(static_cast<std::size_t>(num_vertices));
@@ -749,17 +755,17 @@ class Tessellation {
   bool per_face_;  // BoundaryDisplacement::kPerFace
   int n_;          // Ptex faces
 
-  std::vector<SideEntry> entries_;        // face sides, by line
-  std::vector<std::int64_t> entry_of_;    // 4 f + side -> its entry, or -1
-  std::vector<std::int64_t> grid_offset_; // entry -> its first grid point
-  std::vector<std::size_t> line_start_;   // entries of line g: [line_start_[g], [g + 1])
+  std::vector<SideEntry> entries_;         // face sides, by line
+  std::vector<std::int64_t> entry_of_;     // 4 f + side -> its entry, or -1
+  std::vector<std::int64_t> grid_offset_;  // entry -> its first grid point
+  std::vector<std::size_t> line_start_;    // entries of line g: [line_start_[g], [g + 1])
   std::size_t num_lines_ = 0;
   std::vector<std::int64_t> entry_grid_point_;  // grid point -> merged line point
   std::vector<Frac> line_point_frac_;
   std::vector<std::int64_t> line_point_count_;
   std::vector<Record> records_;
   std::vector<std::int32_t> line_point_vertex_;  // line point -> its vertex (mean displacement)
-  std::vector<std::size_t> point_records_;  // records of point i: [point_records_[i], [i + 1])
+  std::vector<std::size_t> point_records_;       // records of point i: [point_records_[i], [i + 1])
   std::size_t num_points_ = 0;
   // Per-face displacement only (see NumberFaceCopies).
   std::vector<std::size_t> copy_records_, point_copies_;

@@ -18,13 +18,13 @@ struct AnalyzerSteps {
     return analyzer.ForwardDct(samples, nx, ny, coefficients);
   }
   // Its inverse (orthonormal DCT-III).
-  static Status InverseDct(SpectralAnalyzer& analyzer, std::span<const float> coefficients,
-                           int nx, int ny, std::span<float> samples) {
+  static Status InverseDct(SpectralAnalyzer& analyzer, std::span<const float> coefficients, int nx,
+                           int ny, std::span<float> samples) {
     return analyzer.InverseDct(coefficients, nx, ny, samples);
   }
   // An nx x ny block resampled to 2^ulog2 x 2^vlog2 texels in the DCT domain.
-  static Status Resample(SpectralAnalyzer& analyzer, std::span<const float> samples, int nx,
-                         int ny, int ulog2, int vlog2, std::span<float> texels) {
+  static Status Resample(SpectralAnalyzer& analyzer, std::span<const float> samples, int nx, int ny,
+                         int ulog2, int vlog2, std::span<float> texels) {
     return analyzer.Resample(samples, nx, ny, ulog2, vlog2, texels);
   }
 };

@@ -21,7 +21,9 @@ double ReadAlong(const float* values, std::ptrdiff_t stride, int count, double x
 
 // The value on the edge beyond sample s0, with s1 the next sample inward (one spacing away):
 // the edge lies half a spacing beyond s0.
-double Extrapolate(double s0, double s1, bool have_s1) { return have_s1 ? 1.5 * s0 - 0.5 * s1 : s0; }
+double Extrapolate(double s0, double s1, bool have_s1) {
+  return have_s1 ? 1.5 * s0 - 0.5 * s1 : s0;
+}
 
 }  // namespace
 
@@ -35,8 +37,9 @@ double MaxEdgeReadError(const float* texels, const BlockShape& res, const float*
     const double bottom = ReadAlong(texels, 1, rx, x);
     const double top = ReadAlong(texels + std::ptrdiff_t(ry - 1) * rx, 1, rx, x);
     const double at_bottom = Extrapolate(samples[i], ny > 1 ? samples[row + i] : 0, ny > 1);
-    const double at_top = Extrapolate(samples[std::ptrdiff_t(ny - 1) * row + i],
-                                      ny > 1 ? samples[std::ptrdiff_t(ny - 2) * row + i] : 0, ny > 1);
+    const double at_top =
+        Extrapolate(samples[std::ptrdiff_t(ny - 1) * row + i],
+                    ny > 1 ? samples[std::ptrdiff_t(ny - 2) * row + i] : 0, ny > 1);
     worst = std::max({worst, std::fabs(bottom - at_bottom), std::fabs(top - at_top)});
   }
   for (int j = 0; j < ny; ++j) {  // left (u = 0) and right (u = 1) edges
@@ -54,9 +57,10 @@ double MaxEdgeReadError(const float* texels, const BlockShape& res, const float*
       const int i0 = ci ? nx - 1 : 0, i1 = ci ? nx - 2 : 1;
       const int j0 = cj ? ny - 1 : 0, j1 = cj ? ny - 2 : 1;
       auto at = [&](int i, int j) { return double(samples[std::ptrdiff_t(j) * row + i]); };
-      auto edge_value = [&](int j) { return Extrapolate(at(i0, j), nx > 1 ? at(i1, j) : 0, nx > 1); };
-      const double corner =
-          Extrapolate(edge_value(j0), ny > 1 ? edge_value(j1) : 0, ny > 1);
+      auto edge_value = [&](int j) {
+        return Extrapolate(at(i0, j), nx > 1 ? at(i1, j) : 0, nx > 1);
+      };
+      const double corner = Extrapolate(edge_value(j0), ny > 1 ? edge_value(j1) : 0, ny > 1);
       const double texel = texels[std::ptrdiff_t(cj ? ry - 1 : 0) * rx + (ci ? rx - 1 : 0)];
       worst = std::max(worst, std::fabs(texel - corner));
     }
@@ -73,7 +77,9 @@ void PinEdgeTexels(float* texels, const BlockShape& res, const float* samples,
   auto bottom = [&](int i) { return Extrapolate(at(i, 0), ny > 1 ? at(i, 1) : 0, ny > 1); };
   auto top = [&](int i) { return Extrapolate(at(i, ny - 1), ny > 1 ? at(i, ny - 2) : 0, ny > 1); };
   auto left = [&](int j) { return Extrapolate(at(0, j), nx > 1 ? at(1, j) : 0, nx > 1); };
-  auto right = [&](int j) { return Extrapolate(at(nx - 1, j), nx > 1 ? at(nx - 2, j) : 0, nx > 1); };
+  auto right = [&](int j) {
+    return Extrapolate(at(nx - 1, j), nx > 1 ? at(nx - 2, j) : 0, nx > 1);
+  };
   auto texel = [&](int i, int j) -> float& { return texels[std::ptrdiff_t(j) * rx + i]; };
   const bool rows = ry >= 2 && ry < ny, columns = rx >= 2 && rx < nx;
   if (rows) {

@@ -15,7 +15,9 @@ std::vector<std::uint8_t> SharpCreaseEdges(const Mesh& base, const LimitSurface&
   }
   std::vector<std::uint8_t> bits(static_cast<std::size_t>(surface.num_ptex_faces()), 0);
   if (sharp.empty()) return bits;
-  auto is_sharp = [&](std::int32_t a, std::int32_t b) { return sharp.count(std::minmax(a, b)) > 0; };
+  auto is_sharp = [&](std::int32_t a, std::int32_t b) {
+    return sharp.count(std::minmax(a, b)) > 0;
+  };
   for (int f = 0; f < surface.num_ptex_faces(); ++f) {
     const BaseFaceId base_face = surface.base_face(PtexFaceId(f));
     const auto verts = base.face(static_cast<std::size_t>(base_face.value));

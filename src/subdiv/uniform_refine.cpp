@@ -299,7 +299,9 @@ void AtomicMin(std::int32_t& slot, std::int32_t value) {
 // RefineUniform's state, built by its steps in the order RefineUniform calls them.
 struct Refinement {
   Refinement(const LimitSurface::Impl& surface, int levels_, const RefineOptions& options_)
-      : s(surface), levels(levels_), options(options_),
+      : s(surface),
+        levels(levels_),
+        options(options_),
         arena(options_.threads > 0 ? options_.threads : tbb::task_arena::automatic) {}
 
   const LimitSurface::Impl& s;
@@ -310,9 +312,9 @@ struct Refinement {
 
   std::unique_ptr<Far::TopologyRefiner> refiner;
   std::unique_ptr<LastSplit> split;
-  int num_vertices = 0, num_faces = 0;  // at the output level, holes included
-  std::vector<std::int32_t> owner;      // per vertex: the lowest kept leaf face using it
-  std::vector<std::uint8_t> keep;       // per leaf face: not part of a hole
+  int num_vertices = 0, num_faces = 0;      // at the output level, holes included
+  std::vector<std::int32_t> owner;          // per vertex: the lowest kept leaf face using it
+  std::vector<std::uint8_t> keep;           // per leaf face: not part of a hole
   std::vector<std::uint32_t> leaf_offsets;  // only for levels == 0 (faces of any size)
   // Face-vertex lists of all leaves in OpenSubdiv's order (holes included, dropped at the end).
   std::vector<std::int32_t> leaf_vertices;
@@ -373,23 +375,25 @@ struct Refinement {
                                                     refiner->GetLevel(0).GetFaceVertices(f).size());
       }
     }
-    leaf_vertices.resize(levels == 0 ? leaf_offsets.back() : 4 * static_cast<std::size_t>(num_faces));
+    leaf_vertices.resize(levels == 0 ? leaf_offsets.back()
+                                     : 4 * static_cast<std::size_t>(num_faces));
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<int>(0, s.num_base_faces()),
-                        [&](const tbb::blocked_range<int>& r) {
-        LeafWalker& walker = WorkerForThread().walker;
-        for (int f = r.begin(); f != r.end(); ++f) {
-          if (!HasSurface(f)) continue;
-          walker.Walk(f, [&](int face, int corners, const int* vertices, const int*, const float*) {
-            keep[face] = 1;
-            std::int32_t* dst = &leaf_vertices[LeafOffset(face)];
-            for (int m = 0; m < corners; ++m) {
-              dst[m] = vertices[m];
-              AtomicMin(owner[vertices[m]], face);
+      tbb::parallel_for(
+          tbb::blocked_range<int>(0, s.num_base_faces()), [&](const tbb::blocked_range<int>& r) {
+            LeafWalker& walker = WorkerForThread().walker;
+            for (int f = r.begin(); f != r.end(); ++f) {
+              if (!HasSurface(f)) continue;
+              walker.Walk(
+                  f, [&](int face, int corners, const int* vertices, const int*, const float*) {
+                    keep[face] = 1;
+                    std::int32_t* dst = &leaf_vertices[LeafOffset(face)];
+                    for (int m = 0; m < corners; ++m) {
+                      dst[m] = vertices[m];
+                      AtomicMin(owner[vertices[m]], face);
+                    }
+                  });
             }
           });
-        }
-      });
     });
   }
 
@@ -423,14 +427,14 @@ struct Refinement {
     std::string failure;
     Mesh& mesh = out.mesh;
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<int>(0, s.num_base_faces()),
-                        [&](const tbb::blocked_range<int>& r) {
-        Worker& w = WorkerForThread();
-        for (int f = r.begin(); f != r.end(); ++f) {
-          if (!HasSurface(f) || f > failed_face.load(std::memory_order_relaxed)) continue;
-          bool ok = true;
-          w.walker.Walk(
-              f, [&](int face, int corners, const int* vertices, const int* ptex, const float* uv) {
+      tbb::parallel_for(
+          tbb::blocked_range<int>(0, s.num_base_faces()), [&](const tbb::blocked_range<int>& r) {
+            Worker& w = WorkerForThread();
+            for (int f = r.begin(); f != r.end(); ++f) {
+              if (!HasSurface(f) || f > failed_face.load(std::memory_order_relaxed)) continue;
+              bool ok = true;
+              w.walker.Walk(f, [&](int face, int corners, const int* vertices, const int* ptex,
+                                   const float* uv) {
                 for (int m = 0; m < corners && ok; ++m) {
                   if (owner[vertices[m]] != face) continue;
                   const std::int32_t v = new_vertex[vertices[m]];
@@ -457,8 +461,8 @@ struct Refinement {
                   for (int k = 0; k < 8; ++k) out.face_uvs[8 * nf + k] = uv[k];
                 }
               });
-        }
-      });
+            }
+          });
     });
     if (failed_face.load() != std::numeric_limits<int>::max()) {
       return Status::Error(
@@ -482,7 +486,8 @@ struct Refinement {
       if (!keep[f]) continue;
       const std::size_t begin = LeafOffset(f);
       const std::size_t end = levels == 0 ? leaf_offsets[f + 1] : begin + 4;
-      for (std::size_t i = begin; i < end; ++i) leaf_vertices[write++] = new_vertex[leaf_vertices[i]];
+      for (std::size_t i = begin; i < end; ++i)
+        leaf_vertices[write++] = new_vertex[leaf_vertices[i]];
       mesh.face_offsets.push_back(static_cast<std::uint32_t>(write));
     }
     leaf_vertices.resize(write);

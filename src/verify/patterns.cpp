@@ -24,7 +24,9 @@ struct Wave {
   double weight;
 };
 
-double Dot(const double d[3], const double p[3]) { return d[0] * p[0] + d[1] * p[1] + d[2] * p[2]; }
+double Dot(const double d[3], const double p[3]) {
+  return d[0] * p[0] + d[1] * p[1] + d[2] * p[2];
+}
 
 double Smooth(const double p[3], double diagonal) {
   static const double d1[3] = {0.6, 0.64, 0.48}, d2[3] = {-0.48, 0.6, 0.64},
@@ -65,19 +67,25 @@ const std::array<Wave, 24>& NoiseWaves(std::uint32_t seed, double edge) {
 
 std::string_view PatternName(Pattern pattern) {
   switch (pattern) {
-    case Pattern::kSmooth: return "smooth";
-    case Pattern::kDetail: return "detail";
-    case Pattern::kRidges: return "ridges";
-    case Pattern::kNoise: return "noise";
-    case Pattern::kNone: return "none";
-    case Pattern::kImage: return "image";
+    case Pattern::kSmooth:
+      return "smooth";
+    case Pattern::kDetail:
+      return "detail";
+    case Pattern::kRidges:
+      return "ridges";
+    case Pattern::kNoise:
+      return "noise";
+    case Pattern::kNone:
+      return "none";
+    case Pattern::kImage:
+      return "image";
   }
   return "smooth";
 }
 
 StatusOr<Pattern> ParsePattern(std::string_view name) {
-  for (Pattern p : {Pattern::kSmooth, Pattern::kDetail, Pattern::kRidges, Pattern::kNoise,
-                    Pattern::kNone}) {
+  for (Pattern p :
+       {Pattern::kSmooth, Pattern::kDetail, Pattern::kRidges, Pattern::kNoise, Pattern::kNone}) {
     if (name == PatternName(p)) return p;
   }
   if (name == "image") {
@@ -108,7 +116,8 @@ double EvaluatePattern(Pattern pattern, const PatternFrame& f, const float point
                        double(point[2]) - f.center[2]};
   const double D = f.diagonal, A = f.amplitude;
   switch (pattern) {
-    case Pattern::kSmooth: return A * Smooth(p, D);
+    case Pattern::kSmooth:
+      return A * Smooth(p, D);
     case Pattern::kDetail: {
       // Two balls of fine bumps, fading out smoothly over their outer third.
       static const double axis[3] = {0.8, 0.36, 0.48};
@@ -142,8 +151,10 @@ double EvaluatePattern(Pattern pattern, const PatternFrame& f, const float point
       }
       return A * h;
     }
-    case Pattern::kNone: return 0;
-    case Pattern::kImage: return std::numeric_limits<double>::quiet_NaN();
+    case Pattern::kNone:
+      return 0;
+    case Pattern::kImage:
+      return std::numeric_limits<double>::quiet_NaN();
   }
   return 0;
 }

@@ -23,9 +23,9 @@
 #include "core/system.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
+#include "dispex/ptex_sampler.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
-#include "dispex/ptex_sampler.h"
 
 namespace dispex {
 
@@ -195,8 +195,9 @@ std::vector<PtexFaceInfo> MapFacesOnSurface(const LimitSurface& surface, const P
     const PtexAdjacency& adjacency = surface.adjacency(PtexFaceId(f));
     for (int e = 0; e < 4; ++e) {
       info.adjfaces[std::size_t(e)] = adjacency.faces[std::size_t(e)].value;
-      info.adjedges[std::size_t(e)] =
-          adjacency.faces[std::size_t(e)].valid() ? std::uint8_t(adjacency.edges[std::size_t(e)]) : 0;
+      info.adjedges[std::size_t(e)] = adjacency.faces[std::size_t(e)].valid()
+                                          ? std::uint8_t(adjacency.edges[std::size_t(e)])
+                                          : 0;
     }
   }
   return faces;
@@ -228,8 +229,8 @@ Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFil
     for (float x : texels[f]) {
       if (!std::isfinite(x)) {
         return error.Record(static_cast<int>(f),
-                         Status::Error(fmt::format("{}: face {} holds a value that is not finite",
-                                                   map.name(), f)));
+                            Status::Error(fmt::format(
+                                "{}: face {} holds a value that is not finite", map.name(), f)));
       }
     }
   });
@@ -238,9 +239,10 @@ Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFil
   if (const PtexMetaItem* listed = map.FindMetaData("dispex:discontinuous_faces")) {
     for (std::int32_t f : listed->AsInt32()) {
       if (f < 0 || static_cast<std::size_t>(f) >= faces.size()) {
-        return Status::Error(fmt::format("{}: dispex:discontinuous_faces names face {}, not one of "
-                                         "its {} faces",
-                                         map.name(), f, faces.size()));
+        return Status::Error(
+            fmt::format("{}: dispex:discontinuous_faces names face {}, not one of "
+                        "its {} faces",
+                        map.name(), f, faces.size()));
       }
       if (!holes[static_cast<std::size_t>(f)]) discontinuous[static_cast<std::size_t>(f)] = 1;
       skip[static_cast<std::size_t>(f)] = 1;
@@ -267,10 +269,10 @@ Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFil
   }
   const double tau = options.tolerance > 0 ? options.tolerance : r.map_tolerance;
   if ((options.max_edge_step > 0 || options.max_edge_step_p99 > 0) && !(tau > 0)) {
-    return Status::Error(fmt::format(
-        "{}: the edge-step bounds are in tolerances, and the map carries none (no "
-        "dispex:statistics): give the tolerance",
-        map.name()));
+    return Status::Error(
+        fmt::format("{}: the edge-step bounds are in tolerances, and the map carries none (no "
+                    "dispex:statistics): give the tolerance",
+                    map.name()));
   }
   r.edge_tolerance = tau;
   r.edge_max_limit = options.max_edge_step * tau;
@@ -311,7 +313,8 @@ void EdgeThresholds(VerifyReport& r, const VerifyOptions& options) {
 StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   Stopwatch clock;
   if (options.samples_per_face < 0 || options.samples_per_face > 512) {
-    return Status::Error(fmt::format("samples_per_face = {}: must be 0..512", options.samples_per_face));
+    return Status::Error(
+        fmt::format("samples_per_face = {}: must be 0..512", options.samples_per_face));
   }
   std::optional<tbb::global_control> limit;
   if (options.threads > 0) {
@@ -611,10 +614,11 @@ std::string VerifyReportSummary(const VerifyReport& r) {
       }
       return fmt::format("  {:<12} p99 {:.4g}  max {:.4g}{}\n", what, s.p99, s.max, tolerances);
     };
-    out += fmt::format("  edge steps on {} shared edges ({} points; not measured: {} on sharp "
-                       "creases, {} beside faces the map lists as discontinuous):\n",
-                       r.edges - r.crease_edges - r.discontinuous_edges, r.edge_per_face.count,
-                       r.crease_edges, r.discontinuous_edges);
+    out += fmt::format(
+        "  edge steps on {} shared edges ({} points; not measured: {} on sharp "
+        "creases, {} beside faces the map lists as discontinuous):\n",
+        r.edges - r.crease_edges - r.discontinuous_edges, r.edge_per_face.count, r.crease_edges,
+        r.discontinuous_edges);
     out += line("per-face", r.edge_per_face);
     out += line("across-faces", r.edge_across_faces);
     if (!r.worst_edges.empty()) {

@@ -14,8 +14,8 @@ namespace dispex {
 namespace {
 
 using testing::DataPath;
-using testing::SculptOptions;
 using testing::RunDispex;
+using testing::SculptOptions;
 using testing::TempDir;
 namespace fs = std::filesystem;
 
@@ -136,10 +136,9 @@ TEST_F(BadInput, ZeroOrNegativeValuesOfPositiveOptions) {
   ExpectFailure(make + "--amplitude -0.1", "--amplitude", 2);
   ExpectFailure(make + "--levels 0", "--levels", 2);
   const std::string render = "render " + cage_ + " -o " + (dir_ / "r.png") + " ";
-  for (const char* option : {"--density 0", "--min-density 0", "--max-density 0",
-                             "--supersample 0", "--ao -1", "--ao-distance 0"}) {
-    ExpectFailure(render + option, std::string(option).substr(0, std::string(option).find(' ')),
-                  2);
+  for (const char* option : {"--density 0", "--min-density 0", "--max-density 0", "--supersample 0",
+                             "--ao -1", "--ao-distance 0"}) {
+    ExpectFailure(render + option, std::string(option).substr(0, std::string(option).find(' ')), 2);
   }
   const std::string preview = "preview " + map + " -o " + (dir_ / "p.png") + " ";
   ExpectFailure(preview + "--tile 0", "--tile", 2);
@@ -167,9 +166,9 @@ TEST_F(BadInput, SculptCoveringHalfTheBaseIsRefused) {
   out.close();
   ExpectFailure(Extract(cage_, dir_ / "half.obj"), "more than the limit of 5%");
   // The limit is an option: raised, the same extraction succeeds and reports the fraction.
-  auto r = RunDispex(Extract(cage_, dir_ / "half.obj",
-                             "--max-miss-fraction 1 -q --report " + (dir_ / "r.json")),
-                     dir_);
+  auto r = RunDispex(
+      Extract(cage_, dir_ / "half.obj", "--max-miss-fraction 1 -q --report " + (dir_ / "r.json")),
+      dir_);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir_ / "out.ptx"));
   std::ifstream report(dir_ / "r.json");

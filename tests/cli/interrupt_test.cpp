@@ -36,8 +36,8 @@ TEST(Interrupt, SignalsStopExtractionCleanly) {
   int interrupted = 0, finished = 0, handled = 0;
   for (int trial = 0; trial < 12; ++trial) {
     std::ofstream(target) << old_content;
-    std::vector<std::string> args = {DISPEX_EXE, "extract", cage, make.output_path, "-o",
-                                     target, "--oversample", "128", "-q"};
+    std::vector<std::string> args = {
+        DISPEX_EXE, "extract", cage, make.output_path, "-o", target, "--oversample", "128", "-q"};
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);

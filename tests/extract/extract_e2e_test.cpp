@@ -2,18 +2,17 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "dispex/extract.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
-#include "subdiv_ptex_faces.h"
 #include "dispex/verify.h"
 #include "e2e_support.h"
+#include "subdiv_ptex_faces.h"
 
 namespace dispex {
 namespace {

@@ -18,7 +18,9 @@ ExtractOptions Valid() {
   return o;
 }
 
-TEST(ExtractOptions, DefaultsWithPathsAreValid) { EXPECT_TRUE(ValidateExtractOptions(Valid()).ok()); }
+TEST(ExtractOptions, DefaultsWithPathsAreValid) {
+  EXPECT_TRUE(ValidateExtractOptions(Valid()).ok());
+}
 
 TEST(ExtractOptions, MessagesNameTheFieldNotAFlag) {
   const struct {
@@ -32,7 +34,9 @@ TEST(ExtractOptions, MessagesNameTheFieldNotAFlag) {
       {"tolerance = -1", [](ExtractOptions& o) { o.tolerance = -1; }},
       {"tolerance_fraction = 0", [](ExtractOptions& o) { o.tolerance_fraction = 0; }},
       {"search_distance = 0",
-       [](ExtractOptions& o) { o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0}; }},
+       [](ExtractOptions& o) {
+         o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0};
+       }},
       {"data_type", [](ExtractOptions& o) { o.data_type = PtexDataType::kUint8; }},
       {"max_miss_fraction = 2", [](ExtractOptions& o) { o.max_miss_fraction = 2; }},
       {"threads = -1", [](ExtractOptions& o) { o.threads = -1; }},

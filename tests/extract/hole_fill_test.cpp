@@ -91,10 +91,10 @@ TEST(EdgeMeans, AveragesEachEdge) {
 TEST(FillEmptyFaces, FillsChainsInRoundsAndReportsIslands) {
   // Faces 0-1-2-3 in a row (edge 1 of each touches edge 3 of the next); face 4 isolated.
   // Face 0 has data; 1 and 2 missed entirely; 3 has data; 4 missed.
-  std::vector<std::int32_t> adj = {-1, 1, -1, -1,  //
-                                   -1, 2, -1, 0,   //
-                                   -1, 3, -1, 1,   //
-                                   -1, -1, -1, 2,  //
+  std::vector<std::int32_t> adj = {-1, 1,  -1, -1,  //
+                                   -1, 2,  -1, 0,   //
+                                   -1, 3,  -1, 1,   //
+                                   -1, -1, -1, 2,   //
                                    -1, -1, -1, -1};
   std::vector<std::int8_t> edges = {0, 3, 0, 0, 0, 3, 0, 1, 0, 3, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0};
   std::vector<std::uint8_t> filled = {1, 0, 0, 1, 0};

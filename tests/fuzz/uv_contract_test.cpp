@@ -8,8 +8,8 @@
 #include <string>
 #include <utility>
 
-#include "dispex/mesh.h"
 #include "contract_meshes.h"
+#include "dispex/mesh.h"
 #include "fuzz/reader_contract.h"
 
 namespace dispex {
@@ -17,7 +17,9 @@ namespace {
 
 using fuzz_test::TexturedTriangle;
 
-std::string Check(const Mesh& mesh) { return fuzz::CheckMesh(mesh, mesh.source); }
+std::string Check(const Mesh& mesh) {
+  return fuzz::CheckMesh(mesh, mesh.source);
+}
 
 // The check fails, and for a reason that names the UVs.
 ::testing::AssertionResult CaughtAsUvProblem(const Mesh& mesh) {

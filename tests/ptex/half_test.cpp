@@ -28,9 +28,8 @@ std::uint16_t OracleFromFloat(float f) {
   const double a = std::fabs(static_cast<double>(f));
   const double at = OracleToFloat(magnitude);
   // The other neighbour of |f|, on the far side of the rounded value.
-  const double other =
-      a > at ? (magnitude + 1 < 0x7c00 ? OracleToFloat(magnitude + 1) : 65536.0)
-             : (magnitude > 0 ? OracleToFloat(magnitude - 1) : 0.0);
+  const double other = a > at ? (magnitude + 1 < 0x7c00 ? OracleToFloat(magnitude + 1) : 65536.0)
+                              : (magnitude > 0 ? OracleToFloat(magnitude - 1) : 0.0);
   const bool tie = a != at && std::fabs(a - at) == std::fabs(a - other);
   if (!tie || other < at) return even;
   return static_cast<std::uint16_t>((even & 0x8000) | (magnitude + 1));
@@ -60,16 +59,16 @@ TEST(PtexHalf, KnownValues) {
   EXPECT_EQ(FloatToHalf(std::ldexp(1.0f, -14)), 0x0400);  // smallest normal
   EXPECT_EQ(FloatToHalf(std::ldexp(1.0f, -24)), 0x0001);  // smallest subnormal
   // Ties round away from zero (IEEE's ties-to-even would give the first of each pair).
-  EXPECT_EQ(FloatToHalf(std::ldexp(1.0f, -25)), 0x0001);   // tie between 0 and 1
+  EXPECT_EQ(FloatToHalf(std::ldexp(1.0f, -25)), 0x0001);  // tie between 0 and 1
   EXPECT_EQ(FloatToHalf(-std::ldexp(1.0f, -25)), 0x8001);
-  EXPECT_EQ(FloatToHalf(std::ldexp(3.0f, -25)), 0x0002);   // tie between 1 and 2
-  EXPECT_EQ(FloatToHalf(std::ldexp(5.0f, -25)), 0x0003);   // tie between 2 and 3
+  EXPECT_EQ(FloatToHalf(std::ldexp(3.0f, -25)), 0x0002);  // tie between 1 and 2
+  EXPECT_EQ(FloatToHalf(std::ldexp(5.0f, -25)), 0x0003);  // tie between 2 and 3
   EXPECT_EQ(FloatToHalf(std::ldexp(1.0f, -25) * 0.9999999f), 0x0000);
-  EXPECT_EQ(FloatToHalf(1.0f + std::ldexp(1.0f, -11)), 0x3c01);       // tie: up
-  EXPECT_EQ(FloatToHalf(-1.0f - std::ldexp(1.0f, -11)), 0xbc01);      // tie: away from zero
-  EXPECT_EQ(FloatToHalf(1.0f + 3 * std::ldexp(1.0f, -11)), 0x3c02);   // tie: up
-  EXPECT_EQ(FloatToHalf(std::ldexp(2047.0f, -25)), 0x0400);  // tie: up into the normals
-  EXPECT_EQ(FloatToHalf(2049.0f), 0x6801);                    // 2048 | 2050: up
+  EXPECT_EQ(FloatToHalf(1.0f + std::ldexp(1.0f, -11)), 0x3c01);      // tie: up
+  EXPECT_EQ(FloatToHalf(-1.0f - std::ldexp(1.0f, -11)), 0xbc01);     // tie: away from zero
+  EXPECT_EQ(FloatToHalf(1.0f + 3 * std::ldexp(1.0f, -11)), 0x3c02);  // tie: up
+  EXPECT_EQ(FloatToHalf(std::ldexp(2047.0f, -25)), 0x0400);          // tie: up into the normals
+  EXPECT_EQ(FloatToHalf(2049.0f), 0x6801);                           // 2048 | 2050: up
   EXPECT_EQ(FloatToHalf(1e-8f), 0x0000);
   EXPECT_TRUE(IsNanHalf(FloatToHalf(std::numeric_limits<float>::quiet_NaN())));
   EXPECT_TRUE(IsNanHalf(FloatToHalf(std::bit_cast<float>(0x7f800001u))));  // signalling NaN

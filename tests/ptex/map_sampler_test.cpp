@@ -77,7 +77,9 @@ Grid MakeGrid(int n, const std::vector<int>& turn, const std::vector<std::array<
   return g;
 }
 
-double Linear(double x, double y) { return 0.25 * x - 0.5 * y + 2; }
+double Linear(double x, double y) {
+  return 0.25 * x - 0.5 * y + 2;
+}
 
 // Inside the grid (every face the kernel reaches exists and every vertex is regular) the
 // filter reproduces a linear function exactly, at any point of the centre faces, their edges
@@ -176,9 +178,9 @@ std::vector<PtexFaceInfo> FacesOf(const LimitSurface& surface, std::mt19937* rng
 // quads or two sub-faces of equal resolution, or a quad and the sub-faces one level below it,
 // the two sides of an edge read the same value.
 TEST(PtexMapSampler, RealCagesAreContinuousBetweenEqualResolutions) {
-  for (const char* cage : {"meshes/opensubdiv/catmark_fan.obj",
-                           "meshes/keenan_spot/spot_control_mesh.obj",
-                           "meshes/opensubdiv/catmark_car.obj"}) {
+  for (const char* cage :
+       {"meshes/opensubdiv/catmark_fan.obj", "meshes/keenan_spot/spot_control_mesh.obj",
+        "meshes/opensubdiv/catmark_car.obj"}) {
     SCOPED_TRACE(cage);
     auto mesh = ReadMesh(std::string(DISPEX_TEST_DATA_DIR) + "/" + cage);
     ASSERT_TRUE(mesh.ok()) << mesh.status().message();

@@ -234,7 +234,8 @@ struct Config {
   PtexMeshType mesh;
 };
 void PrintTo(const Config& c, std::ostream* os) {
-  *os << PtexDataTypeName(c.type) << " x" << c.channels << " alpha " << c.alpha << " " << PtexMeshTypeName(c.mesh);
+  *os << PtexDataTypeName(c.type) << " x" << c.channels << " alpha " << c.alpha << " "
+      << PtexMeshTypeName(c.mesh);
 }
 
 class PtexRoundTrip : public ::testing::TestWithParam<Config> {};

@@ -5,6 +5,8 @@
 // edges identified as Vtr does (Vtr::Level::completeTopologyFromFaceVertices, see BuildEdges), and
 // an edge has a neighbour only when exactly two face corners use it. subdiv_faces_test compares
 // the result with OpenSubdiv itself on every cage in tests/data/meshes.
+#include "subdiv_ptex_faces.h"
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -12,8 +14,6 @@
 #include <unordered_map>
 #include <utility>
 #include <vector>
-
-#include "subdiv_ptex_faces.h"
 
 namespace dispex {
 

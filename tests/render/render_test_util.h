@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "../extract/e2e_support.h"
 #include "dispex/ptex.h"
 #include "dispex/render.h"
-#include "../extract/e2e_support.h"
 
 namespace dispex::render_test {
 

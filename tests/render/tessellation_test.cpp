@@ -306,9 +306,9 @@ std::size_t DistinctPositions(const Mesh& mesh) {
 // though every face has its own copies of the shared points.
 TEST(TessellationPerFace, SameSurfaceAsTheMeanWhereFacesAgree) {
   TempDir dir;
-  for (const char* name : {"meshes/opensubdiv/catmark_cube.obj",
-                           "meshes/opensubdiv/catmark_pyramid.obj",
-                           "meshes/opensubdiv/catmark_fan.obj"}) {
+  for (const char* name :
+       {"meshes/opensubdiv/catmark_cube.obj", "meshes/opensubdiv/catmark_pyramid.obj",
+        "meshes/opensubdiv/catmark_fan.obj"}) {
     for (int seed : {0, 2}) {
       SCOPED_TRACE(std::string(name) + " seed " + std::to_string(seed));
       const CageAndSurface c = LoadCage(DataPath(name));

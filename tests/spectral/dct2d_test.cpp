@@ -12,8 +12,8 @@
 
 #include "dct_reference.h"
 #include "dispex/spectral.h"
-#include "spectral/analyzer_steps.h"
 #include "spectral/aligned_buffer.h"
+#include "spectral/analyzer_steps.h"
 
 namespace dispex::spectral {
 namespace {

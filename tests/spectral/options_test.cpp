@@ -24,15 +24,15 @@ TEST(SpectralOptionsTest, ErrorsNameTheFieldAndValue) {
             "tolerance = nan: must be finite and >= 0 (object units)");
   o = {};
   o.nonzero_threshold = -0.5;
-  EXPECT_EQ(ValidateSpectralOptions(o).message(), "nonzero_threshold = -0.5: must be finite and >= 0");
+  EXPECT_EQ(ValidateSpectralOptions(o).message(),
+            "nonzero_threshold = -0.5: must be finite and >= 0");
   o = {};
   o.fixed_vlog2 = 12;
   EXPECT_EQ(ValidateSpectralOptions(o).message(),
             "fixed_ulog2 x fixed_vlog2 = 6 x 12: 12 is outside 0..9");
   o = {};
   o.rule = static_cast<ResolutionRule>(7);
-  EXPECT_EQ(ValidateSpectralOptions(o).message(),
-            "rule = 7: not one of bound, nonzero, fixed");
+  EXPECT_EQ(ValidateSpectralOptions(o).message(), "rule = 7: not one of bound, nonzero, fixed");
 }
 
 TEST(SpectralOptionsTest, RuleNamesRoundTrip) {

@@ -119,10 +119,11 @@ TEST(RandomBlocksTest, BoundHoldsForTheBandLimitedSeries) {
     if (face->constant) continue;
     const std::vector<float> texels(face->texels.begin(), face->texels.end());
     std::vector<float> series(block.size());
-    ASSERT_TRUE(spectral::AnalyzerSteps::Resample(analyzer, texels, 1 << face->ulog2, 1 << face->vlog2,
-                              std::countr_zero(static_cast<unsigned>(d.nx)),
-                              std::countr_zero(static_cast<unsigned>(d.ny)), series)
-                    .ok());
+    ASSERT_TRUE(
+        spectral::AnalyzerSteps::Resample(analyzer, texels, 1 << face->ulog2, 1 << face->vlog2,
+                                          std::countr_zero(static_cast<unsigned>(d.nx)),
+                                          std::countr_zero(static_cast<unsigned>(d.ny)), series)
+            .ok());
     double worst = 0;
     for (std::size_t k = 0; k < block.size(); ++k) {
       worst = std::max(worst, std::fabs(double(series[k]) - block[k]));

@@ -115,7 +115,9 @@ TEST(ResolutionTest, VerificationStepsUpUntilTheReadBackIsWithinTolerance) {
   // The texels are the DCT-domain resampling at the final resolution, and the bound's own
   // choice did fail the read-back check.
   std::vector<float> again(texels.size());
-  ASSERT_TRUE(spectral::AnalyzerSteps::Resample(analyzer, block, 64, 64, face->ulog2, face->vlog2, again).ok());
+  ASSERT_TRUE(
+      spectral::AnalyzerSteps::Resample(analyzer, block, 64, 64, face->ulog2, face->vlog2, again)
+          .ok());
   EXPECT_EQ(again, texels);
   std::vector<float> bound_choice(32);
   ASSERT_TRUE(spectral::AnalyzerSteps::Resample(analyzer, block, 64, 64, 3, 2, bound_choice).ok());

@@ -36,7 +36,8 @@ void WriteMap(const std::string& cage, const std::string& out, Fill fill) {
     const PtexAdjacency& a = surface->adjacency(PtexFaceId(f));
     for (int e = 0; e < 4; ++e) {
       info.adjfaces[std::size_t(e)] = a.faces[std::size_t(e)].value;
-      info.adjedges[std::size_t(e)] = a.faces[std::size_t(e)].valid() ? std::uint8_t(a.edges[std::size_t(e)]) : 0;
+      info.adjedges[std::size_t(e)] =
+          a.faces[std::size_t(e)].valid() ? std::uint8_t(a.edges[std::size_t(e)]) : 0;
     }
     std::vector<float> texels = fill(f, info);
     ASSERT_TRUE(writer->SetFace(PtexFaceId(f), info, texels).ok());
