@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# make test-tsan: the TBB pipeline under ThreadSanitizer. A small sculpt is made, extracted and
-# verified at 4 threads (more than this machine's cores, so tasks interleave) with the dispex
+# make test-tsan: the TBB pipeline under ThreadSanitizer. A small sculpt is made, extracted (with
+# watertight edges for the filter, then for both readers) and verified at 4 threads (more than this machine's cores, so tasks interleave) with the dispex
 # binary of a -DDISPEX_TSAN=ON build, loading a libtbb built with TSan
 # (scripts/build-tsan-tbb.sh) so that TBB's own hand-offs between threads are seen; any data
 # race reported fails the run (scripts/tsan-suppressions.txt lists the one known report from
@@ -24,4 +24,7 @@ cage="$root/tests/data/meshes/keenan_spot/spot_control_mesh.obj"
   --report "$work/report.json"
 "$dispex" verify "$cage" "$work/sculpt.obj" "$work/map.ptx" --truth "$work/sculpt.obj.truth" \
   --threads 4 -q
-echo "tsan-extract: make-sculpt, extract and verify at 4 threads ran without a data race"
+# Watertight edges for both readers: faces re-extracted in rounds, edges measured in parallel.
+"$dispex" extract "$cage" "$work/sculpt.obj" -o "$work/all.ptx" --watertight all --threads 4 -q
+"$dispex" verify "$cage" "$work/all.ptx" --threads 4 -q
+echo "tsan-extract: make-sculpt, extract (filter and all) and verify at 4 threads ran without a data race"
