@@ -27,7 +27,7 @@ bool Discontinuous(const FaceStats& stats) {
 struct MapView {
   std::vector<PtexFaceInfo> faces;
   std::vector<std::vector<float>> texels;
-  std::vector<std::uint8_t> skip_faces;  // holes, and faces that missed entirely
+  std::vector<std::uint8_t> skip_faces;  // holes, and faces whose data may jump
 };
 
 // Moves the kept texels into the view (ReturnTexels moves them back).
