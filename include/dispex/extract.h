@@ -16,6 +16,7 @@
 #include "dispex/ptex.h"
 #include "dispex/spectral.h"
 #include "dispex/status.h"
+#include "dispex/subdiv.h"
 #include "dispex/trace.h"
 
 namespace dispex {
@@ -34,8 +35,8 @@ StatusOr<HolePolicy> ParseHolePolicy(std::string_view name);
 // "Watertight edges"), except at edges where the displacement itself jumps.
 enum class WatertightEdges : std::uint8_t {
   // The reference Ptex filter across faces (what renderers built on the Ptex library read):
-  // resolutions raised where neighbours of different resolution would step. Costs a few
-  // percent of texels (docs/BENCHMARKS.md).
+  // resolutions raised where neighbours of different resolution would step. Costs under 1%
+  // of the texels on the maps measured (docs/BENCHMARKS.md).
   kFilter,
   // Also per-face bilinear reading (readers that do not filter across faces): edge texels
   // pinned to the edge and resolutions raised until faces read on their own meet. Costs
@@ -92,6 +93,13 @@ struct ExtractOptions {
   // (bytes; 0: the memory the machine has available). See EstimateExtractMemory.
   std::uint64_t max_memory = 0;
 };
+
+// The face table of every map of `surface`, taken from the limit surface (OpenSubdiv's Ptex
+// numbering and adjacency are the one source of both, so a map's faces are the faces that
+// were sampled): one PtexFaceInfo per Ptex face with neighbours and shared edges as
+// Far::PtexIndices gives them (-1 / 0 where there is none), `subface` for the quads an n-gon
+// is split into, resolution 1x1 (each face's own is set when it is written).
+std::vector<PtexFaceInfo> PtexFaceTable(const LimitSurface& surface);
 
 // Checks ranges and combinations; the message names the option.
 Status ValidateExtractOptions(const ExtractOptions& options);

@@ -176,7 +176,6 @@ Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
   ReturnTexels(view, faces);
 
   for (std::size_t f = 0; f < n; ++f) report.edge_raised_faces += raised[f];
-  ListDiscontinuousFaces(inputs, faces, report);
   for (const auto& [key, s] : current) {
     report.edge_step_per_face = std::max(report.edge_step_per_face, s.per_face);
     report.edge_step_across_faces = std::max(report.edge_step_across_faces, s.across_faces);

@@ -15,10 +15,12 @@ namespace dispex::extract {
 // settings.edge_step_budget, raise the resolution that causes it -- through the cross-face
 // filter the coarser side (along the edge first, then across), for per-face reading
 // (WatertightEdges::kAll) both sides across the edge -- and run ProcessFace again for the
-// raised faces. An edge whose step twice fell by less than a quarter after a raise, or whose
-// faces are already at their sample resolution, is left as it is and counted. Edges on
-// infinitely sharp creases and next to faces that missed entirely are not held. Fills the
-// report's edge fields. Deterministic: decisions depend only on the texels.
+// raised faces (round by round, measuring again only the edges of the faces raised). An edge
+// whose step twice fell by less than a quarter after a raise, or whose faces are at their
+// finest sampling (settings.max_samples_log2), is left as it is and counted. Edges on
+// infinitely sharp creases and beside faces whose data may jump (ListDiscontinuousFaces) are
+// not held. Fills the report's edge fields but the discontinuous ones. Deterministic:
+// decisions depend only on the texels.
 Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
                   ProcessedFaces& faces, ExtractReport& report);
 

@@ -74,9 +74,8 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
   if (settings.watertight != WatertightEdges::kOff) {
     DISPEX_RETURN_IF_ERROR(MatchEdges(inputs, settings, faces, report));
     DISPEX_RETURN_IF_ERROR(WriteKeptFaces(writer, inputs, faces));
-  } else {
-    ListDiscontinuousFaces(inputs, faces, report);
   }
+  ListDiscontinuousFaces(inputs, faces, report);
   report.t_sample_trace = faces_clock.seconds();
 
   DISPEX_RETURN_IF_ERROR(AddFaceTotals(options, inputs, settings, faces, report));

@@ -11,7 +11,6 @@
 #include "dispex/cancel.h"
 #include "extract/memory_check.h"
 #include "extract/parallel_errors.h"
-#include "extract/ptex_face_table.h"
 
 namespace dispex::extract {
 

@@ -1,6 +1,6 @@
-#include "extract/ptex_face_table.h"
+#include "dispex/extract.h"
 
-namespace dispex::extract {
+namespace dispex {
 
 std::vector<PtexFaceInfo> PtexFaceTable(const LimitSurface& surface) {
   std::vector<PtexFaceInfo> faces(static_cast<std::size_t>(surface.num_ptex_faces()));
@@ -17,4 +17,4 @@ std::vector<PtexFaceInfo> PtexFaceTable(const LimitSurface& surface) {
   return faces;
 }
 
-}  // namespace dispex::extract
+}  // namespace dispex

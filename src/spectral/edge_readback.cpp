@@ -25,44 +25,58 @@ double Extrapolate(double s0, double s1, bool have_s1) {
   return have_s1 ? 1.5 * s0 - 0.5 * s1 : s0;
 }
 
+// The displacement on a face's edges and corners, extrapolated from its samples.
+class EdgeValues {
+ public:
+  EdgeValues(const float* samples, const BlockShape& shape)
+      : samples_(samples), nx_(shape.nx), ny_(shape.ny) {}
+  // Beyond sample column i at the bottom (v = 0) / top edge, beyond row j at the left / right.
+  double Bottom(int i) const { return Across(i, 0, 0, 1); }
+  double Top(int i) const { return Across(i, ny_ - 1, 0, -1); }
+  double Left(int j) const { return Across(0, j, 1, 0); }
+  double Right(int j) const { return Across(nx_ - 1, j, -1, 0); }
+  // At corner (ci, cj), 1 being the far side: extrapolated along u, then along v.
+  double Corner(int ci, int cj) const {
+    const int i0 = ci ? nx_ - 1 : 0, di = ci ? -1 : 1;
+    const int j0 = cj ? ny_ - 1 : 0, dj = cj ? -1 : 1;
+    return Extrapolate(Across(i0, j0, di, 0), ny_ > 1 ? Across(i0, j0 + dj, di, 0) : 0, ny_ > 1);
+  }
+
+ private:
+  double At(int i, int j) const { return samples_[std::ptrdiff_t(j) * nx_ + i]; }
+  // Beyond sample (i, j), the next one inward being (i + di, j + dj) when the block has it.
+  double Across(int i, int j, int di, int dj) const {
+    const bool have = di ? nx_ > 1 : ny_ > 1;
+    return Extrapolate(At(i, j), have ? At(i + di, j + dj) : 0, have);
+  }
+  const float* samples_;
+  int nx_, ny_;
+};
+
 }  // namespace
 
 double MaxEdgeReadError(const float* texels, const BlockShape& res, const float* samples,
                         const BlockShape& shape) {
   const int nx = shape.nx, ny = shape.ny, rx = res.nx, ry = res.ny;
-  const std::ptrdiff_t row = nx;
+  const EdgeValues edge(samples, shape);
   double worst = 0;
   for (int i = 0; i < nx; ++i) {  // bottom (v = 0) and top (v = 1) edges
     const double x = (i + 0.5) / nx;
     const double bottom = ReadAlong(texels, 1, rx, x);
     const double top = ReadAlong(texels + std::ptrdiff_t(ry - 1) * rx, 1, rx, x);
-    const double at_bottom = Extrapolate(samples[i], ny > 1 ? samples[row + i] : 0, ny > 1);
-    const double at_top =
-        Extrapolate(samples[std::ptrdiff_t(ny - 1) * row + i],
-                    ny > 1 ? samples[std::ptrdiff_t(ny - 2) * row + i] : 0, ny > 1);
-    worst = std::max({worst, std::fabs(bottom - at_bottom), std::fabs(top - at_top)});
+    worst = std::max({worst, std::fabs(bottom - edge.Bottom(i)), std::fabs(top - edge.Top(i))});
   }
   for (int j = 0; j < ny; ++j) {  // left (u = 0) and right (u = 1) edges
     const double y = (j + 0.5) / ny;
     const double left = ReadAlong(texels, rx, ry, y);
     const double right = ReadAlong(texels + (rx - 1), rx, ry, y);
-    const float* s = samples + std::ptrdiff_t(j) * row;
-    const double at_left = Extrapolate(s[0], nx > 1 ? s[1] : 0, nx > 1);
-    const double at_right = Extrapolate(s[nx - 1], nx > 1 ? s[nx - 2] : 0, nx > 1);
-    worst = std::max({worst, std::fabs(left - at_left), std::fabs(right - at_right)});
+    worst = std::max({worst, std::fabs(left - edge.Left(j)), std::fabs(right - edge.Right(j))});
   }
   // The corners: the corner texel, against the samples extrapolated both ways.
   for (int cj : {0, 1}) {
     for (int ci : {0, 1}) {
-      const int i0 = ci ? nx - 1 : 0, i1 = ci ? nx - 2 : 1;
-      const int j0 = cj ? ny - 1 : 0, j1 = cj ? ny - 2 : 1;
-      auto at = [&](int i, int j) { return double(samples[std::ptrdiff_t(j) * row + i]); };
-      auto edge_value = [&](int j) {
-        return Extrapolate(at(i0, j), nx > 1 ? at(i1, j) : 0, nx > 1);
-      };
-      const double corner = Extrapolate(edge_value(j0), ny > 1 ? edge_value(j1) : 0, ny > 1);
       const double texel = texels[std::ptrdiff_t(cj ? ry - 1 : 0) * rx + (ci ? rx - 1 : 0)];
-      worst = std::max(worst, std::fabs(texel - corner));
+      worst = std::max(worst, std::fabs(texel - edge.Corner(ci, cj)));
     }
   }
   return worst;
@@ -71,22 +85,14 @@ double MaxEdgeReadError(const float* texels, const BlockShape& res, const float*
 void PinEdgeTexels(float* texels, const BlockShape& res, const float* samples,
                    const BlockShape& shape) {
   const int nx = shape.nx, ny = shape.ny, rx = res.nx, ry = res.ny;
-  const std::ptrdiff_t row = nx;
-  auto at = [&](int i, int j) { return double(samples[std::ptrdiff_t(j) * row + i]); };
-  // The edge value beyond sample (i, j) at the bottom / top / left / right.
-  auto bottom = [&](int i) { return Extrapolate(at(i, 0), ny > 1 ? at(i, 1) : 0, ny > 1); };
-  auto top = [&](int i) { return Extrapolate(at(i, ny - 1), ny > 1 ? at(i, ny - 2) : 0, ny > 1); };
-  auto left = [&](int j) { return Extrapolate(at(0, j), nx > 1 ? at(1, j) : 0, nx > 1); };
-  auto right = [&](int j) {
-    return Extrapolate(at(nx - 1, j), nx > 1 ? at(nx - 2, j) : 0, nx > 1);
-  };
+  const EdgeValues edge(samples, shape);
   auto texel = [&](int i, int j) -> float& { return texels[std::ptrdiff_t(j) * rx + i]; };
   const bool rows = ry >= 2 && ry < ny, columns = rx >= 2 && rx < nx;
   if (rows) {
     const int span = nx / rx;
     for (int i = 0; i < rx; ++i) {
       double b = 0, t = 0;
-      for (int k = i * span; k < (i + 1) * span; ++k) b += bottom(k), t += top(k);
+      for (int k = i * span; k < (i + 1) * span; ++k) b += edge.Bottom(k), t += edge.Top(k);
       texel(i, 0) = static_cast<float>(b / span);
       texel(i, ry - 1) = static_cast<float>(t / span);
     }
@@ -95,20 +101,14 @@ void PinEdgeTexels(float* texels, const BlockShape& res, const float* samples,
     const int span = ny / ry;
     for (int j = 0; j < ry; ++j) {
       double l = 0, r = 0;
-      for (int k = j * span; k < (j + 1) * span; ++k) l += left(k), r += right(k);
+      for (int k = j * span; k < (j + 1) * span; ++k) l += edge.Left(k), r += edge.Right(k);
       texel(0, j) = static_cast<float>(l / span);
       texel(rx - 1, j) = static_cast<float>(r / span);
     }
   }
   if (rows && columns) {
     for (int cj : {0, 1}) {
-      for (int ci : {0, 1}) {
-        const int i0 = ci ? nx - 1 : 0, i1 = ci ? nx - 2 : 1;
-        const int j0 = cj ? ny - 1 : 0, j1 = cj ? ny - 2 : 1;
-        auto edge_value = [&](int j) { return Extrapolate(at(i0, j), at(i1, j), true); };
-        texel(ci ? rx - 1 : 0, cj ? ry - 1 : 0) =
-            static_cast<float>(Extrapolate(edge_value(j0), edge_value(j1), true));
-      }
+      for (int ci : {0, 1}) texel(ci ? rx - 1 : 0, cj ? ry - 1 : 0) = float(edge.Corner(ci, cj));
     }
   }
 }

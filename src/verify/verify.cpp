@@ -21,6 +21,7 @@
 
 #include "core/first_error.h"
 #include "core/system.h"
+#include "dispex/extract.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
 #include "dispex/ptex_sampler.h"
@@ -185,20 +186,11 @@ void RmsThreshold(VerifyReport& r, const char* what, const ErrorStats& s, double
 // The map's face table for the sampler: resolutions from the map, adjacency and sub-face
 // flags from the base's limit surface (the map's own adjacency is not trusted).
 std::vector<PtexFaceInfo> MapFacesOnSurface(const LimitSurface& surface, const PtexFile& map) {
-  std::vector<PtexFaceInfo> faces(static_cast<std::size_t>(surface.num_ptex_faces()));
-  for (int f = 0; f < surface.num_ptex_faces(); ++f) {
-    const PtexFaceInfo& stored = map.face_info(PtexFaceId(f));
-    PtexFaceInfo& info = faces[std::size_t(f)];
-    info.ulog2 = stored.ulog2;
-    info.vlog2 = stored.vlog2;
-    info.subface = surface.num_ptex_faces(surface.base_face(PtexFaceId(f))) != 1;
-    const PtexAdjacency& adjacency = surface.adjacency(PtexFaceId(f));
-    for (int e = 0; e < 4; ++e) {
-      info.adjfaces[std::size_t(e)] = adjacency.faces[std::size_t(e)].value;
-      info.adjedges[std::size_t(e)] = adjacency.faces[std::size_t(e)].valid()
-                                          ? std::uint8_t(adjacency.edges[std::size_t(e)])
-                                          : 0;
-    }
+  std::vector<PtexFaceInfo> faces = PtexFaceTable(surface);
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    const PtexFaceInfo& stored = map.face_info(PtexFaceId(static_cast<int>(f)));
+    faces[f].ulog2 = stored.ulog2;
+    faces[f].vlog2 = stored.vlog2;
   }
   return faces;
 }

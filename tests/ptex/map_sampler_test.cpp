@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "dispex/extract.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex_sampler.h"
 #include "dispex/subdiv.h"
@@ -156,16 +157,10 @@ TEST(PtexMapSampler, MixedResolutionsKeepConstantsConstant) {
   }
 }
 
+// The cage's face table with every face at a random level (rng) or at level 3, sub-faces at 2.
 std::vector<PtexFaceInfo> FacesOf(const LimitSurface& surface, std::mt19937* rng) {
-  std::vector<PtexFaceInfo> faces(std::size_t(surface.num_ptex_faces()));
-  for (int f = 0; f < surface.num_ptex_faces(); ++f) {
-    const PtexAdjacency& a = surface.adjacency(PtexFaceId(f));
-    PtexFaceInfo& info = faces[std::size_t(f)];
-    info.subface = surface.num_ptex_faces(surface.base_face(PtexFaceId(f))) != 1;
-    for (int e = 0; e < 4; ++e) {
-      info.adjfaces[std::size_t(e)] = a.faces[std::size_t(e)].value;
-      info.adjedges[std::size_t(e)] = std::uint8_t(a.edges[std::size_t(e)]);
-    }
+  std::vector<PtexFaceInfo> faces = PtexFaceTable(surface);
+  for (PtexFaceInfo& info : faces) {
     // A sub-face is a quarter of a quad to the filter: at one level less they match.
     const int level = rng ? int((*rng)() % 4) : info.subface ? 2 : 3;
     info.ulog2 = info.vlog2 = std::int8_t(level);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "../extract/e2e_support.h"
+#include "dispex/extract.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
 #include "dispex/subdiv.h"
@@ -21,7 +22,7 @@ using testing::DataPath;
 constexpr double kTau = 1e-3;
 
 // Writes a map of the cage with every face from `fill(face, info)`: info's resolution is set by
-// fill, adjacency comes from the limit surface.
+// fill, adjacency comes from the limit surface (PtexFaceTable).
 template <class Fill>
 void WriteMap(const std::string& cage, const std::string& out, Fill fill) {
   auto mesh = ReadMesh(cage);
@@ -30,15 +31,9 @@ void WriteMap(const std::string& cage, const std::string& out, Fill fill) {
   ASSERT_TRUE(surface.ok()) << surface.status().message();
   auto writer = PtexWriter::Create(out, PtexWriterOptions{}, surface->num_ptex_faces());
   ASSERT_TRUE(writer.ok()) << writer.status().message();
+  const std::vector<PtexFaceInfo> table = PtexFaceTable(*surface);
   for (int f = 0; f < surface->num_ptex_faces(); ++f) {
-    PtexFaceInfo info;
-    info.subface = surface->num_ptex_faces(surface->base_face(PtexFaceId(f))) != 1;
-    const PtexAdjacency& a = surface->adjacency(PtexFaceId(f));
-    for (int e = 0; e < 4; ++e) {
-      info.adjfaces[std::size_t(e)] = a.faces[std::size_t(e)].value;
-      info.adjedges[std::size_t(e)] =
-          a.faces[std::size_t(e)].valid() ? std::uint8_t(a.edges[std::size_t(e)]) : 0;
-    }
+    PtexFaceInfo info = table[std::size_t(f)];
     std::vector<float> texels = fill(f, info);
     ASSERT_TRUE(writer->SetFace(PtexFaceId(f), info, texels).ok());
   }
