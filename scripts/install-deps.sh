@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config git
   libosd-dev libembree-dev libtbb-dev
-  libdeflate-dev zlib1g-dev libfftw3-dev
+  libdeflate-dev zlib1g-dev libfftw3-dev libxxhash-dev
   libfast-float-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libpng-dev libgtest-dev libgmock-dev libbenchmark-dev
 )

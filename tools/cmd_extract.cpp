@@ -247,6 +247,10 @@ void SetupExtract(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-memory", args->max_memory,
                   "refuse work estimated to need more memory than this (e.g. 8G; default: the "
                   "memory available)");
+  cmd->add_flag("--incremental", o.incremental,
+                "re-use the map at the output path: left as it is when made from the same "
+                "inputs and options, else only the faces whose inputs changed are extracted "
+                "(the result is the file a full extraction writes)");
   cmd->add_option("--report", args->report_path, "write a JSON report to this file");
   cmd->add_option("--preview", args->preview_dir,
                   "also write DIR/<map>_atlas.png and DIR/<map>_compare.png (base and base + "

@@ -92,6 +92,13 @@ struct ExtractOptions {
   // Refuse, before the work starts, an extraction estimated to need more memory than this
   // (bytes; 0: the memory the machine has available). See EstimateExtractMemory.
   std::uint64_t max_memory = 0;
+
+  // Re-use the map already at output_path (docs/INCREMENTAL.md): when the inputs and options
+  // are those it was made from, it is left as it is (not rewritten); otherwise only the faces
+  // whose key changed are extracted again and the others copied from it. The result is the
+  // same file a full extraction writes. A map that is missing, unreadable, or written by
+  // another version is not re-used (a warning says why).
+  bool incremental = false;
 };
 
 // The face table of every map of `surface`, taken from the limit surface (OpenSubdiv's Ptex
@@ -178,6 +185,16 @@ struct ExtractReport {
   // Largest over held edges; per face only with WatertightEdges::kAll (0 otherwise).
   double edge_step_per_face = 0, edge_step_across_faces = 0;
   double displacement_min = 0, displacement_max = 0, displacement_rms = 0;
+
+  // Incremental extraction (ExtractOptions::incremental).
+  std::string inputs_key;  // of the inputs and options: the map stores it as dispex:inputs_key
+  bool unchanged = false;  // the map was made from the same inputs and options: not rewritten
+  std::int64_t faces_copied = 0;     // from the previous map
+  std::int64_t faces_extracted = 0;  // Ptex faces with a surface that were not copied
+  // Why faces were extracted again: "no previous map", the previous map's notice, or what
+  // changed ("base, sculpt, options: tolerance").
+  std::string redo_reason;
+  double t_keys = 0;  // computing the face keys, seconds
 
   // Output.
   std::uint64_t bytes_written = 0;

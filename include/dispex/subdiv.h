@@ -130,6 +130,21 @@ class LimitSurface {
   std::unique_ptr<Impl> impl_;
 };
 
+// What the limit surface over each base face is made from: a 128-bit key (two halves of
+// XXH3-128) of the positions of the vertices of the faces around its corners (the
+// Catmull-Clark one-ring) in the ring's own numbering, the ring's topology, the sharpness of
+// its edges and vertices, boundaries, non-manifold edges and holes, and the surface's global
+// options (scheme options, resolved approximation levels, evaluation path); and the bounding
+// box of the ring's vertices, which holds the face's limit surface (limit points are convex
+// combinations of them). Equal keys on two surfaces with the same Ptex numbering mean the same
+// limit surface over that face: incremental extraction re-uses a face's texels when its key,
+// among others, is unchanged.
+struct BaseFacePatch {
+  std::array<std::uint64_t, 2> key{};
+  Float3 lower, upper;
+};
+std::vector<BaseFacePatch> BaseFacePatches(const LimitSurface& surface);
+
 // Counters of one evaluator, for reports and benchmarks.
 struct LimitEvaluatorStats {
   std::int64_t faces = 0;          // Ptex faces evaluated

@@ -6,15 +6,19 @@
 #include <algorithm>
 #include <optional>
 
-#include "core/content_hash.h"
 #include "core/system.h"
 #include "dispex/cancel.h"
+#include "extract/face_keys.h"
 #include "extract/memory_check.h"
 #include "extract/parallel_errors.h"
 
 namespace dispex::extract {
 
 namespace {
+
+std::string Fingerprint(const Mesh& mesh) {
+  return "xxh3-128:" + MeshContentKey(mesh).Hex();
+}
 
 struct MeshesRead {
   Mesh base;
@@ -27,7 +31,6 @@ StatusOr<MeshesRead> ReadMeshes(const ExtractOptions& options, ExtractReport& re
   ReadOptions read_options;
   read_options.threads = options.threads;
   std::optional<StatusOr<Mesh>> sculpt_read;
-  StatusOr<std::string> sculpt_fingerprint = Status::Error("not computed");
   std::optional<StatusOr<Mesh>> base_read;
   std::optional<StatusOr<LimitSurface>> surface_built;
   {
@@ -36,7 +39,7 @@ StatusOr<MeshesRead> ReadMeshes(const ExtractOptions& options, ExtractReport& re
       Stopwatch clock;
       sculpt_read.emplace(ReadMesh(options.sculpt_path, read_options));
       report.t_read_sculpt = clock.seconds();
-      if (sculpt_read->ok()) sculpt_fingerprint = FileFingerprint(options.sculpt_path);
+      if (sculpt_read->ok()) report.sculpt_fingerprint = Fingerprint(sculpt_read->value());
     });
     Stopwatch clock;
     base_read.emplace(ReadMesh(options.base_path, read_options));
@@ -52,8 +55,7 @@ StatusOr<MeshesRead> ReadMeshes(const ExtractOptions& options, ExtractReport& re
   if (!surface_built->ok()) return surface_built->status();
   if (!sculpt_read->ok()) return sculpt_read->status();
   if (CancelRequested()) return Cancelled();
-  DISPEX_ASSIGN_OR_RETURN(report.base_fingerprint, FileFingerprint(options.base_path));
-  DISPEX_ASSIGN_OR_RETURN(report.sculpt_fingerprint, std::move(sculpt_fingerprint));
+  report.base_fingerprint = Fingerprint(base_read->value());
   return MeshesRead{std::move(*base_read).value(), std::move(*sculpt_read).value(),
                     std::move(*surface_built).value()};
 }
@@ -90,26 +92,27 @@ Status CheckMemoryForInputs(const ExtractOptions& options, const MeshesRead& mes
 
 }  // namespace
 
-StatusOr<ExtractInputs> LoadInputs(const ExtractOptions& options, std::uint64_t memory_limit,
+StatusOr<ExtractInputs> ReadInputs(const ExtractOptions& options, std::uint64_t memory_limit,
                                    ExtractReport& report) {
   DISPEX_RETURN_IF_ERROR(CheckMemoryBeforeReading(options, memory_limit));
   DISPEX_ASSIGN_OR_RETURN(MeshesRead meshes, ReadMeshes(options, report));
   ReportMeshes(options, meshes, report);
   DISPEX_RETURN_IF_ERROR(CheckMemoryForInputs(options, meshes, memory_limit));
+  std::vector<PtexFaceInfo> faces = PtexFaceTable(meshes.surface);
+  return ExtractInputs{std::move(meshes.base), std::move(meshes.sculpt), std::move(meshes.surface),
+                       std::move(faces), nullptr};
+}
 
+Status BuildTracer(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report) {
   Stopwatch clock;
   TracerOptions tracer_options;
   tracer_options.quality = options.bvh_quality;
   tracer_options.isa = options.embree_isa;
-  DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer,
-                          MakeEmbreeTracer(meshes.sculpt, tracer_options));
+  DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, tracer_options));
   report.t_bvh = clock.seconds();
-  report.tracer = tracer->stats().backend;
+  report.tracer = inputs.tracer->stats().backend;
   if (CancelRequested()) return Cancelled();
-
-  std::vector<PtexFaceInfo> faces = PtexFaceTable(meshes.surface);
-  return ExtractInputs{std::move(meshes.base), std::move(meshes.sculpt), std::move(meshes.surface),
-                       std::move(faces), std::move(tracer)};
+  return Status::Ok();
 }
 
 }  // namespace dispex::extract

@@ -23,10 +23,13 @@ struct ExtractInputs {
 };
 
 // Reads the sculpt while the base is read and its limit surface built, fingerprints both
-// files, checks the estimated memory against `memory_limit` (bytes; 0: no check) before
-// reading and again once the sculpt's size is known, and builds the BVH. Fills the report's
-// input counts, fingerprints, timings and warnings.
-StatusOr<ExtractInputs> LoadInputs(const ExtractOptions& options, std::uint64_t memory_limit,
+// meshes (MeshContentKey), and checks the estimated memory against `memory_limit` (bytes; 0:
+// no check) before reading and again once the sculpt's size is known. Fills the report's
+// input counts, fingerprints, timings and warnings. The tracer is left to BuildTracer.
+StatusOr<ExtractInputs> ReadInputs(const ExtractOptions& options, std::uint64_t memory_limit,
                                    ExtractReport& report);
+
+// The sculpt's BVH.
+Status BuildTracer(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report);
 
 }  // namespace dispex::extract

@@ -4,6 +4,8 @@
 
 #include <filesystem>
 
+#include "extract/face_records.h"
+
 namespace dispex::extract {
 
 namespace {
@@ -115,7 +117,19 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
   return j;
 }
 
-Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractReport& report) {
+Hash128 InputsKey(const ExtractReport& report) {
+  Hasher h;
+  h.Add(std::string_view(report.version));
+  h.Add(std::string_view(ExtractOptionsJson(report.options).dump()));
+  h.Add(std::string_view(report.base_fingerprint)).Add(std::string_view(report.sculpt_fingerprint));
+  h.Add(std::string_view(FileName(report.base_path)));
+  h.Add(std::string_view(FileName(report.sculpt_path)));
+  return h.Digest();
+}
+
+Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractReport& report,
+                          std::span<const Hash128> face_keys, std::span<const FaceStats> first_pass,
+                          std::span<const EdgeMeans> edge_means) {
   DISPEX_RETURN_IF_ERROR(AddMeshMetaData(writer, base));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:version", report.version));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:base", FileName(report.base_path)));
@@ -134,7 +148,11 @@ Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractRep
     DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
         "dispex:discontinuous_faces", std::span<const std::int32_t>(report.discontinuous_faces)));
   }
-  return Status::Ok();
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData(kInputsKeyMetaKey, report.inputs_key));
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
+      kFaceKeysMetaKey, std::span<const std::int8_t>(EncodeFaceKeys(face_keys))));
+  return writer.AddMetaData(
+      kFaceRecordsMetaKey, std::span<const std::int8_t>(EncodeFaceRecords(first_pass, edge_means)));
 }
 
 }  // namespace dispex::extract

@@ -5,9 +5,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/hash128.h"
 #include "dispex/extract.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
+#include "extract/face_pipeline.h"
 
 namespace dispex::extract {
 
@@ -19,8 +21,16 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& report);
 // Adds the standard mesh meta data (PtexFaceVertCounts, ...) and dispex's own keys:
 // dispex:version, dispex:base, dispex:base_fingerprint, dispex:sculpt,
 // dispex:sculpt_fingerprint, dispex:options (JSON), dispex:statistics (JSON),
-// dispex:tolerance, dispex:search_distance, and dispex:discontinuous_faces (int32 Ptex face
-// ids whose data may jump at their edges; when there are any).
-Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractReport& report);
+// dispex:tolerance, dispex:search_distance, dispex:discontinuous_faces (int32 Ptex face
+// ids whose data may jump at their edges; when there are any), and what an incremental
+// extraction re-uses: dispex:inputs_key, dispex:face_keys (16 bytes per face) and
+// dispex:face_records_v1 (each face's first pass).
+Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractReport& report,
+                          std::span<const Hash128> face_keys, std::span<const FaceStats> first_pass,
+                          std::span<const EdgeMeans> edge_means);
+
+// The key of everything the map is made from: version, options, both meshes' content and the
+// names the meta data records.
+Hash128 InputsKey(const ExtractReport& report);
 
 }  // namespace dispex::extract

@@ -13,6 +13,13 @@ std::string ExtractReportJson(const ExtractReport& r) {
                  {"sculpt", r.sculpt_path},
                  {"sculpt_fingerprint", r.sculpt_fingerprint}};
   j["output"] = {{"path", r.output_path}, {"bytes", r.bytes_written}};
+  j["inputs_key"] = r.inputs_key;
+  if (r.options.incremental) {
+    j["incremental"] = {{"unchanged", r.unchanged},
+                        {"faces_copied", r.faces_copied},
+                        {"faces_extracted", r.faces_extracted},
+                        {"redo_reason", r.redo_reason}};
+  }
   j["options"] = extract::ExtractOptionsJson(r.options);
   j["threads"] = r.threads;
   j["statistics"] = extract::ExtractStatisticsJson(r);
@@ -28,10 +35,15 @@ std::string ExtractReportJson(const ExtractReport& r) {
                             {"floored", e.floored},
                             {"capped", e.capped}};
   }
-  j["phases_seconds"] = {{"read_base", r.t_read_base},  {"read_sculpt", r.t_read_sculpt},
-                         {"topology", r.t_topology},    {"bvh", r.t_bvh},
-                         {"auto_settings", r.t_search}, {"sample_trace", r.t_sample_trace},
-                         {"write", r.t_write},          {"total", r.t_total}};
+  j["phases_seconds"] = {{"read_base", r.t_read_base},
+                         {"read_sculpt", r.t_read_sculpt},
+                         {"topology", r.t_topology},
+                         {"bvh", r.t_bvh},
+                         {"auto_settings", r.t_search},
+                         {"face_keys", r.t_keys},
+                         {"sample_trace", r.t_sample_trace},
+                         {"write", r.t_write},
+                         {"total", r.t_total}};
   j["cpu_seconds"] = {{"limit", r.cpu_limit},
                       {"trace", r.cpu_trace},
                       {"spectral", r.cpu_spectral},
@@ -46,6 +58,16 @@ std::string ExtractReportJson(const ExtractReport& r) {
 std::string ExtractReportSummary(const ExtractReport& r) {
   const SpectralTotals& s = r.spectral;
   std::string out;
+  if (r.unchanged) {
+    return fmt::format(
+        "dispex: {} is up to date (made from the same inputs and options): not rewritten, "
+        "{:.2f}s\n",
+        r.output_path, r.t_total);
+  }
+  if (r.options.incremental) {
+    out += fmt::format("dispex: incremental: {} faces copied, {} extracted ({})\n", r.faces_copied,
+                       r.faces_extracted, r.redo_reason);
+  }
   out += fmt::format("dispex: {} ({} Ptex faces) <- {} ({} faces)\n", r.output_path, r.ptex_faces,
                      r.sculpt_path, r.sculpt_faces);
   out += fmt::format("  tolerance {:.4g}{}  search distance {:.4g}{}\n", r.tolerance,

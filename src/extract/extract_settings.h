@@ -3,6 +3,7 @@
 #pragma once
 
 #include "dispex/extract.h"
+#include "dispex/ptex.h"
 #include "dispex/spectral.h"
 #include "dispex/trace.h"
 #include "extract/extract_inputs.h"
@@ -19,6 +20,7 @@ struct ExtractSettings {
   NormalQuery retry_query;
   SpectralOptions spectral;  // resolution rule and the resolved tolerance
   HolePolicy holes = HolePolicy::kFill;
+  PtexDataType data_type = PtexDataType::kFloat;  // kept texels are rounded to it
   // Watertight edges (kOff unless the rule is kErrorBound), and the largest step MatchEdges
   // lets a shared edge keep: the tolerance.
   WatertightEdges watertight = WatertightEdges::kOff;

@@ -73,6 +73,8 @@ StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
   FaceResult result;
   if (inputs.surface.is_hole(face)) return result;
   FaceStats& r = result.stats;
+  const std::uint64_t rays_before = w.counters.rays_cast;
+  const std::int64_t fallbacks_before = w.evaluator.stats().fallback_normals;
   // A least resolution beyond the planned samples takes as many samples.
   const int n = 1 << std::max<int>({settings.plan.log2[static_cast<std::size_t>(face.value)],
                                     least_log2[0], least_log2[1]});
@@ -90,6 +92,9 @@ StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
   step.Reset();
   r.recovered = TraceSamples(*inputs.tracer, settings, count, w);
   w.cpu_trace += step.seconds();
+  r.rays = static_cast<std::int64_t>(w.counters.rays_cast - rays_before);
+  r.fallback_normals =
+      static_cast<std::int32_t>(w.evaluator.stats().fallback_normals - fallbacks_before);
   TakeDistances(count, w, r);
 
   if (r.misses > 0) {

@@ -30,6 +30,8 @@ struct FaceStats {
   double sum_squares = 0;
   SpectralFaceStats spectral;
   std::int8_t ulog2 = 0, vlog2 = 0;
+  std::int64_t rays = 0;              // cast for this face
+  std::int32_t fallback_normals = 0;  // LimitEvaluatorStats::fallback_normals of this face
 };
 
 struct FaceResult {

@@ -7,6 +7,7 @@
 #include "core/progress.h"
 #include "core/system.h"
 #include "extract/parallel_errors.h"
+#include "extract/previous_map.h"
 
 namespace dispex::extract {
 
@@ -36,19 +37,24 @@ Status WriteFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFaceId fac
                            : writer.SetFace(face, info, analysed.texels);
 }
 
-void AddWorkers(const tbb::enumerable_thread_specific<FaceScratch>& scratches,
-                WorkerTotals& totals) {
+void AddCpuTimes(const tbb::enumerable_thread_specific<FaceScratch>& scratches,
+                 WorkerTotals& totals) {
   for (const FaceScratch& w : scratches) {
-    totals.rays_cast += w.counters.rays_cast;
     totals.cpu_limit += w.cpu_limit;
     totals.cpu_trace += w.cpu_trace;
     totals.cpu_spectral += w.cpu_spectral;
     totals.cpu_write += w.cpu_write;
-    totals.fallback_normals += w.evaluator.stats().fallback_normals;
   }
 }
 
-KeptFace Keep(const FaceResult& result) {
+// Kept texels hold what the map will store, so that the edges are measured on it and a face
+// read back from the map is kept exactly as it was.
+void RoundToDataType(PtexDataType type, std::vector<float>& texels) {
+  if (type != PtexDataType::kHalf) return;
+  for (float& t : texels) t = HalfToFloat(FloatToHalf(t));
+}
+
+KeptFace Keep(const FaceResult& result, PtexDataType type) {
   KeptFace kept;
   switch (result.kind) {
     case FaceResult::Kind::kAllMissed:
@@ -60,6 +66,7 @@ KeptFace Keep(const FaceResult& result) {
       kept.ulog2 = static_cast<std::int8_t>(result.analysed.ulog2);
       kept.vlog2 = static_cast<std::int8_t>(result.analysed.vlog2);
       kept.texels.assign(result.analysed.texels.begin(), result.analysed.texels.end());
+      RoundToDataType(type, kept.texels);
       break;
   }
   kept.kept = true;
@@ -95,6 +102,7 @@ Status WriteConstantFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFa
 }
 
 StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
+                                      const PreviousMap* previous, std::span<const Hash128> keys,
                                       bool progress, PtexWriter& writer) {
   const int num_faces = inputs.surface.num_ptex_faces();
   const bool keep = settings.watertight != WatertightEdges::kOff;
@@ -102,17 +110,39 @@ StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const Extract
   out.stats.resize(static_cast<std::size_t>(num_faces));
   out.edge_means.resize(static_cast<std::size_t>(num_faces));
   if (keep) out.kept.resize(static_cast<std::size_t>(num_faces));
+  std::vector<std::uint8_t> copied(static_cast<std::size_t>(num_faces), 0);
   tbb::enumerable_thread_specific<FaceScratch> scratches(
       [&] { return FaceScratch(inputs.surface); });
   Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", progress);
 
-  auto process = [&](PtexFaceId face, FaceScratch& w) -> Status {
-    DISPEX_ASSIGN_OR_RETURN(FaceResult result, ProcessFace(face, inputs, settings, w));
+  // The face's first pass as the previous map holds it.
+  auto copy = [&](PtexFaceId face) -> Status {
     const auto f = static_cast<std::size_t>(face.value);
+    const FaceRecord& record = previous->record(f);
+    out.stats[f] = record.stats;
+    out.edge_means[f] = record.edge_means;
+    copied[f] = 1;
+    if (record.stats.all_missed) return Status::Ok();
+    KeptFace kept;
+    DISPEX_RETURN_IF_ERROR(previous->ReadTexels(f, kept));
+    if (keep) {
+      out.kept[f] = std::move(kept);
+      return Status::Ok();
+    }
+    const PtexFaceInfo info = FaceInfo(inputs, face, kept.ulog2, kept.vlog2);
+    return kept.texels.size() == 1 ? writer.SetConstantFace(face, info, {kept.texels.data(), 1})
+                                   : writer.SetFace(face, info, kept.texels);
+  };
+  auto process = [&](PtexFaceId face, FaceScratch& w) -> Status {
+    const auto f = static_cast<std::size_t>(face.value);
+    if (previous != nullptr && !inputs.surface.is_hole(face) && previous->Reusable(f, keys[f])) {
+      return copy(face);
+    }
+    DISPEX_ASSIGN_OR_RETURN(FaceResult result, ProcessFace(face, inputs, settings, w));
     out.stats[f] = result.stats;
     out.edge_means[f] = result.edge_means;
     if (keep) {
-      out.kept[f] = Keep(result);
+      out.kept[f] = Keep(result, settings.data_type);
       return Status::Ok();
     }
     ThreadCpuStopwatch step;
@@ -124,7 +154,13 @@ StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const Extract
       num_faces, [](int k) { return k; }, scratches, &bar, process);
   bar.Finish();
   DISPEX_RETURN_IF_ERROR(status);
-  AddWorkers(scratches, out.workers);
+  AddCpuTimes(scratches, out.workers);
+  for (std::size_t f = 0; f < out.stats.size(); ++f) {
+    out.workers.rays_cast += static_cast<std::uint64_t>(out.stats[f].rays);
+    out.workers.fallback_normals += out.stats[f].fallback_normals;
+    out.faces_copied += copied[f];
+  }
+  out.first_pass = out.stats;
   return out;
 }
 
@@ -138,15 +174,18 @@ Status ReprocessFaces(const ExtractInputs& inputs, const ExtractSettings& settin
     DISPEX_ASSIGN_OR_RETURN(FaceResult result,
                             ProcessFace(face, inputs, settings, w, least_log2[f]));
     processed.stats[f] = result.stats;
-    processed.kept[f] = Keep(result);
+    processed.kept[f] = Keep(result, settings.data_type);
     return Status::Ok();
   };
   DISPEX_RETURN_IF_ERROR(ForEachFace(
       static_cast<int>(faces.size()), [&](int k) { return faces[static_cast<std::size_t>(k)]; },
       scratches, nullptr, process));
   WorkerTotals extra;
-  AddWorkers(scratches, extra);
-  processed.workers.rays_cast += extra.rays_cast;
+  AddCpuTimes(scratches, extra);
+  for (int f : faces) {
+    processed.workers.rays_cast +=
+        static_cast<std::uint64_t>(processed.stats[static_cast<std::size_t>(f)].rays);
+  }
   processed.workers.cpu_limit += extra.cpu_limit;
   processed.workers.cpu_trace += extra.cpu_trace;
   processed.workers.cpu_spectral += extra.cpu_spectral;

@@ -7,6 +7,7 @@
 #include <span>
 #include <vector>
 
+#include "core/hash128.h"
 #include "dispex/ptex.h"
 #include "extract/extract_inputs.h"
 #include "extract/extract_settings.h"
@@ -30,15 +31,22 @@ struct KeptFace {
 
 struct ProcessedFaces {
   std::vector<FaceStats> stats;       // per Ptex face
+  std::vector<FaceStats> first_pass;  // per Ptex face, before edges raised any (the map keeps it)
   std::vector<EdgeMeans> edge_means;  // per Ptex face
   std::vector<KeptFace> kept;         // per Ptex face, when settings.watertight is on
   WorkerTotals workers;
+  std::int64_t faces_copied = 0;  // taken from the previous map
 };
 
-// Every face through ProcessFace, in parallel. Each face is written to the map as soon as it
-// is done, or, with watertight edges, kept for MatchEdges and WriteKeptFaces. On an error, the
-// error of the lowest face id (whatever the scheduling), or the cancellation.
+class PreviousMap;
+
+// Every face through ProcessFace, in parallel, except those `previous` (may be null) holds
+// with the same key (`keys`, per Ptex face), whose first pass is copied from it. Each face is
+// written to the map as soon as it is done, or, with watertight edges, kept for MatchEdges and
+// WriteKeptFaces. On an error, the error of the lowest face id (whatever the scheduling), or
+// the cancellation.
 StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
+                                      const PreviousMap* previous, std::span<const Hash128> keys,
                                       bool progress, PtexWriter& writer);
 
 // Runs ProcessFace again for `faces` with their least resolutions (`least_log2`, per Ptex

@@ -1,0 +1,28 @@
+// What each Ptex face's first pass (ProcessFace with no least resolution) is made from, as a
+// key: incremental extraction re-uses a face whose key is unchanged.
+#pragma once
+
+#include <vector>
+
+#include "core/hash128.h"
+#include "extract/extract_inputs.h"
+#include "extract/extract_settings.h"
+
+namespace dispex::extract {
+
+// Everything a mesh as read holds that can change a map: positions, faces, subdivision tags
+// (not its groups, UVs or file name).
+Hash128 MeshContentKey(const Mesh& mesh);
+
+// The settings every face's first pass reads (distances, spectral options, holes, data type,
+// watertight mode, sampling caps) and the version of the pipeline.
+Hash128 SettingsKey(const ExtractSettings& settings);
+
+// Per Ptex face: SettingsKey, the face's limit patch (BaseFacePatches) and sub-face, its
+// planned samples, and every sculpt face its rays can reach: those whose bounding box meets
+// the face's reach box (the patch's box grown by the longest search distance and a margin),
+// as an order-free sum of each sculpt face's key (its corners' positions, in order). The
+// keys do not depend on the thread count.
+std::vector<Hash128> ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings);
+
+}  // namespace dispex::extract

@@ -1,0 +1,35 @@
+// What each face's first pass produced (its statistics and edge means), as stored in a map's
+// meta data so that an incremental extraction can re-use the face without re-extracting it.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "core/hash128.h"
+#include "extract/face_pipeline.h"
+
+namespace dispex::extract {
+
+inline constexpr const char* kFaceKeysMetaKey = "dispex:face_keys";
+inline constexpr const char* kFaceRecordsMetaKey = "dispex:face_records_v1";
+inline constexpr const char* kInputsKeyMetaKey = "dispex:inputs_key";
+
+struct FaceRecord {
+  FaceStats stats;
+  EdgeMeans edge_means;
+};
+
+// Little-endian, fixed size per face.
+std::vector<std::int8_t> EncodeFaceRecords(std::span<const FaceStats> stats,
+                                           std::span<const EdgeMeans> edge_means);
+// nullopt when the bytes do not hold `num_faces` records.
+std::optional<std::vector<FaceRecord>> DecodeFaceRecords(std::span<const std::uint8_t> bytes,
+                                                         std::size_t num_faces);
+
+std::vector<std::int8_t> EncodeFaceKeys(std::span<const Hash128> keys);
+std::optional<std::vector<Hash128>> DecodeFaceKeys(std::span<const std::uint8_t> bytes,
+                                                   std::size_t num_faces);
+
+}  // namespace dispex::extract

@@ -1,0 +1,43 @@
+// The map an earlier extraction left at the output path, read for what an incremental
+// extraction can re-use: its inputs key, and per face the key, the first-pass record and the
+// texels.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/hash128.h"
+#include "dispex/ptex.h"
+#include "extract/face_records.h"
+#include "extract/process_faces.h"
+
+namespace dispex::extract {
+
+class PreviousMap {
+ public:
+  // Never fails: a missing file re-uses nothing and leaves notice() empty; a map that cannot be
+  // read, was not written by this version of dispex, or has another number of faces re-uses
+  // nothing, and notice() says why in one line.
+  static PreviousMap Open(const std::string& path, std::size_t num_faces);
+
+  bool usable() const { return file_.has_value(); }
+  const std::string& notice() const { return notice_; }
+  // The previous map's meta data string for `key` ("" when absent or unusable).
+  std::string MetaString(const std::string& key) const;
+
+  // True when face f's key is `key` and its stored texels are what its first pass wrote (the
+  // watertight edges did not raise its resolution afterwards).
+  bool Reusable(std::size_t f, const Hash128& key) const;
+  const FaceRecord& record(std::size_t f) const { return records_[f]; }
+  // The face's texels as KeptFace holds them (one value for a constant face).
+  Status ReadTexels(std::size_t f, KeptFace& out) const;
+
+ private:
+  std::optional<PtexFile> file_;
+  std::vector<Hash128> keys_;
+  std::vector<FaceRecord> records_;
+  std::string notice_;
+};
+
+}  // namespace dispex::extract
