@@ -176,6 +176,9 @@ struct TracerStats {
   std::size_t copied_bytes = 0;         // bytes dispex copied from the mesh (0 when all shared)
   bool shared_vertices = false;         // Embree reads mesh.positions in place
   bool shared_indices = false;          // Embree reads mesh.face_indices in place
+  // The power of two at or above the largest |coordinate| of the scene's bounds: the rounding
+  // margins and sideways steps of the queries scale with it, so hits depend on it in rare cases.
+  float scale = 0;
 };
 
 // ---- The tracer ----------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-// Content hashes that identify input files in a map's meta data and reports.
+// CRC-32 checksums (shape file names).
 #pragma once
 
 #include <cstddef>
@@ -12,8 +12,5 @@ namespace dispex {
 
 // CRC-32 (IEEE, as zlib computes it) of the bytes, via libdeflate's accelerated routine.
 std::uint32_t Crc32(std::string_view bytes);
-
-// "crc32:1a2b3c4d size:12345" for a file, read through a memory map.
-StatusOr<std::string> FileFingerprint(const std::string& path);
 
 }  // namespace dispex

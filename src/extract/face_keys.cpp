@@ -231,7 +231,9 @@ std::vector<Hash128> ComputeFaceKeys(const ExtractInputs& inputs, const ExtractS
   std::vector<std::uint8_t> skip(num_faces);
   for (std::size_t f = 0; f < num_faces; ++f) skip[f] = surface.is_hole(PtexFaceId(int(f)));
   const std::vector<Hash128> sculpt = SculptReachKeys(inputs.sculpt, boxes, skip);
-  const Hash128 settings_key = SettingsKey(settings);
+  Hasher global;
+  global.Add(SettingsKey(settings)).Add(inputs.tracer->stats().scale);
+  const Hash128 settings_key = global.Digest();
 
   std::vector<Hash128> keys(num_faces);
   tbb::parallel_for(std::size_t{0}, num_faces, [&](std::size_t f) {

@@ -1,0 +1,275 @@
+// Incremental extraction (docs/INCREMENTAL.md): after every edit of a sequence -- local moves
+// of sculpt vertices, a locally re-meshed sculpt, a moved base vertex, a crease, an option --
+// the incremental map must be byte-identical to a full extraction of the same inputs, while
+// re-extracting only part of the faces for local edits. A stale face (one copied although its
+// inputs changed) makes the byte comparison fail; a key that changes for every edit makes the
+// "part of the faces" checks fail.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include "dispex/extract.h"
+#include "dispex/mesh.h"
+#include "dispex/ptex.h"
+#include "e2e_support.h"
+
+namespace dispex {
+namespace {
+
+using testing::DataPath;
+using testing::Slurp;
+using testing::TempDir;
+
+struct Variant {
+  const char* name;
+  const char* cage;  // under tests/data/meshes
+  int levels;
+  PtexDataType data_type;
+  WatertightEdges watertight;
+  // The automatic search distance depends on the whole sculpt and base (a percentile of sparse
+  // distances, to 4 bits): an edit that moves it re-extracts every face. Given, local edits
+  // always stay local.
+  bool auto_search_distance;
+};
+
+void PrintTo(const Variant& v, std::ostream* os) {
+  *os << v.name;
+}
+
+class Incremental : public ::testing::TestWithParam<Variant> {
+ protected:
+  void SetUp() override {
+    base_ = dir_ / "base.obj";
+    sculpt_ = dir_ / "sculpt.obj";
+    auto cage = ReadMesh(DataPath("meshes/") + GetParam().cage);
+    ASSERT_TRUE(cage.ok()) << cage.status().message();
+    cage_ = std::move(*cage);
+    ASSERT_TRUE(WriteObj(base_, cage_).ok());
+    auto made = MakeSculpt(
+        testing::SculptOptions(base_, sculpt_, GetParam().levels, Pattern::kDetail, 0.005));
+    ASSERT_TRUE(made.ok()) << made.status().message();
+    auto sculpt = ReadMesh(sculpt_);
+    ASSERT_TRUE(sculpt.ok());
+    sculpt_mesh_ = std::move(*sculpt);
+  }
+
+  ExtractOptions Options(const std::string& output) const {
+    ExtractOptions o;
+    o.base_path = base_;
+    o.sculpt_path = sculpt_;
+    o.output_path = output;
+    o.data_type = GetParam().data_type;
+    o.watertight = GetParam().watertight;
+    o.tolerance = tolerance_;
+    if (!GetParam().auto_search_distance) {
+      o.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.01};
+    }
+    return o;
+  }
+
+  // The incremental run on inc.ptx, checked byte for byte against a full run.
+  ExtractReport Step(const std::string& what) {
+    ExtractOptions full = Options(dir_ / ("full_" + std::to_string(step_++) + ".ptx"));
+    auto expected = Extract(full);
+    EXPECT_TRUE(expected.ok()) << what << ": " << expected.status().message();
+    ExtractOptions inc = Options(dir_ / "inc.ptx");
+    inc.incremental = true;
+    auto report = Extract(inc);
+    EXPECT_TRUE(report.ok()) << what << ": " << report.status().message();
+    if (!report.ok() || !expected.ok()) return {};
+    EXPECT_TRUE(Slurp(inc.output_path) == Slurp(full.output_path))
+        << what << ": the incremental map differs from a full extraction (" << report->faces_copied
+        << " faces copied, " << report->faces_extracted
+        << " extracted): " << FirstDifference(inc.output_path, full.output_path);
+    return *report;
+  }
+
+  // Where two maps differ: the first face (resolution or texels) or meta data item.
+  static std::string FirstDifference(const std::string& a_path, const std::string& b_path) {
+    auto a = PtexFile::Open(a_path);
+    auto b = PtexFile::Open(b_path);
+    if (!a.ok() || !b.ok()) return "unreadable";
+    if (a->num_faces() != b->num_faces()) return "face counts";
+    std::vector<float> ta, tb;
+    for (int f = 0; f < a->num_faces(); ++f) {
+      const PtexFaceInfo &ia = a->face_info(PtexFaceId(f)), &ib = b->face_info(PtexFaceId(f));
+      if (ia.ulog2 != ib.ulog2 || ia.vlog2 != ib.vlog2) {
+        return "face " + std::to_string(f) + " resolution";
+      }
+      if (!a->ReadFace(PtexFaceId(f), 0, ta).ok() || !b->ReadFace(PtexFaceId(f), 0, tb).ok() ||
+          ta != tb) {
+        return "face " + std::to_string(f) + " texels";
+      }
+    }
+    const PtexMetaItem* ra = a->FindMetaData("dispex:face_records_v1");
+    const PtexMetaItem* rb = b->FindMetaData("dispex:face_records_v1");
+    if (ra && rb && ra->bytes != rb->bytes && ra->bytes.size() == rb->bytes.size()) {
+      const std::size_t size = ra->bytes.size() / static_cast<std::size_t>(a->num_faces());
+      std::size_t at = 0;
+      while (ra->bytes[at] == rb->bytes[at]) ++at;
+      return "face record " + std::to_string(at / size) + " byte " + std::to_string(at % size);
+    }
+    for (const PtexMetaItem& item : a->meta_data()) {
+      const PtexMetaItem* other = b->FindMetaData(item.key);
+      if (other == nullptr || other->bytes != item.bytes) {
+        const std::string x = item.AsString(), y = other ? other->AsString() : "";
+        std::size_t at = 0;
+        while (at < x.size() && at < y.size() && x[at] == y[at]) ++at;
+        const std::size_t from = at > 60 ? at - 60 : 0;
+        return "meta data " + item.key + " at byte " + std::to_string(at) + ": ..." +
+               x.substr(from, 120) + " / ..." + y.substr(from, 120);
+      }
+    }
+    return "layout only";
+  }
+
+  // Moves the sculpt's vertices within `radius` of a random vertex by a smooth bump.
+  void EditSculptInBall(unsigned seed, double radius, double amplitude) {
+    std::mt19937 rng(seed);
+    const Float3 c = sculpt_mesh_.positions[rng() % sculpt_mesh_.num_vertices()];
+    std::uniform_real_distribution<float> dir(-1, 1);
+    const Float3 d{dir(rng), dir(rng), dir(rng)};
+    for (Float3& p : sculpt_mesh_.positions) {
+      const double r = std::hypot(p.x - c.x, p.y - c.y, p.z - c.z);
+      if (r >= radius) continue;
+      const auto w = static_cast<float>(amplitude * 0.5 * (1 + std::cos(M_PI * r / radius)));
+      p = {p.x + w * d.x, p.y + w * d.y, p.z + w * d.z};
+    }
+    ASSERT_TRUE(WriteObj(sculpt_, sculpt_mesh_).ok());
+  }
+
+  // Splits every quad near a random vertex into two triangles: a locally re-meshed sculpt,
+  // whose later faces all move to other indices.
+  void RemeshSculptLocally(unsigned seed, double radius) {
+    std::mt19937 rng(seed);
+    const Float3 c = sculpt_mesh_.positions[rng() % sculpt_mesh_.num_vertices()];
+    Mesh out = sculpt_mesh_;
+    out.face_offsets = {0};
+    out.face_indices.clear();
+    for (std::size_t f = 0; f < sculpt_mesh_.num_faces(); ++f) {
+      const auto face = sculpt_mesh_.face(f);
+      const Float3& p = sculpt_mesh_.positions[static_cast<std::size_t>(face[0])];
+      const bool near = std::hypot(p.x - c.x, p.y - c.y, p.z - c.z) < radius;
+      if (near && face.size() == 4) {
+        for (int k : {0, 1, 2, 0, 2, 3}) out.face_indices.push_back(face[k]);
+        out.face_offsets.push_back(static_cast<std::uint32_t>(out.face_indices.size() - 3));
+      } else {
+        out.face_indices.insert(out.face_indices.end(), face.begin(), face.end());
+      }
+      out.face_offsets.push_back(static_cast<std::uint32_t>(out.face_indices.size()));
+    }
+    sculpt_mesh_ = std::move(out);
+    ASSERT_TRUE(WriteObj(sculpt_, sculpt_mesh_).ok());
+  }
+
+  std::int64_t SurfaceFaces(const ExtractReport& r) const {
+    return static_cast<std::int64_t>(r.ptex_faces - r.hole_faces);
+  }
+
+  TempDir dir_;
+  std::string base_, sculpt_;
+  Mesh cage_, sculpt_mesh_;
+  double tolerance_ = 0;  // automatic
+  int step_ = 0;
+};
+
+TEST_P(Incremental, EveryStepEqualsAFullExtraction) {
+  ExtractReport first = Step("first run, no map yet");
+  EXPECT_EQ(first.faces_copied, 0);
+  EXPECT_EQ(first.redo_reason, "no previous map");
+
+  // Nothing changed: the map is not rewritten.
+  const auto before = std::filesystem::last_write_time(dir_ / "inc.ptx");
+  ExtractReport same = Step("unchanged inputs");
+  EXPECT_TRUE(same.unchanged);
+  EXPECT_EQ(std::filesystem::last_write_time(dir_ / "inc.ptx"), before);
+
+  const double diagonal = first.base_diagonal;
+  for (unsigned seed : {1u, 2u, 3u}) {
+    EditSculptInBall(seed, 0.04 * diagonal, 0.002);
+    ExtractReport r = Step("sculpt edited in a ball, seed " + std::to_string(seed));
+    EXPECT_FALSE(r.unchanged);
+    EXPECT_GT(r.faces_copied, 0) << "a local edit re-extracted every face";
+    EXPECT_GT(r.faces_extracted, 0);
+    EXPECT_EQ(r.redo_reason, "sculpt");
+  }
+
+  RemeshSculptLocally(4, 0.04 * diagonal);
+  // Triangles: the sculpt is no longer the base subdivided, so where the oversampling rule
+  // then plans other sample counts the faces are extracted again.
+  ExtractReport remeshed = Step("sculpt re-meshed locally");
+  EXPECT_GT(remeshed.faces_extracted, 0);
+
+  // A base vertex moved: the faces around it change (their limit patches), not the others.
+  cage_.positions[cage_.num_vertices() / 2].x += static_cast<float>(0.002 * diagonal);
+  ASSERT_TRUE(WriteObj(base_, cage_).ok());
+  ExtractReport moved = Step("base vertex moved");
+  EXPECT_GT(moved.faces_copied, SurfaceFaces(moved) / 2);
+  EXPECT_LT(moved.faces_extracted, SurfaceFaces(moved) / 2);
+  EXPECT_GT(moved.faces_extracted, 0);
+  EXPECT_EQ(moved.redo_reason, "base");
+
+  // A crease on one edge of the base.
+  const auto face = cage_.face(0);
+  ASSERT_TRUE(
+      WriteObj(base_, cage_, fmt::format("t crease 2/1/0 {} {} 2.5\n", face[0], face[1])).ok());
+  ExtractReport creased = Step("crease added");
+  EXPECT_GT(creased.faces_extracted, 0);
+  if (!GetParam().auto_search_distance) {
+    EXPECT_GT(creased.faces_copied, SurfaceFaces(creased) / 2);
+  }
+
+  // An option every face depends on: nothing can be copied.
+  tolerance_ = 0.9 * first.tolerance;
+  ExtractReport retuned = Step("tolerance changed");
+  EXPECT_EQ(retuned.faces_copied, 0);
+  EXPECT_EQ(retuned.redo_reason, "options: tolerance");
+
+  // With the new option in the map, local edits are incremental again.
+  // A larger bump that also moves the sculpt's outermost points (the tracer's scale).
+  EditSculptInBall(5, 0.04 * diagonal, 0.006 * diagonal);
+  Step("larger sculpt edit after the option change");
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cages, Incremental,
+    ::testing::Values(Variant{"spot_float_filter", "keenan_spot/spot_control_mesh.obj", 3,
+                              PtexDataType::kFloat, WatertightEdges::kFilter, false},
+                      Variant{"spot_half_all", "keenan_spot/spot_control_mesh.obj", 3,
+                              PtexDataType::kHalf, WatertightEdges::kAll, false},
+                      Variant{"car_ngons_boundary_float_off", "opensubdiv/catmark_car.obj", 3,
+                              PtexDataType::kFloat, WatertightEdges::kOff, true}),
+    [](const auto& param_info) { return std::string(param_info.param.name); });
+
+TEST(IncrementalMaps, AMapNotWrittenByDispexIsIgnoredWithANotice) {
+  TempDir dir;
+  const std::string base = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
+  const std::string sculpt = dir / "sculpt.obj";
+  ASSERT_TRUE(MakeSculpt(testing::SculptOptions(base, sculpt, 2, Pattern::kSmooth, 0.005)).ok());
+  ExtractOptions o;
+  o.base_path = base;
+  o.sculpt_path = sculpt;
+  o.output_path = dir / "full.ptx";
+  ASSERT_TRUE(Extract(o).ok());
+  for (const std::string& junk :
+       {std::string("not a ptex file"), Slurp(DataPath("ptex/quad_float1.ptx"))}) {
+    o.output_path = dir / "inc.ptx";
+    { std::ofstream(o.output_path, std::ios::binary) << junk; }
+    o.incremental = true;
+    auto r = Extract(o);
+    ASSERT_TRUE(r.ok()) << r.status().message();
+    EXPECT_EQ(r->faces_copied, 0);
+    ASSERT_FALSE(r->warnings.empty());
+    EXPECT_NE(r->warnings.back().find("not re-used"), std::string::npos) << r->warnings.back();
+    EXPECT_EQ(Slurp(o.output_path), Slurp(dir / "full.ptx"));
+  }
+}
+
+}  // namespace
+}  // namespace dispex
