@@ -12,7 +12,7 @@ set(levels core 0 mesh 1 subdiv 2 trace 3 spectral 4 ptex 5 extract 6 verify 7 r
 # The module each public header belongs to.
 set(owners
   status core ids core version core files core cancel core
-  mesh mesh
+  mesh mesh shapes mesh
   subdiv subdiv
   trace trace
   spectral spectral
