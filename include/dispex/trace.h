@@ -80,6 +80,10 @@ struct TracerOptions {
   // this CPU lacks, is an error of MakeEmbreeTracer. The contract of the queries below holds
   // under every ISA; hit t values agree to the last bit wherever the same primitive is hit.
   std::string isa;
+  // The length the rounding margins and sideways steps of the queries scale with. 0: the
+  // largest |coordinate| of the scene's bounds. Extraction gives one taken from the base mesh,
+  // so that an edit of the sculpt's outermost parts does not change every face's hits.
+  float scale = 0;
 };
 
 // The names TracerOptions::isa accepts, narrowest first, and those this CPU can run.
@@ -176,7 +180,7 @@ struct TracerStats {
   std::size_t copied_bytes = 0;         // bytes dispex copied from the mesh (0 when all shared)
   bool shared_vertices = false;         // Embree reads mesh.positions in place
   bool shared_indices = false;          // Embree reads mesh.face_indices in place
-  // The power of two at or above the largest |coordinate| of the scene's bounds: the rounding
+  // TracerOptions::scale as used (the scene's largest |coordinate| when it was 0): the rounding
   // margins and sideways steps of the queries scale with it, so hits depend on it in rare cases.
   float scale = 0;
 };

@@ -4,6 +4,7 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 
 #include "core/system.h"
@@ -15,6 +16,17 @@
 namespace dispex::extract {
 
 namespace {
+
+// The power of two at or above the base's largest |coordinate|: the magnitude of the ray
+// origins, and independent of the sculpt.
+float TracerScale(const Mesh& base) {
+  const BoundingBox box = ComputeBounds(base);
+  float largest = 0;
+  for (float c : {box.min.x, box.min.y, box.min.z, box.max.x, box.max.y, box.max.z}) {
+    largest = std::max(largest, std::fabs(c));
+  }
+  return largest > 0 ? std::exp2(std::ceil(std::log2(largest))) : 1.0f;
+}
 
 std::string Fingerprint(const Mesh& mesh) {
   return "xxh3-128:" + MeshContentKey(mesh).Hex();
@@ -108,6 +120,7 @@ Status BuildTracer(const ExtractOptions& options, ExtractInputs& inputs, Extract
   TracerOptions tracer_options;
   tracer_options.quality = options.bvh_quality;
   tracer_options.isa = options.embree_isa;
+  tracer_options.scale = TracerScale(inputs.base);
   DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, tracer_options));
   report.t_bvh = clock.seconds();
   report.tracer = inputs.tracer->stats().backend;

@@ -18,11 +18,11 @@ Hash128 MeshContentKey(const Mesh& mesh);
 // watertight mode, sampling caps) and the version of the pipeline.
 Hash128 SettingsKey(const ExtractSettings& settings);
 
-// Per Ptex face: SettingsKey and the tracer's scale (TracerStats::scale), the face's limit patch (BaseFacePatches) and sub-face, its
-// planned samples, and every sculpt face its rays can reach: those whose bounding box meets
-// the face's reach box (the patch's box grown by the longest search distance and a margin),
-// as an order-free sum of each sculpt face's key (its corners' positions, in order). The
-// keys do not depend on the thread count.
+// Per Ptex face: SettingsKey and the tracer's scale (TracerStats::scale), the face's limit patch
+// (BaseFacePatches) and sub-face, its planned samples, and every sculpt face its rays can reach:
+// those whose bounding box meets the face's reach box (the patch's box grown by the longest search
+// distance and a margin), as an order-free sum of each sculpt face's key (its corners' positions,
+// in order). The keys do not depend on the thread count.
 std::vector<Hash128> ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings);
 
 }  // namespace dispex::extract

@@ -171,9 +171,7 @@ Status EmbreeScene::Setup(const Mesh& mesh, const TracerOptions& options) {
                         bounds.upper_y, bounds.upper_z}) {
     if (std::isfinite(c)) scale_ = std::max(scale_, std::fabs(c));
   }
-  // Up to a power of two: the margins only need its magnitude, and hits then do not change
-  // when an edit moves the scene's outermost point a little (incremental extraction keys on it).
-  if (scale_ > 0) scale_ = std::exp2(std::ceil(std::log2(scale_)));
+  if (options.scale > 0) scale_ = options.scale;
   stats_.scale = scale_;
   retry_misses_ = options.retry_misses;
   verify_hits_ = options.verify_hits;

@@ -232,7 +232,8 @@ TEST_P(Incremental, EveryStepEqualsAFullExtraction) {
   EXPECT_EQ(retuned.redo_reason, "options: tolerance");
 
   // With the new option in the map, local edits are incremental again.
-  // A larger bump that also moves the sculpt's outermost points (the tracer's scale).
+  // A larger bump that moves the sculpt's outermost points (which the tracer's scale once
+  // followed: docs/INCREMENTAL.md).
   EditSculptInBall(5, 0.04 * diagonal, 0.006 * diagonal);
   Step("larger sculpt edit after the option change");
 }
