@@ -1,7 +1,9 @@
-// dispex extract BASE SCULPT -o OUT.ptx [options]
+// dispex extract BASE SCULPT -o OUT.ptx | --out-dir DIR [--shapes a,b] | --manifest FILE [options]
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "command.h"
 #include "dispex/cancel.h"
@@ -30,6 +32,7 @@ constexpr FlagName kExtractFlags[] = {
     {"max_miss_fraction", "--max-miss-fraction"},
     {"threads", "--threads"},
     {"max_memory", "--max-memory"},
+    {"output_dir", "--out-dir"},
 };
 
 struct ExtractArgs {
@@ -47,7 +50,12 @@ struct ExtractArgs {
   std::string report_path;
   std::string preview_dir;
   std::string max_memory;
+  std::string output_dir;
+  std::vector<std::string> shapes;
+  std::string manifest_path;
   bool quiet = false;
+
+  bool asset() const { return !output_dir.empty() || !manifest_path.empty(); }
 };
 
 // "8G", "512M", "300K" or a number of bytes.
@@ -150,13 +158,58 @@ Status Resolve(ExtractArgs& a) {
     return Status::Error(
         fmt::format("--report {}: must differ from the inputs and the output", a.report_path));
   }
+  if (a.asset()) {
+    if (!o.output_path.empty()) return Status::Error("give -o or --out-dir/--manifest, not both");
+    if (!a.manifest_path.empty() && !a.shapes.empty()) {
+      return Status::Error("--shapes selects shapes of BASE; a --manifest names its own");
+    }
+    if (!a.preview_dir.empty()) return Status::Error("--preview needs -o (one map)");
+    return Status::Ok();
+  }
+  if (!a.shapes.empty()) return Status::Error("--shapes needs --out-dir (one map per shape)");
+  if (o.base_path.empty() || o.sculpt_path.empty()) {
+    return Status::Error("give BASE and SCULPT (or --manifest)");
+  }
+  if (o.output_path.empty()) return Status::Error("give -o OUT.ptx, or --out-dir DIR");
   return ValidateExtractOptions(o);
+}
+
+// --out-dir or --manifest: one map per shape.
+int RunAsset(ExtractArgs& args) {
+  ExtractAssetOptions asset;
+  asset.options = args.options;
+  asset.output_dir = args.output_dir;
+  asset.shapes = args.shapes;
+  if (!args.manifest_path.empty()) {
+    if (!args.options.base_path.empty() || !args.options.sculpt_path.empty()) {
+      return ReportFailure(Status::Error("--manifest names the files: give no BASE or SCULPT"),
+                           kExtractFlags, 2);
+    }
+    auto read = ReadExtractManifest(args.manifest_path, asset);
+    if (!read.ok()) return ReportFailure(read.status(), kExtractFlags, 2);
+    asset = std::move(*read);
+  } else if (args.options.base_path.empty() || args.options.sculpt_path.empty()) {
+    return ReportFailure(Status::Error("give BASE and SCULPT (or --manifest)"), kExtractFlags, 2);
+  }
+  auto report = ExtractAsset(asset);
+  if (!report.ok()) {
+    int sig = CancelSignal();
+    return ReportFailure(report.status(), kExtractFlags, sig ? 128 + sig : 1);
+  }
+  if (!args.report_path.empty()) {
+    std::string json = AssetReportJson(*report);
+    Status written = WriteFileAtomically(args.report_path, json.data(), json.size());
+    if (!written.ok()) return ReportFailure(written.WithPrefix("--report"));
+  }
+  if (!args.quiet) std::fputs(AssetReportSummary(*report).c_str(), stderr);
+  return 0;
 }
 
 int RunExtract(ExtractArgs& args) {
   Status resolved = Resolve(args);
   if (!resolved.ok()) return ReportFailure(resolved, kExtractFlags, 2);
   InstallCancelSignalHandlers();
+  if (args.asset()) return RunAsset(args);
   auto report = Extract(args.options);
   if (!report.ok()) {
     int sig = CancelSignal();
@@ -180,12 +233,19 @@ void SetupExtract(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<ExtractArgs>();
   ExtractOptions& o = args->options;
   CLI::App* cmd = app.add_subcommand(
-      "extract", "Extract a Ptex displacement map: BASE cage + SCULPT -> OUT.ptx");
-  cmd->add_option("base", o.base_path, "base mesh: the Catmull-Clark cage (.obj, .ply)")
-      ->required();
-  cmd->add_option("sculpt", o.sculpt_path, "sculpted high-resolution mesh (.obj, .ply)")
-      ->required();
-  cmd->add_option("-o,--output", o.output_path, "output Ptex file (.ptx)")->required();
+      "extract",
+      "Extract a Ptex displacement map: BASE cage + SCULPT -> OUT.ptx, or one map per shape");
+  cmd->add_option("base", o.base_path, "base mesh: the Catmull-Clark cage (.obj, .ply)");
+  cmd->add_option("sculpt", o.sculpt_path, "sculpted high-resolution mesh (.obj, .ply)");
+  cmd->add_option("-o,--output", o.output_path, "output Ptex file (.ptx) of a single-shape base");
+  cmd->add_option("--out-dir", args->output_dir,
+                  "one map per shape (OBJ o/g group) of the base: DIR/<shape>.ptx, each shape's "
+                  "rays hitting only the sculpt's shape of the same name");
+  cmd->add_option("--shapes", args->shapes, "with --out-dir: only these shapes (a,b,c)")
+      ->delimiter(',');
+  cmd->add_option("--manifest", args->manifest_path,
+                  "JSON naming shapes spread over several files, with options per shape "
+                  "(docs/SHAPES.md); the command line's options are its defaults");
   cmd->add_option("--oversample", args->oversample,
                   "samples per side of each face: 'auto' (from the sculpt's density) or a "
                   "power of two 1..512")

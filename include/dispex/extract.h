@@ -113,6 +113,7 @@ Status ValidateExtractOptions(const ExtractOptions& options);
 
 struct ExtractReport {
   std::string version;
+  std::string shape;  // the shape's name when extracted as part of an asset (ExtractAsset)
   std::string base_path, sculpt_path, output_path;
   std::string base_fingerprint, sculpt_fingerprint;
   ExtractOptions options;  // as given
@@ -203,8 +204,65 @@ struct ExtractReport {
 };
 
 // Runs the whole pipeline. Errors (bad inputs, nothing hit, a miss under HolePolicy::kFail,
-// cancellation) leave no output file.
+// cancellation) leave no output file. A base made of several shapes (ExtractAsset) is an error
+// that names them.
 StatusOr<ExtractReport> Extract(const ExtractOptions& options);
+
+// ---- Assets of several shapes ---------------------------------------------------------------
+
+// A shape of an asset named in a manifest: the files that hold it and its own options.
+struct AssetShapeSpec {
+  std::string name;  // the shape's o/g group name in both files (any name for single-shape files)
+  std::string base_path, sculpt_path;
+  ExtractOptions options;  // paths and output ignored
+};
+
+struct ExtractAssetOptions {
+  // Every option for every shape; base_path and sculpt_path are the asset's files (unless
+  // `manifest` is given); output_path is not used.
+  ExtractOptions options;
+  // The maps: output_dir/<file name>.ptx, file names from ShapeFileNames (include/dispex/shapes.h).
+  std::string output_dir;
+  // Only these shapes of the base (empty: all of them).
+  std::vector<std::string> shapes;
+  // When not empty, these shapes, each from its own files with its own options, instead of the
+  // shapes of options.base_path and options.sculpt_path.
+  std::vector<AssetShapeSpec> manifest;
+};
+
+struct AssetReport {
+  std::string version;
+  std::string output_dir;
+  struct Shape {
+    std::string name;
+    std::string file;  // the map's path
+    ExtractReport report;
+  };
+  std::vector<Shape> shapes;  // in the base's (or the manifest's) order
+  std::vector<std::string> warnings;
+  double t_read = 0, t_total = 0;  // seconds: reading the files, and everything
+  std::uint64_t peak_rss_bytes = 0;
+};
+
+// One map per shape of an asset (OBJ o/g groups; a PLY is one shape): each base shape paired
+// by name with the sculpt's shape (MatchShapes), so that its rays hit only that sculpt shape,
+// and extracted as Extract would extract it alone. Each file is read once; shapes run in
+// parallel; every map is the same whatever the order or thread count. With
+// options.incremental, each shape's map is re-used as Extract re-uses it. On an error, the
+// maps of the shapes before it in the base's order may have been written (each whole).
+StatusOr<AssetReport> ExtractAsset(const ExtractAssetOptions& options);
+
+// A manifest (JSON, docs/SHAPES.md) of shapes spread over several files, each with its own
+// options: {"output_dir": "maps", "options": {...}, "shapes": [{"name": "head", "base":
+// "head.obj", "sculpt": "head_sculpt.obj", "options": {"tolerance": 0.001}}, ...]}. Paths are
+// relative to the manifest's folder; options (named as ExtractOptions' fields, values as the
+// command line takes them) apply over `defaults`, shape options over the manifest's. Errors
+// name the file and the entry.
+StatusOr<ExtractAssetOptions> ReadExtractManifest(const std::string& path,
+                                                  const ExtractAssetOptions& defaults);
+
+std::string AssetReportJson(const AssetReport& report);
+std::string AssetReportSummary(const AssetReport& report);
 
 // The report as JSON (pretty-printed) and as a short human summary.
 std::string ExtractReportJson(const ExtractReport& report);

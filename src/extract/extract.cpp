@@ -3,8 +3,7 @@
 // add up the totals -> write the map. Each stage is in its own file of src/extract.
 #include "dispex/extract.h"
 
-#include <tbb/global_control.h>
-#include <tbb/task_arena.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -12,11 +11,13 @@
 
 #include "core/system.h"
 #include "dispex/cancel.h"
+#include "dispex/shapes.h"
 #include "dispex/version.h"
 #include "extract/edge_matching.h"
 #include "extract/extract_inputs.h"
 #include "extract/extract_meta.h"
 #include "extract/extract_settings.h"
+#include "extract/extract_shape.h"
 #include "extract/face_keys.h"
 #include "extract/face_records.h"
 #include "extract/face_totals.h"
@@ -28,17 +29,6 @@
 namespace dispex::extract {
 
 namespace {
-
-ExtractReport StartReport(const ExtractOptions& options, int threads) {
-  ExtractReport report;
-  report.version = DISPEX_VERSION_STRING;
-  report.options = options;
-  report.base_path = options.base_path;
-  report.sculpt_path = options.sculpt_path;
-  report.output_path = options.output_path;
-  report.threads = threads;
-  return report;
-}
 
 // A temporary file beside the target until CommitMap.
 StatusOr<PtexWriter> CreateMap(const ExtractOptions& options, const ExtractInputs& inputs) {
@@ -89,13 +79,48 @@ std::string RedoReason(const PreviousMap& previous, const ExtractReport& report)
   return out;
 }
 
+// Several disjoint shapes are ExtractAsset's: one map per shape.
+Status CheckOneShape(const ExtractOptions& options, const Mesh& base) {
+  if (base.group_names.size() < 2) return Status::Ok();
+  auto shapes = SplitShapes(base, /*require_disjoint=*/true);
+  if (!shapes.ok() || shapes->size() < 2) return Status::Ok();  // groups of one surface
+  std::string names;
+  for (std::size_t i = 0; i < shapes->size() && i < 10; ++i) {
+    names += fmt::format("{}'{}'", i ? ", " : "", (*shapes)[i].name);
+  }
+  if (shapes->size() > 10) names += ", ...";
+  return Status::Error(fmt::format("{} has {} shapes ({}): write one map per shape with output_dir",
+                                   options.base_path, shapes->size(), names));
+}
+
 StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int threads) {
   Stopwatch total_clock;
   ExtractReport report = StartReport(options, threads);
-  const std::uint64_t memory_limit =
-      options.max_memory > 0 ? options.max_memory : AvailableMemoryBytes();
-
+  const std::uint64_t memory_limit = MemoryLimit(options);
   DISPEX_ASSIGN_OR_RETURN(ExtractInputs inputs, ReadInputs(options, memory_limit, report));
+  DISPEX_RETURN_IF_ERROR(CheckOneShape(options, inputs.base));
+  return ExtractShape(options, std::move(inputs), std::move(report), total_clock);
+}
+
+}  // namespace
+
+std::uint64_t MemoryLimit(const ExtractOptions& options) {
+  return options.max_memory > 0 ? options.max_memory : AvailableMemoryBytes();
+}
+
+ExtractReport StartReport(const ExtractOptions& options, int threads) {
+  ExtractReport report;
+  report.version = DISPEX_VERSION_STRING;
+  report.options = options;
+  report.base_path = options.base_path;
+  report.sculpt_path = options.sculpt_path;
+  report.output_path = options.output_path;
+  report.threads = threads;
+  return report;
+}
+
+StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInputs inputs,
+                                     ExtractReport report, const Stopwatch& total_clock) {
   report.inputs_key = InputsKey(report).Hex();
   const auto num_faces = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
   PreviousMap previous;
@@ -103,7 +128,6 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
     previous = PreviousMap::Open(options.output_path, num_faces);
     if (previous.usable() && previous.MetaString(kInputsKeyMetaKey) == report.inputs_key) {
       report.unchanged = true;
-      report.redo_reason = "";
       report.t_total = total_clock.seconds();
       report.peak_rss_bytes = PeakResidentBytes();
       return report;
@@ -140,27 +164,14 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
   return report;
 }
 
-}  // namespace
-
 }  // namespace dispex::extract
 
 namespace dispex {
 
 StatusOr<ExtractReport> Extract(const ExtractOptions& options) {
   DISPEX_RETURN_IF_ERROR(ValidateExtractOptions(options));
-  // threads = N runs every parallel loop (Embree's BVH build included) in an arena of N
-  // threads, more than the machine's cores if asked: the map is the same at any count.
-  std::optional<tbb::global_control> thread_limit;
-  if (options.threads > 0) {
-    thread_limit.emplace(tbb::global_control::max_allowed_parallelism,
-                         static_cast<std::size_t>(options.threads));
-  }
-  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
-  arena.initialize();
-  const int threads =
-      std::min(arena.max_concurrency(), static_cast<int>(tbb::global_control::active_value(
-                                            tbb::global_control::max_allowed_parallelism)));
-  return arena.execute([&] { return extract::ExtractInArena(options, threads); });
+  return extract::RunInArena(
+      options.threads, [&](int threads) { return extract::ExtractInArena(options, threads); });
 }
 
 }  // namespace dispex

@@ -102,17 +102,33 @@ Status CheckMemoryForInputs(const ExtractOptions& options, const MeshesRead& mes
                               std::min<std::uint64_t>(max_texels, 1ull << 31), memory_limit);
 }
 
+StatusOr<ExtractInputs> FinishInputs(const ExtractOptions& options, MeshesRead meshes,
+                                     std::uint64_t memory_limit, ExtractReport& report) {
+  ReportMeshes(options, meshes, report);
+  DISPEX_RETURN_IF_ERROR(CheckMemoryForInputs(options, meshes, memory_limit));
+  std::vector<PtexFaceInfo> faces = PtexFaceTable(meshes.surface);
+  return ExtractInputs{std::move(meshes.base), std::move(meshes.sculpt), std::move(meshes.surface),
+                       std::move(faces), nullptr};
+}
+
 }  // namespace
 
 StatusOr<ExtractInputs> ReadInputs(const ExtractOptions& options, std::uint64_t memory_limit,
                                    ExtractReport& report) {
   DISPEX_RETURN_IF_ERROR(CheckMemoryBeforeReading(options, memory_limit));
   DISPEX_ASSIGN_OR_RETURN(MeshesRead meshes, ReadMeshes(options, report));
-  ReportMeshes(options, meshes, report);
-  DISPEX_RETURN_IF_ERROR(CheckMemoryForInputs(options, meshes, memory_limit));
-  std::vector<PtexFaceInfo> faces = PtexFaceTable(meshes.surface);
-  return ExtractInputs{std::move(meshes.base), std::move(meshes.sculpt), std::move(meshes.surface),
-                       std::move(faces), nullptr};
+  return FinishInputs(options, std::move(meshes), memory_limit, report);
+}
+
+StatusOr<ExtractInputs> InputsFromMeshes(const ExtractOptions& options, Mesh base, Mesh sculpt,
+                                         std::uint64_t memory_limit, ExtractReport& report) {
+  report.base_fingerprint = Fingerprint(base);
+  report.sculpt_fingerprint = Fingerprint(sculpt);
+  Stopwatch clock;
+  DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
+  report.t_topology = clock.seconds();
+  return FinishInputs(options, MeshesRead{std::move(base), std::move(sculpt), std::move(surface)},
+                      memory_limit, report);
 }
 
 Status BuildTracer(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report) {

@@ -29,6 +29,11 @@ struct ExtractInputs {
 StatusOr<ExtractInputs> ReadInputs(const ExtractOptions& options, std::uint64_t memory_limit,
                                    ExtractReport& report);
 
+// The same from meshes already read (the shapes of an asset): fingerprints, limit surface,
+// counts, memory check. Read times stay 0.
+StatusOr<ExtractInputs> InputsFromMeshes(const ExtractOptions& options, Mesh base, Mesh sculpt,
+                                         std::uint64_t memory_limit, ExtractReport& report);
+
 // The sculpt's BVH.
 Status BuildTracer(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report);
 

@@ -119,7 +119,7 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
 
 Hash128 InputsKey(const ExtractReport& report) {
   Hasher h;
-  h.Add(std::string_view(report.version));
+  h.Add(std::string_view(report.version)).Add(std::string_view(report.shape));
   h.Add(std::string_view(ExtractOptionsJson(report.options).dump()));
   h.Add(std::string_view(report.base_fingerprint)).Add(std::string_view(report.sculpt_fingerprint));
   h.Add(std::string_view(FileName(report.base_path)));
@@ -132,6 +132,9 @@ Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractRep
                           std::span<const EdgeMeans> edge_means) {
   DISPEX_RETURN_IF_ERROR(AddMeshMetaData(writer, base));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:version", report.version));
+  if (!report.shape.empty()) {
+    DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:shape", report.shape));
+  }
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:base", FileName(report.base_path)));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:base_fingerprint", report.base_fingerprint));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:sculpt", FileName(report.sculpt_path)));

@@ -15,12 +15,14 @@ namespace dispex::extract {
 
 // Every option that affects the output (not threads, progress or paths).
 nlohmann::json ExtractOptionsJson(const ExtractOptions& options);
+// The JSON report of one map (ExtractReportJson, and each shape of AssetReportJson).
+nlohmann::json ExtractReportObject(const ExtractReport& report);
 // Resolved settings and statistics that do not depend on timing or thread count.
 nlohmann::json ExtractStatisticsJson(const ExtractReport& report);
 
 // Adds the standard mesh meta data (PtexFaceVertCounts, ...) and dispex's own keys:
-// dispex:version, dispex:base, dispex:base_fingerprint, dispex:sculpt,
-// dispex:sculpt_fingerprint, dispex:options (JSON), dispex:statistics (JSON),
+// dispex:version, dispex:shape (when part of an asset), dispex:base, dispex:base_fingerprint,
+// dispex:sculpt, dispex:sculpt_fingerprint, dispex:options (JSON), dispex:statistics (JSON),
 // dispex:tolerance, dispex:search_distance, dispex:discontinuous_faces (int32 Ptex face
 // ids whose data may jump at their edges; when there are any), and what an incremental
 // extraction re-uses: dispex:inputs_key, dispex:face_keys (16 bytes per face) and

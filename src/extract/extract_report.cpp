@@ -5,9 +5,12 @@
 
 namespace dispex {
 
-std::string ExtractReportJson(const ExtractReport& r) {
+namespace extract {
+
+nlohmann::json ExtractReportObject(const ExtractReport& r) {
   nlohmann::json j;
   j["version"] = r.version;
+  if (!r.shape.empty()) j["shape"] = r.shape;
   j["inputs"] = {{"base", r.base_path},
                  {"base_fingerprint", r.base_fingerprint},
                  {"sculpt", r.sculpt_path},
@@ -52,7 +55,63 @@ std::string ExtractReportJson(const ExtractReport& r) {
   j["peak_rss_bytes"] = r.peak_rss_bytes;
   j["tracer"] = r.tracer;
   j["warnings"] = r.warnings;
+  return j;
+}
+
+}  // namespace extract
+
+std::string ExtractReportJson(const ExtractReport& r) {
+  return extract::ExtractReportObject(r).dump(2) + "\n";
+}
+
+std::string AssetReportJson(const AssetReport& r) {
+  nlohmann::json j;
+  j["version"] = r.version;
+  j["output_dir"] = r.output_dir;
+  std::int64_t unchanged = 0, copied = 0, extracted = 0;
+  std::uint64_t bytes = 0;
+  nlohmann::json shapes = nlohmann::json::array();
+  for (const AssetReport::Shape& s : r.shapes) {
+    nlohmann::json shape = extract::ExtractReportObject(s.report);
+    shape["file"] = s.file;
+    shapes.push_back(std::move(shape));
+    unchanged += s.report.unchanged;
+    copied += s.report.faces_copied;
+    extracted += s.report.faces_extracted;
+    bytes += s.report.bytes_written;
+  }
+  j["shapes"] = std::move(shapes);
+  j["totals"] = {{"shapes", r.shapes.size()},
+                 {"unchanged", unchanged},
+                 {"faces_copied", copied},
+                 {"faces_extracted", extracted},
+                 {"bytes_written", bytes}};
+  j["phases_seconds"] = {{"read", r.t_read}, {"total", r.t_total}};
+  j["peak_rss_bytes"] = r.peak_rss_bytes;
+  j["warnings"] = r.warnings;
   return j.dump(2) + "\n";
+}
+
+std::string AssetReportSummary(const AssetReport& r) {
+  std::string out = fmt::format(
+      "dispex: {} shapes -> {}/ (read {:.2f}s, total {:.2f}s, peak {:.0f} MB)\n", r.shapes.size(),
+      r.output_dir, r.t_read, r.t_total, double(r.peak_rss_bytes) / 1e6);
+  for (const AssetReport::Shape& s : r.shapes) {
+    const ExtractReport& e = s.report;
+    if (e.unchanged) {
+      out += fmt::format("  {:<20} {} up to date, not rewritten\n", s.name, s.file);
+      continue;
+    }
+    out += fmt::format("  {:<20} {} {} Ptex faces, texels {} -> {}, {:.2f}s{}\n", s.name, s.file,
+                       e.ptex_faces, e.spectral.texels_before, e.spectral.texels_after, e.t_total,
+                       e.options.incremental
+                           ? fmt::format(" ({} faces copied, {} extracted: {})", e.faces_copied,
+                                         e.faces_extracted, e.redo_reason)
+                           : "");
+    for (const std::string& w : e.warnings) out += "    warning: " + w + "\n";
+  }
+  for (const std::string& w : r.warnings) out += "  warning: " + w + "\n";
+  return out;
 }
 
 std::string ExtractReportSummary(const ExtractReport& r) {

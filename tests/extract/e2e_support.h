@@ -112,6 +112,49 @@ inline VerifyReport CheckTruth(const std::string& base, const std::string& map,
   return report.ok() ? *report : VerifyReport{};
 }
 
+// Where two maps differ: the first face (resolution or texels), the first face record, or the
+// first meta data item; "layout only" when those are all equal. With `faces_only`, "" when every
+// face is equal.
+inline std::string MapDifference(const std::string& a_path, const std::string& b_path,
+                                 bool faces_only = false) {
+  auto a = PtexFile::Open(a_path);
+  auto b = PtexFile::Open(b_path);
+  if (!a.ok() || !b.ok()) return "unreadable";
+  if (a->num_faces() != b->num_faces()) return "face counts";
+  std::vector<float> ta, tb;
+  for (int f = 0; f < a->num_faces(); ++f) {
+    const PtexFaceInfo &ia = a->face_info(PtexFaceId(f)), &ib = b->face_info(PtexFaceId(f));
+    if (ia.ulog2 != ib.ulog2 || ia.vlog2 != ib.vlog2) {
+      return "face " + std::to_string(f) + " resolution";
+    }
+    if (!a->ReadFace(PtexFaceId(f), 0, ta).ok() || !b->ReadFace(PtexFaceId(f), 0, tb).ok() ||
+        ta != tb) {
+      return "face " + std::to_string(f) + " texels";
+    }
+  }
+  if (faces_only) return "";
+  const PtexMetaItem* ra = a->FindMetaData("dispex:face_records_v1");
+  const PtexMetaItem* rb = b->FindMetaData("dispex:face_records_v1");
+  if (ra && rb && ra->bytes != rb->bytes && ra->bytes.size() == rb->bytes.size()) {
+    const std::size_t size = ra->bytes.size() / static_cast<std::size_t>(a->num_faces());
+    std::size_t at = 0;
+    while (ra->bytes[at] == rb->bytes[at]) ++at;
+    return "face record " + std::to_string(at / size) + " byte " + std::to_string(at % size);
+  }
+  for (const PtexMetaItem& item : a->meta_data()) {
+    const PtexMetaItem* other = b->FindMetaData(item.key);
+    if (other == nullptr || other->bytes != item.bytes) {
+      const std::string x = item.AsString(), y = other ? other->AsString() : "";
+      std::size_t at = 0;
+      while (at < x.size() && at < y.size() && x[at] == y[at]) ++at;
+      const std::size_t from = at > 60 ? at - 60 : 0;
+      return "meta data " + item.key + " at byte " + std::to_string(at) + ": ..." +
+             x.substr(from, 120) + " / ..." + y.substr(from, 120);
+    }
+  }
+  return "layout only";
+}
+
 // A fresh folder per test, removed afterwards.
 class TempDir {
  public:

@@ -86,47 +86,8 @@ class Incremental : public ::testing::TestWithParam<Variant> {
     EXPECT_TRUE(Slurp(inc.output_path) == Slurp(full.output_path))
         << what << ": the incremental map differs from a full extraction (" << report->faces_copied
         << " faces copied, " << report->faces_extracted
-        << " extracted): " << FirstDifference(inc.output_path, full.output_path);
+        << " extracted): " << testing::MapDifference(inc.output_path, full.output_path);
     return *report;
-  }
-
-  // Where two maps differ: the first face (resolution or texels) or meta data item.
-  static std::string FirstDifference(const std::string& a_path, const std::string& b_path) {
-    auto a = PtexFile::Open(a_path);
-    auto b = PtexFile::Open(b_path);
-    if (!a.ok() || !b.ok()) return "unreadable";
-    if (a->num_faces() != b->num_faces()) return "face counts";
-    std::vector<float> ta, tb;
-    for (int f = 0; f < a->num_faces(); ++f) {
-      const PtexFaceInfo &ia = a->face_info(PtexFaceId(f)), &ib = b->face_info(PtexFaceId(f));
-      if (ia.ulog2 != ib.ulog2 || ia.vlog2 != ib.vlog2) {
-        return "face " + std::to_string(f) + " resolution";
-      }
-      if (!a->ReadFace(PtexFaceId(f), 0, ta).ok() || !b->ReadFace(PtexFaceId(f), 0, tb).ok() ||
-          ta != tb) {
-        return "face " + std::to_string(f) + " texels";
-      }
-    }
-    const PtexMetaItem* ra = a->FindMetaData("dispex:face_records_v1");
-    const PtexMetaItem* rb = b->FindMetaData("dispex:face_records_v1");
-    if (ra && rb && ra->bytes != rb->bytes && ra->bytes.size() == rb->bytes.size()) {
-      const std::size_t size = ra->bytes.size() / static_cast<std::size_t>(a->num_faces());
-      std::size_t at = 0;
-      while (ra->bytes[at] == rb->bytes[at]) ++at;
-      return "face record " + std::to_string(at / size) + " byte " + std::to_string(at % size);
-    }
-    for (const PtexMetaItem& item : a->meta_data()) {
-      const PtexMetaItem* other = b->FindMetaData(item.key);
-      if (other == nullptr || other->bytes != item.bytes) {
-        const std::string x = item.AsString(), y = other ? other->AsString() : "";
-        std::size_t at = 0;
-        while (at < x.size() && at < y.size() && x[at] == y[at]) ++at;
-        const std::size_t from = at > 60 ? at - 60 : 0;
-        return "meta data " + item.key + " at byte " + std::to_string(at) + ": ..." +
-               x.substr(from, 120) + " / ..." + y.substr(from, 120);
-      }
-    }
-    return "layout only";
   }
 
   // Moves the sculpt's vertices within `radius` of a random vertex by a smooth bump.

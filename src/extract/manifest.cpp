@@ -1,0 +1,169 @@
+// ReadExtractManifest: an asset's shapes from several files, each with its own options.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "dispex/extract.h"
+
+namespace dispex {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+StatusOr<int> IntValue(const json& v) {
+  if (!v.is_number_integer()) return Status::Error(fmt::format("{} is not an integer", v.dump()));
+  return v.get<int>();
+}
+
+StatusOr<double> NumberValue(const json& v) {
+  if (!v.is_number()) return Status::Error(fmt::format("{} is not a number", v.dump()));
+  return v.get<double>();
+}
+
+StatusOr<std::string> TextValue(const json& v) {
+  if (!v.is_string()) return Status::Error(fmt::format("{} is not a string", v.dump()));
+  return v.get<std::string>();
+}
+
+// Sets one option by its ExtractOptions field name, from a value as the command line takes it.
+Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
+  auto text = [&]() { return v.is_string() ? v.get<std::string>() : v.dump(); };
+  if (name == "oversample") {
+    if (v == "auto") {
+      o.oversample = 0;
+      return Status::Ok();
+    }
+    DISPEX_ASSIGN_OR_RETURN(o.oversample, IntValue(v));
+  } else if (name == "max_oversample") {
+    DISPEX_ASSIGN_OR_RETURN(o.max_oversample, IntValue(v));
+  } else if (name == "min_oversample") {
+    DISPEX_ASSIGN_OR_RETURN(o.min_oversample, IntValue(v));
+  } else if (name == "search_distance") {
+    DISPEX_ASSIGN_OR_RETURN(o.search_distance, ParseSearchDistance(text()));
+  } else if (name == "ray_policy") {
+    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
+    DISPEX_ASSIGN_OR_RETURN(o.ray_policy, ParseHitPolicy(s));
+  } else if (name == "tolerance") {
+    DISPEX_ASSIGN_OR_RETURN(o.tolerance, NumberValue(v));
+  } else if (name == "tolerance_fraction") {
+    DISPEX_ASSIGN_OR_RETURN(o.tolerance_fraction, NumberValue(v));
+  } else if (name == "resolution_rule") {
+    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
+    DISPEX_ASSIGN_OR_RETURN(o.resolution_rule, ParseResolutionRule(s));
+  } else if (name == "nonzero_threshold") {
+    DISPEX_ASSIGN_OR_RETURN(o.nonzero_threshold, NumberValue(v));
+  } else if (name == "data_type") {
+    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
+    if (s != "float" && s != "half") return Status::Error(fmt::format("'{}': float or half", s));
+    o.data_type = s == "half" ? PtexDataType::kHalf : PtexDataType::kFloat;
+  } else if (name == "compression_level") {
+    DISPEX_ASSIGN_OR_RETURN(o.compression_level, IntValue(v));
+  } else if (name == "holes") {
+    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
+    DISPEX_ASSIGN_OR_RETURN(o.holes, ParseHolePolicy(s));
+  } else if (name == "watertight") {
+    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
+    DISPEX_ASSIGN_OR_RETURN(o.watertight, ParseWatertightEdges(s));
+  } else if (name == "max_miss_fraction") {
+    DISPEX_ASSIGN_OR_RETURN(o.max_miss_fraction, NumberValue(v));
+  } else if (name == "bvh_quality") {
+    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
+    DISPEX_ASSIGN_OR_RETURN(o.bvh_quality, ParseBuildQuality(s));
+  } else {
+    return Status::Error(
+        "unknown option (known: oversample, max_oversample, min_oversample, search_distance, "
+        "ray_policy, tolerance, tolerance_fraction, resolution_rule, nonzero_threshold, "
+        "data_type, compression_level, holes, watertight, max_miss_fraction, bvh_quality)");
+  }
+  return Status::Ok();
+}
+
+Status SetOptions(ExtractOptions& o, const json& options, const std::string& where) {
+  if (!options.is_object()) return Status::Error(where + ": not an object");
+  for (const auto& [name, value] : options.items()) {
+    Status s = SetOption(o, name, value);
+    if (!s.ok()) return s.WithPrefix(fmt::format("{}.{}", where, name));
+  }
+  return Status::Ok();
+}
+
+StatusOr<std::string> PathIn(const json& entry, const char* key, const fs::path& folder,
+                             const std::string& where) {
+  if (!entry.contains(key) || !entry[key].is_string() || entry[key].get<std::string>().empty()) {
+    return Status::Error(fmt::format("{}: no \"{}\" file", where, key));
+  }
+  const fs::path p(entry[key].get<std::string>());
+  return (p.is_absolute() ? p : folder / p).lexically_normal().string();
+}
+
+}  // namespace
+
+StatusOr<ExtractAssetOptions> ReadExtractManifest(const std::string& path,
+                                                  const ExtractAssetOptions& defaults) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::Error(fmt::format("{}: cannot be read", path));
+  std::stringstream text;
+  text << in.rdbuf();
+  const json manifest = json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
+  if (manifest.is_discarded()) return Status::Error(fmt::format("{}: not valid JSON", path));
+  if (!manifest.is_object()) return Status::Error(fmt::format("{}: not a JSON object", path));
+  const fs::path folder = fs::path(path).parent_path();
+  ExtractAssetOptions out = defaults;
+  out.manifest.clear();
+  for (const auto& [key, value] : manifest.items()) {
+    if (key != "output_dir" && key != "options" && key != "shapes") {
+      return Status::Error(fmt::format(
+          "{}: unknown key \"{}\" (known: output_dir, options, shapes)", path, key));
+    }
+  }
+  if (manifest.contains("output_dir") && out.output_dir.empty()) {
+    if (!manifest["output_dir"].is_string()) {
+      return Status::Error(fmt::format("{}: output_dir is not a string", path));
+    }
+    const fs::path dir(manifest["output_dir"].get<std::string>());
+    out.output_dir = (dir.is_absolute() ? dir : folder / dir).lexically_normal().string();
+  }
+  if (manifest.contains("options")) {
+    DISPEX_RETURN_IF_ERROR(SetOptions(out.options, manifest["options"], path + ": options"));
+  }
+  if (!manifest.contains("shapes") || !manifest["shapes"].is_array() ||
+      manifest["shapes"].empty()) {
+    return Status::Error(fmt::format("{}: \"shapes\" must be a non-empty list", path));
+  }
+  for (std::size_t i = 0; i < manifest["shapes"].size(); ++i) {
+    const json& entry = manifest["shapes"][i];
+    const std::string where = fmt::format("{}: shapes[{}]", path, i);
+    if (!entry.is_object()) return Status::Error(where + ": not an object");
+    for (const auto& [key, value] : entry.items()) {
+      if (key != "name" && key != "base" && key != "sculpt" && key != "options") {
+        return Status::Error(fmt::format(
+            "{}: unknown key \"{}\" (known: name, base, sculpt, options)", where, key));
+      }
+    }
+    AssetShapeSpec spec;
+    if (!entry.contains("name") || !entry["name"].is_string()) {
+      return Status::Error(where + ": no \"name\"");
+    }
+    spec.name = entry["name"].get<std::string>();
+    DISPEX_ASSIGN_OR_RETURN(spec.base_path, PathIn(entry, "base", folder, where));
+    DISPEX_ASSIGN_OR_RETURN(spec.sculpt_path, PathIn(entry, "sculpt", folder, where));
+    spec.options = out.options;
+    if (entry.contains("options")) {
+      DISPEX_RETURN_IF_ERROR(SetOptions(spec.options, entry["options"], where + ".options"));
+    }
+    for (const AssetShapeSpec& other : out.manifest) {
+      if (other.name == spec.name) {
+        return Status::Error(fmt::format("{}: shape '{}' is named twice", where, spec.name));
+      }
+    }
+    out.manifest.push_back(std::move(spec));
+  }
+  return out;
+}
+
+}  // namespace dispex
