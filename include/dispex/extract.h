@@ -196,6 +196,9 @@ struct ExtractReport {
   // changed ("base, sculpt, options: tolerance").
   std::string redo_reason;
   double t_keys = 0;  // computing the face keys, seconds
+  // With a given search distance: the Ptex faces whose reach the BVH holds when it holds only
+  // part of the sculpt (docs/INCREMENTAL.md); 0 when it holds all of it.
+  std::int64_t tracer_faces = 0;
 
   // Output.
   std::uint64_t bytes_written = 0;

@@ -46,6 +46,9 @@ struct MeshShape {
 // return it (face_offsets from 0 to face_indices.size()). Linear time; parallel over faces and
 // shapes; the result does not depend on the thread count.
 StatusOr<std::vector<MeshShape>> SplitShapes(const Mesh& mesh, bool require_disjoint);
+// The same, moving a single-shape mesh into its shape instead of copying it (`mesh` is then
+// left empty; with several shapes it is left as it was).
+StatusOr<std::vector<MeshShape>> SplitShapes(Mesh&& mesh, bool require_disjoint);
 
 // Safe, distinct file names (without extension) for shape names, in the same order:
 //  1. Every byte outside [A-Za-z0-9._-] becomes '_', a leading '.' becomes '_', a name longer

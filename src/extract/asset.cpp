@@ -53,14 +53,20 @@ StatusOr<std::map<std::string, Mesh>> ReadFiles(const std::vector<std::string>& 
 // The shapes of each file, split once.
 class ShapeSource {
  public:
-  explicit ShapeSource(std::map<std::string, Mesh> files) : files_(std::move(files)) {}
+  // `shared`: files read both as a base and as a sculpt, split twice from the same mesh.
+  ShapeSource(std::map<std::string, Mesh> files, std::vector<std::string> shared)
+      : files_(std::move(files)), shared_(std::move(shared)) {}
 
   StatusOr<std::vector<MeshShape>*> Shapes(const std::string& path, bool base) {
     auto& cache = base ? base_shapes_ : sculpt_shapes_;
     auto it = cache.find(path);
     if (it == cache.end()) {
+      // A file that is only a base or only a sculpt gives its arrays to a single shape.
+      const bool both = std::find(shared_.begin(), shared_.end(), path) != shared_.end();
+      Mesh& mesh = files_.at(path);
       DISPEX_ASSIGN_OR_RETURN(std::vector<MeshShape> shapes,
-                              SplitShapes(files_.at(path), /*require_disjoint=*/base));
+                              both ? SplitShapes(static_cast<const Mesh&>(mesh), base)
+                                   : SplitShapes(std::move(mesh), base));
       it = cache.emplace(path, std::move(shapes)).first;
     }
     return &it->second;
@@ -68,6 +74,7 @@ class ShapeSource {
 
  private:
   std::map<std::string, Mesh> files_;
+  std::vector<std::string> shared_;
   std::map<std::string, std::vector<MeshShape>> base_shapes_, sculpt_shapes_;
 };
 
@@ -96,6 +103,7 @@ StatusOr<std::vector<ShapeJob>> PlanFromManifest(const ExtractAssetOptions& o,
   for (const AssetShapeSpec& spec : o.manifest) names.push_back(spec.name);
   const std::vector<std::string> files = ShapeFileNames(names);
   std::vector<ShapeJob> jobs;
+  std::map<std::pair<std::string, std::size_t>, std::string> taken;  // shape -> entry
   for (std::size_t i = 0; i < o.manifest.size(); ++i) {
     const AssetShapeSpec& spec = o.manifest[i];
     DISPEX_ASSIGN_OR_RETURN(std::vector<MeshShape> * base, source.Shapes(spec.base_path, true));
@@ -107,8 +115,18 @@ StatusOr<std::vector<ShapeJob>> PlanFromManifest(const ExtractAssetOptions& o,
         base->size() == 1 ? std::span<const std::string>() : std::span(selected);
     DISPEX_ASSIGN_OR_RETURN(
         ShapeMatch match, MatchShapes(*base, *sculpt, selection, spec.base_path, spec.sculpt_path));
-    ShapeJob job{spec.name, spec.options, (*base)[match.base_index[0]].mesh,
-                 (*sculpt)[match.sculpt_index[0]].mesh};
+    // Each shape of a file serves one entry, which takes its arrays.
+    for (const auto& [path, index] :
+         {std::pair(spec.base_path, match.base_index[0]),
+          std::pair("sculpt " + spec.sculpt_path, match.sculpt_index[0])}) {
+      const auto [at, inserted] = taken.emplace(std::pair(path, index), spec.name);
+      if (!inserted) {
+        return Status::Error(fmt::format("shapes '{}' and '{}' use the same shape of {}",
+                                         at->second, spec.name, path));
+      }
+    }
+    ShapeJob job{spec.name, spec.options, std::move((*base)[match.base_index[0]].mesh),
+                 std::move((*sculpt)[match.sculpt_index[0]].mesh)};
     job.options.base_path = spec.base_path;
     job.options.sculpt_path = spec.sculpt_path;
     job.options.output_path = (fs::path(o.output_dir) / (files[i] + ".ptx")).string();
@@ -123,23 +141,29 @@ StatusOr<AssetReport> ExtractAssetInArena(const ExtractAssetOptions& o, int thre
   report.version = DISPEX_VERSION_STRING;
   report.output_dir = o.output_dir;
 
-  std::vector<std::string> paths;
+  std::vector<std::string> bases, sculpts;
   if (o.manifest.empty()) {
-    paths = {o.options.base_path, o.options.sculpt_path};
+    bases = {o.options.base_path};
+    sculpts = {o.options.sculpt_path};
   } else {
     for (const AssetShapeSpec& spec : o.manifest) {
-      paths.push_back(spec.base_path);
-      paths.push_back(spec.sculpt_path);
+      bases.push_back(spec.base_path);
+      sculpts.push_back(spec.sculpt_path);
     }
+  }
+  std::vector<std::string> paths = bases, shared;
+  for (const std::string& p : sculpts) {
+    paths.push_back(p);
+    if (std::find(bases.begin(), bases.end(), p) != bases.end()) shared.push_back(p);
   }
   Stopwatch read_clock;
   DISPEX_ASSIGN_OR_RETURN(auto files, ReadFiles(paths, o.options.threads));
   report.t_read = read_clock.seconds();
   if (CancelRequested()) return Cancelled();
-  ShapeSource source(std::move(files));
-  DISPEX_ASSIGN_OR_RETURN(std::vector<ShapeJob> jobs,
-                          o.manifest.empty() ? PlanFromFiles(o, source, report.warnings)
-                                             : PlanFromManifest(o, source));
+  ShapeSource source(std::move(files), std::move(shared));
+  DISPEX_ASSIGN_OR_RETURN(
+      std::vector<ShapeJob> jobs,
+      o.manifest.empty() ? PlanFromFiles(o, source, report.warnings) : PlanFromManifest(o, source));
   std::error_code ec;
   fs::create_directories(o.output_dir, ec);
   if (ec) {
@@ -160,9 +184,9 @@ StatusOr<AssetReport> ExtractAssetInArena(const ExtractAssetOptions& o, int thre
     const std::uint64_t memory_limit = MemoryLimit(job.options);
     auto inputs = InputsFromMeshes(job.options, std::move(job.base), std::move(job.sculpt),
                                    memory_limit, shape_report);
-    auto done = inputs.ok() ? ExtractShape(job.options, std::move(*inputs),
-                                           std::move(shape_report), clock)
-                            : StatusOr<ExtractReport>(inputs.status());
+    auto done = inputs.ok()
+                    ? ExtractShape(job.options, std::move(*inputs), std::move(shape_report), clock)
+                    : StatusOr<ExtractReport>(inputs.status());
     if (!done.ok()) {
       return error.Record(static_cast<int>(i),
                           done.status().WithPrefix(fmt::format("shape '{}'", job.name)));

@@ -85,8 +85,8 @@ std::int64_t Texels(const ProcessedFaces& processed, const ExtractInputs& inputs
 
 }  // namespace
 
-Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
-                  ProcessedFaces& faces, ExtractReport& report) {
+Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, ProcessedFaces& faces,
+                  ExtractReport& report) {
   const double budget = settings.edge_step_budget;
   const bool per_face = settings.watertight == WatertightEdges::kAll;
   const std::vector<std::uint8_t> sharp = SharpCreaseEdges(inputs.base, inputs.surface);

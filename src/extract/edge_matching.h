@@ -21,8 +21,8 @@ namespace dispex::extract {
 // infinitely sharp creases and beside faces whose data may jump (ListDiscontinuousFaces) are
 // not held. Fills the report's edge fields but the discontinuous ones. Deterministic:
 // decisions depend only on the texels.
-Status MatchEdges(const ExtractInputs& inputs, const ExtractSettings& settings,
-                  ProcessedFaces& faces, ExtractReport& report);
+Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, ProcessedFaces& faces,
+                  ExtractReport& report);
 
 // Faces whose displacement may jump (samples filled over holes of the sculpt, other-sheet hits,
 // no hit at all) into report.discontinuous_faces, and the edges beside them into

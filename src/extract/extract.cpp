@@ -79,6 +79,52 @@ std::string RedoReason(const PreviousMap& previous, const ExtractReport& report)
   return out;
 }
 
+// Faces the edge pass re-extracts lie near those whose first pass runs (it raises a ring of
+// faces per round, in at most 8 rounds, and most raises are beside the faces that changed):
+// the local tracer covers this many rings around them, and the whole sculpt's tracer is built
+// if the edge pass asks for a face beyond (EnsureTraced).
+constexpr int kLocalRings = 2;
+
+// The tracer of an incremental run with a given search distance: the sculpt within reach of
+// the faces whose first pass runs (not copied) and of the faces kLocalRings around them; the
+// whole sculpt when that is most of it.
+Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previous,
+                        std::span<const Hash128> keys, const ExtractSettings& settings,
+                        ExtractInputs& inputs, ExtractReport& report) {
+  const auto n = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
+  std::vector<std::uint8_t> traced(n, 0);
+  std::vector<int> ring;
+  for (std::size_t f = 0; f < n; ++f) {
+    if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
+    if (!previous.Reusable(f, keys[f])) {
+      traced[f] = 1;
+      ring.push_back(static_cast<int>(f));
+    }
+  }
+  for (int step = 0; step < kLocalRings && !ring.empty(); ++step) {
+    std::vector<int> next;
+    for (int f : ring) {
+      for (std::int32_t g : inputs.faces[static_cast<std::size_t>(f)].adjfaces) {
+        if (g >= 0 && !traced[static_cast<std::size_t>(g)]) {
+          traced[static_cast<std::size_t>(g)] = 1;
+          next.push_back(g);
+        }
+      }
+    }
+    ring = std::move(next);
+  }
+  const auto count = static_cast<std::size_t>(std::count(traced.begin(), traced.end(), 1));
+  inputs.tracer_options.quality = options.bvh_quality;
+  inputs.tracer_options.isa = options.embree_isa;
+  inputs.tracer_options.scale = TracerScale(inputs.base);
+  if (2 * count > n) return BuildTracer(options, inputs, report);
+  Stopwatch clock;
+  Mesh part = SculptWithinReach(inputs, settings, traced);
+  report.t_bvh = clock.seconds();
+  report.tracer_faces = static_cast<std::int64_t>(count);
+  return BuildPartTracer(std::move(part), std::move(traced), inputs, report);
+}
+
 // Several disjoint shapes are ExtractAsset's: one map per shape.
 Status CheckOneShape(const ExtractOptions& options, const Mesh& base) {
   if (base.group_names.size() < 2) return Status::Ok();
@@ -135,11 +181,17 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
     if (!previous.notice().empty()) report.warnings.push_back(previous.notice());
     report.redo_reason = RedoReason(previous, report);
   }
-  DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
+  // The automatic search distance is estimated with rays over the whole surface; a given one
+  // lets a re-run trace only the sculpt within reach of the faces it extracts.
+  const bool local = options.incremental && previous.usable() &&
+                     options.search_distance.kind != SearchDistanceSpec::Kind::kAuto;
+  if (!local) DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
   DISPEX_ASSIGN_OR_RETURN(ExtractSettings settings, ResolveSettings(options, inputs, report));
   Stopwatch keys_clock;
   const std::vector<Hash128> keys = ComputeFaceKeys(inputs, settings);
   report.t_keys = keys_clock.seconds();
+  if (local)
+    DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, keys, settings, inputs, report));
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateMap(options, inputs));
 
   Stopwatch faces_clock;
@@ -152,6 +204,7 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   DISPEX_RETURN_IF_ERROR(FillMissedFaces(options, inputs, faces, writer, report));
   if (settings.watertight != WatertightEdges::kOff) {
     DISPEX_RETURN_IF_ERROR(MatchEdges(inputs, settings, faces, report));
+    if (inputs.widened) report.tracer += "; then the whole sculpt, for faces the edges raised";
     DISPEX_RETURN_IF_ERROR(WriteKeptFaces(writer, inputs, faces));
   }
   ListDiscontinuousFaces(inputs, faces, report);

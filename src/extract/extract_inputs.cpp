@@ -17,17 +17,6 @@ namespace dispex::extract {
 
 namespace {
 
-// The power of two at or above the base's largest |coordinate|: the magnitude of the ray
-// origins, and independent of the sculpt.
-float TracerScale(const Mesh& base) {
-  const BoundingBox box = ComputeBounds(base);
-  float largest = 0;
-  for (float c : {box.min.x, box.min.y, box.min.z, box.max.x, box.max.y, box.max.z}) {
-    largest = std::max(largest, std::fabs(c));
-  }
-  return largest > 0 ? std::exp2(std::ceil(std::log2(largest))) : 1.0f;
-}
-
 std::string Fingerprint(const Mesh& mesh) {
   return "xxh3-128:" + MeshContentKey(mesh).Hex();
 }
@@ -107,8 +96,15 @@ StatusOr<ExtractInputs> FinishInputs(const ExtractOptions& options, MeshesRead m
   ReportMeshes(options, meshes, report);
   DISPEX_RETURN_IF_ERROR(CheckMemoryForInputs(options, meshes, memory_limit));
   std::vector<PtexFaceInfo> faces = PtexFaceTable(meshes.surface);
-  return ExtractInputs{std::move(meshes.base), std::move(meshes.sculpt), std::move(meshes.surface),
-                       std::move(faces), nullptr};
+  return ExtractInputs{std::move(meshes.base),
+                       std::move(meshes.sculpt),
+                       std::move(meshes.surface),
+                       std::move(faces),
+                       nullptr,
+                       {},
+                       {},
+                       false,
+                       {}};
 }
 
 }  // namespace
@@ -131,16 +127,53 @@ StatusOr<ExtractInputs> InputsFromMeshes(const ExtractOptions& options, Mesh bas
                       memory_limit, report);
 }
 
+float TracerScale(const Mesh& base) {
+  const BoundingBox box = ComputeBounds(base);
+  float largest = 0;
+  for (float c : {box.min.x, box.min.y, box.min.z, box.max.x, box.max.y, box.max.z}) {
+    largest = std::max(largest, std::fabs(c));
+  }
+  return largest > 0 ? std::exp2(std::ceil(std::log2(largest))) : 1.0f;
+}
+
 Status BuildTracer(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report) {
   Stopwatch clock;
-  TracerOptions tracer_options;
-  tracer_options.quality = options.bvh_quality;
-  tracer_options.isa = options.embree_isa;
-  tracer_options.scale = TracerScale(inputs.base);
-  DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, tracer_options));
-  report.t_bvh = clock.seconds();
+  inputs.tracer_options.quality = options.bvh_quality;
+  inputs.tracer_options.isa = options.embree_isa;
+  inputs.tracer_options.scale = TracerScale(inputs.base);
+  inputs.traced.clear();
+  DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, inputs.tracer_options));
+  report.t_bvh += clock.seconds();
   report.tracer = inputs.tracer->stats().backend;
   if (CancelRequested()) return Cancelled();
+  return Status::Ok();
+}
+
+Status BuildPartTracer(Mesh part, std::vector<std::uint8_t> traced, ExtractInputs& inputs,
+                       ExtractReport& report) {
+  Stopwatch clock;
+  inputs.tracer.reset();
+  inputs.traced_part = std::move(part);
+  DISPEX_ASSIGN_OR_RETURN(inputs.tracer,
+                          MakeEmbreeTracer(inputs.traced_part, inputs.tracer_options));
+  inputs.traced = std::move(traced);
+  report.t_bvh += clock.seconds();
+  report.tracer = inputs.tracer->stats().backend + fmt::format(", {} of {} sculpt faces",
+                                                               inputs.traced_part.num_faces(),
+                                                               inputs.sculpt.num_faces());
+  return Status::Ok();
+}
+
+Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces) {
+  if (inputs.traced.empty()) return Status::Ok();
+  for (int f : faces) {
+    if (inputs.traced[static_cast<std::size_t>(f)]) continue;
+    DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, inputs.tracer_options));
+    inputs.traced.clear();
+    inputs.traced_part = Mesh{};
+    inputs.widened = true;
+    return Status::Ok();
+  }
   return Status::Ok();
 }
 

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "dispex/extract.h"
@@ -20,6 +21,14 @@ struct ExtractInputs {
   LimitSurface surface;             // of the base
   std::vector<PtexFaceInfo> faces;  // the map's face table, from `surface`
   std::unique_ptr<Tracer> tracer;   // the sculpt's BVH; reads the sculpt's arrays
+  // An incremental run may trace against only the part of the sculpt that the faces it
+  // extracts can reach (BuildLocalTracer): `traced` flags those Ptex faces, and EnsureTraced
+  // swaps in the whole sculpt's tracer before any other face is extracted. Empty: the tracer
+  // holds the whole sculpt.
+  std::vector<std::uint8_t> traced;
+  Mesh traced_part;      // the part of the sculpt that tracer reads, when it reads a part
+  bool widened = false;  // EnsureTraced replaced a part's tracer by the whole sculpt's
+  TracerOptions tracer_options;
 };
 
 // Reads the sculpt while the base is read and its limit surface built, fingerprints both
@@ -34,7 +43,20 @@ StatusOr<ExtractInputs> ReadInputs(const ExtractOptions& options, std::uint64_t 
 StatusOr<ExtractInputs> InputsFromMeshes(const ExtractOptions& options, Mesh base, Mesh sculpt,
                                          std::uint64_t memory_limit, ExtractReport& report);
 
+// The power of two at or above the base's largest |coordinate|: the tracer's scale
+// (TracerOptions::scale), the magnitude of the ray origins, and independent of the sculpt.
+float TracerScale(const Mesh& base);
+
 // The sculpt's BVH.
 Status BuildTracer(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report);
+
+// The BVH of `part` (sculpt faces, BuildLocalTracer's choice; kept in `inputs` for the tracer
+// to read) for the Ptex faces `traced` flags.
+Status BuildPartTracer(Mesh part, std::vector<std::uint8_t> traced, ExtractInputs& inputs,
+                       ExtractReport& report);
+
+// Before `faces` are extracted: the whole sculpt's tracer if the current one does not hold
+// everything their rays can reach.
+Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces);
 
 }  // namespace dispex::extract

@@ -21,7 +21,8 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
     j["incremental"] = {{"unchanged", r.unchanged},
                         {"faces_copied", r.faces_copied},
                         {"faces_extracted", r.faces_extracted},
-                        {"redo_reason", r.redo_reason}};
+                        {"redo_reason", r.redo_reason},
+                        {"tracer_faces", r.tracer_faces}};
   }
   j["options"] = extract::ExtractOptionsJson(r.options);
   j["threads"] = r.threads;

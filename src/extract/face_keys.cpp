@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
@@ -17,12 +18,6 @@ namespace {
 
 struct Box {
   std::array<float, 3> lower{}, upper{};
-  bool Meets(const Box& other) const {
-    for (int k = 0; k < 3; ++k) {
-      if (lower[k] > other.upper[k] || other.lower[k] > upper[k]) return false;
-    }
-    return true;
-  }
 };
 
 // The region each Ptex face's rays can reach: its patch's box grown by the longest search,
@@ -48,10 +43,13 @@ std::vector<Box> ReachBoxes(const LimitSurface& surface, const std::vector<BaseF
   return boxes;
 }
 
-// The reach boxes binned in a uniform grid of about one box per cell.
-class BoxGrid {
+// A uniform grid over the reach boxes, `per_side` cells per (median) box side, at most
+// kMaxCells cells.
+class CellGrid {
  public:
-  BoxGrid(const std::vector<Box>& boxes, const std::vector<std::uint8_t>& skip) : boxes_(boxes) {
+  static constexpr std::size_t kMaxCells = std::size_t{1} << 20;
+
+  CellGrid(const std::vector<Box>& boxes, const std::vector<std::uint8_t>& skip, double per_side) {
     bounds_.lower = {INFINITY, INFINITY, INFINITY};
     bounds_.upper = {-INFINITY, -INFINITY, -INFINITY};
     std::vector<float> sides;
@@ -67,52 +65,35 @@ class BoxGrid {
     }
     if (sides.empty()) return;
     std::nth_element(sides.begin(), sides.begin() + sides.size() / 2, sides.end());
-    // At most about eight cells per box.
-    double volume = 1;
-    for (int k = 0; k < 3; ++k) {
-      volume *= std::max(double(bounds_.upper[k]) - double(bounds_.lower[k]), 1e-30);
+    double cell_side = std::max<double>(sides[sides.size() / 2] / per_side, 1e-30);
+    for (;; cell_side *= 1.25) {
+      std::size_t total = 1;
+      for (int k = 0; k < 3; ++k) {
+        const double span = double(bounds_.upper[k]) - double(bounds_.lower[k]);
+        dims_[k] = static_cast<int>(std::clamp(std::ceil(span / cell_side), 1.0, 1024.0));
+        scale_[k] = span > 0 ? dims_[k] / span : 0;
+        total *= static_cast<std::size_t>(dims_[k]);
+      }
+      if (total <= kMaxCells) break;
     }
-    const double cell_side = std::max<double>(
-        {sides[sides.size() / 2], std::cbrt(volume / (8.0 * double(sides.size()))), 1e-30});
-    for (int k = 0; k < 3; ++k) {
-      const double span = double(bounds_.upper[k]) - double(bounds_.lower[k]);
-      dims_[k] = static_cast<int>(std::clamp(std::ceil(span / cell_side), 1.0, 256.0));
-      scale_[k] = span > 0 ? dims_[k] / span : 0;
-    }
-    cells_.assign(static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2] + 1, 0);
-    // Two passes (count, fill) into flat arrays.
-    std::vector<std::int32_t> counts(cells_.size(), 0);
-    ForCells(skip, [&](std::size_t cell, std::int32_t) { ++counts[cell]; });
-    for (std::size_t c = 0; c + 1 < cells_.size(); ++c) cells_[c + 1] = cells_[c] + counts[c];
-    members_.resize(static_cast<std::size_t>(cells_.back()));
-    std::fill(counts.begin(), counts.end(), 0);
-    ForCells(skip, [&](std::size_t cell, std::int32_t f) {
-      members_[static_cast<std::size_t>(cells_[cell] + counts[cell]++)] = f;
-    });
   }
 
-  // Calls visit(face) once for every reach box that meets `box`.
+  std::size_t num_cells() const { return static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2]; }
+  // The cell of a point; points outside the grid go to the nearest border cell.
+  std::size_t CellOf(const std::array<float, 3>& p) const {
+    return Index(Cell(p[0], 0), Cell(p[1], 1), Cell(p[2], 2));
+  }
+  // Calls visit(cell) for every cell that meets `box` grown by `grow` on every side.
   template <class Visit>
-  void ForEachMeeting(const Box& box, Visit visit) const {
-    if (members_.empty() || !box.Meets(bounds_)) return;
-    const auto [lo, hi] = CellRange(box);
+  void ForEachCell(const Box& box, float grow, Visit visit) const {
+    std::array<int, 3> lo, hi;
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = Cell(box.lower[k] - grow, k);
+      hi[k] = Cell(box.upper[k] + grow, k);
+    }
     for (int z = lo[2]; z <= hi[2]; ++z) {
       for (int y = lo[1]; y <= hi[1]; ++y) {
-        for (int x = lo[0]; x <= hi[0]; ++x) {
-          const std::size_t cell = Index(x, y, z);
-          for (std::int32_t k = cells_[cell]; k < cells_[cell + 1]; ++k) {
-            const std::int32_t f = members_[static_cast<std::size_t>(k)];
-            const Box& other = boxes_[static_cast<std::size_t>(f)];
-            if (!box.Meets(other)) continue;
-            // A pair met in several cells counts in the cell of its overlap's lower corner.
-            std::array<float, 3> corner;
-            for (int a = 0; a < 3; ++a) corner[a] = std::max(box.lower[a], other.lower[a]);
-            if (Index(Cell(corner[0], 0), Cell(corner[1], 1), Cell(corner[2], 2)) != cell) {
-              continue;
-            }
-            visit(f);
-          }
-        }
+        for (int x = lo[0]; x <= hi[0]; ++x) visit(Index(x, y, z));
       }
     }
   }
@@ -125,69 +106,84 @@ class BoxGrid {
   std::size_t Index(int x, int y, int z) const {
     return (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0] + x;
   }
-  std::pair<std::array<int, 3>, std::array<int, 3>> CellRange(const Box& b) const {
-    std::array<int, 3> lo, hi;
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = Cell(b.lower[k], k);
-      hi[k] = Cell(b.upper[k], k);
-    }
-    return {lo, hi};
-  }
-  template <class Add>
-  void ForCells(const std::vector<std::uint8_t>& skip, Add add) const {
-    for (std::size_t f = 0; f < boxes_.size(); ++f) {
-      if (skip[f]) continue;
-      const auto [lo, hi] = CellRange(boxes_[f]);
-      for (int z = lo[2]; z <= hi[2]; ++z) {
-        for (int y = lo[1]; y <= hi[1]; ++y) {
-          for (int x = lo[0]; x <= hi[0]; ++x) add(Index(x, y, z), static_cast<std::int32_t>(f));
-        }
-      }
-    }
-  }
 
-  const std::vector<Box>& boxes_;
   Box bounds_;
   std::array<int, 3> dims_{1, 1, 1};
   std::array<double, 3> scale_{0, 0, 0};
-  std::vector<std::int32_t> cells_;    // CSR offsets, one past the last cell at the end
-  std::vector<std::int32_t> members_;  // face ids, cell after cell
 };
 
-// The order-free sum of the keys of the sculpt faces each reach box meets.
+struct FaceBounds {
+  std::array<float, 3> centre;
+  float half_extent = 0;  // rounded up: the centre may sit an ulp off the middle
+};
+
+FaceBounds Bounds(const Mesh& sculpt, std::size_t s) {
+  std::array<float, 3> lower{INFINITY, INFINITY, INFINITY};
+  std::array<float, 3> upper{-INFINITY, -INFINITY, -INFINITY};
+  for (std::int32_t v : sculpt.face(s)) {
+    const Float3& p = sculpt.positions[static_cast<std::size_t>(v)];
+    const std::array<float, 3> xyz{p.x, p.y, p.z};
+    for (int k = 0; k < 3; ++k) {
+      lower[k] = std::min(lower[k], xyz[k]);
+      upper[k] = std::max(upper[k], xyz[k]);
+    }
+  }
+  FaceBounds b;
+  for (int k = 0; k < 3; ++k) {
+    b.centre[k] = 0.5f * (lower[k] + upper[k]);
+    b.half_extent = std::max(
+        b.half_extent,
+        std::nextafter(std::max(upper[k] - b.centre[k], b.centre[k] - lower[k]), INFINITY));
+  }
+  return b;
+}
+
+// The longest distance a query's rays go.
+double Reach(const ExtractSettings& settings) {
+  return std::max<double>(settings.query.distance, settings.retry_query.distance);
+}
+
+// Per reach box, the order-free sum of the keys of the sculpt faces that can meet it: each
+// sculpt face's key is added to the cell of its centroid, and a box sums the cells within the
+// largest half-extent of a sculpt face from it (every face whose bounding box meets the box has
+// its centroid there; faces in those cells that do not meet it only make the key change more
+// often than it must).
 std::vector<Hash128> SculptReachKeys(const Mesh& sculpt, const std::vector<Box>& boxes,
                                      const std::vector<std::uint8_t>& skip) {
-  const BoxGrid grid(boxes, skip);
-  tbb::combinable<std::vector<Hash128>> sums([&] { return std::vector<Hash128>(boxes.size()); });
+  const CellGrid grid(boxes, skip, /*per_side=*/2);
+  struct Sums {
+    std::vector<Hash128> cells;
+    float half_extent = 0;
+  };
+  tbb::combinable<Sums> sums([&] { return Sums{std::vector<Hash128>(grid.num_cells()), 0.0f}; });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sculpt.num_faces(), 1 << 14),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      std::vector<Hash128>& keys = sums.local();
+                      Sums& local = sums.local();
                       std::vector<float> corners;
                       for (std::size_t s = range.begin(); s != range.end(); ++s) {
-                        const std::span<const std::int32_t> face = sculpt.face(s);
-                        Box box;
-                        box.lower = {INFINITY, INFINITY, INFINITY};
-                        box.upper = {-INFINITY, -INFINITY, -INFINITY};
                         corners.clear();
-                        for (std::int32_t v : face) {
+                        for (std::int32_t v : sculpt.face(s)) {
                           const Float3& p = sculpt.positions[static_cast<std::size_t>(v)];
-                          const std::array<float, 3> xyz{p.x, p.y, p.z};
-                          for (int k = 0; k < 3; ++k) {
-                            box.lower[k] = std::min(box.lower[k], xyz[k]);
-                            box.upper[k] = std::max(box.upper[k], xyz[k]);
-                            corners.push_back(xyz[k]);
-                          }
+                          corners.insert(corners.end(), {p.x, p.y, p.z});
                         }
-                        const Hash128 key = HashBytes(std::as_bytes(std::span(corners)));
-                        grid.ForEachMeeting(
-                            box, [&](std::int32_t f) { keys[static_cast<std::size_t>(f)] += key; });
+                        const FaceBounds b = Bounds(sculpt, s);
+                        local.half_extent = std::max(local.half_extent, b.half_extent);
+                        local.cells[grid.CellOf(b.centre)] +=
+                            HashBytes(std::as_bytes(std::span(corners)));
                       }
                     });
-  std::vector<Hash128> total(boxes.size());
-  sums.combine_each([&](const std::vector<Hash128>& part) {
-    for (std::size_t f = 0; f < total.size(); ++f) total[f] += part[f];
+  std::vector<Hash128> cells(grid.num_cells());
+  float half_extent = 0;
+  sums.combine_each([&](const Sums& part) {
+    for (std::size_t c = 0; c < cells.size(); ++c) cells[c] += part.cells[c];
+    half_extent = std::max(half_extent, part.half_extent);
   });
-  return total;
+  std::vector<Hash128> keys(boxes.size());
+  tbb::parallel_for(std::size_t{0}, boxes.size(), [&](std::size_t f) {
+    if (skip[f]) return;
+    grid.ForEachCell(boxes[f], half_extent, [&](std::size_t c) { keys[f] += cells[c]; });
+  });
+  return keys;
 }
 
 }  // namespace
@@ -226,13 +222,12 @@ std::vector<Hash128> ComputeFaceKeys(const ExtractInputs& inputs, const ExtractS
   const LimitSurface& surface = inputs.surface;
   const auto num_faces = static_cast<std::size_t>(surface.num_ptex_faces());
   const std::vector<BaseFacePatch> patches = BaseFacePatches(surface);
-  const double reach = std::max<double>(settings.query.distance, settings.retry_query.distance);
-  const std::vector<Box> boxes = ReachBoxes(surface, patches, reach);
+  const std::vector<Box> boxes = ReachBoxes(surface, patches, Reach(settings));
   std::vector<std::uint8_t> skip(num_faces);
   for (std::size_t f = 0; f < num_faces; ++f) skip[f] = surface.is_hole(PtexFaceId(int(f)));
   const std::vector<Hash128> sculpt = SculptReachKeys(inputs.sculpt, boxes, skip);
   Hasher global;
-  global.Add(SettingsKey(settings)).Add(inputs.tracer->stats().scale);
+  global.Add(SettingsKey(settings)).Add(TracerScale(inputs.base));
   const Hash128 settings_key = global.Digest();
 
   std::vector<Hash128> keys(num_faces);
@@ -247,6 +242,61 @@ std::vector<Hash128> ComputeFaceKeys(const ExtractInputs& inputs, const ExtractS
     keys[f] = h.Digest();
   });
   return keys;
+}
+
+Mesh SculptWithinReach(const ExtractInputs& inputs, const ExtractSettings& settings,
+                       std::span<const std::uint8_t> faces) {
+  const LimitSurface& surface = inputs.surface;
+  const Mesh& sculpt = inputs.sculpt;
+  const std::vector<Box> boxes = ReachBoxes(surface, BaseFacePatches(surface), Reach(settings));
+  std::vector<std::uint8_t> skip(boxes.size());
+  for (std::size_t f = 0; f < boxes.size(); ++f) {
+    skip[f] = !faces[f] || surface.is_hole(PtexFaceId(static_cast<int>(f)));
+  }
+  // Finer than the keys' grid: the part of the sculpt to build a BVH of is found once.
+  const CellGrid grid(boxes, skip, /*per_side=*/6);
+  // The largest half-extent of a sculpt face, then every face whose centre's cell a box reaches.
+  const float half_extent = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, sculpt.num_faces(), 1 << 14), 0.0f,
+      [&](const tbb::blocked_range<std::size_t>& range, float largest) {
+        for (std::size_t s = range.begin(); s != range.end(); ++s) {
+          const FaceBounds b = Bounds(sculpt, s);
+          largest = std::max(largest, b.half_extent);
+        }
+        return largest;
+      },
+      [](float a, float b) { return std::max(a, b); });
+  std::vector<std::uint8_t> marked(grid.num_cells(), 0);
+  for (std::size_t f = 0; f < boxes.size(); ++f) {
+    if (!skip[f]) grid.ForEachCell(boxes[f], half_extent, [&](std::size_t c) { marked[c] = 1; });
+  }
+  std::vector<std::uint8_t> keep(sculpt.num_faces());
+  tbb::parallel_for(std::size_t{0}, sculpt.num_faces(), [&](std::size_t s) {
+    keep[s] = marked[grid.CellOf(Bounds(sculpt, s).centre)];
+  });
+  // The kept faces in their order, their vertices renumbered in ascending order.
+  std::vector<std::int32_t> vertex(sculpt.num_vertices(), -1);
+  Mesh part;
+  part.source = sculpt.source;
+  part.face_offsets.push_back(0);
+  for (std::size_t s = 0; s < sculpt.num_faces(); ++s) {
+    if (!keep[s]) continue;
+    for (std::int32_t v : sculpt.face(s)) vertex[static_cast<std::size_t>(v)] = 0;
+  }
+  for (std::size_t v = 0; v < vertex.size(); ++v) {
+    if (vertex[v] < 0) continue;
+    vertex[v] = static_cast<std::int32_t>(part.positions.size());
+    part.positions.push_back(sculpt.positions[v]);
+  }
+  part.positions.reserve(part.positions.size() + 1);
+  for (std::size_t s = 0; s < sculpt.num_faces(); ++s) {
+    if (!keep[s]) continue;
+    for (std::int32_t v : sculpt.face(s)) {
+      part.face_indices.push_back(vertex[static_cast<std::size_t>(v)]);
+    }
+    part.face_offsets.push_back(static_cast<std::uint32_t>(part.face_indices.size()));
+  }
+  return part;
 }
 
 }  // namespace dispex::extract

@@ -2,6 +2,7 @@
 // key: incremental extraction re-uses a face whose key is unchanged.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "core/hash128.h"
@@ -24,5 +25,11 @@ Hash128 SettingsKey(const ExtractSettings& settings);
 // distance and a margin), as an order-free sum of each sculpt face's key (its corners' positions,
 // in order). The keys do not depend on the thread count.
 std::vector<Hash128> ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings);
+
+// The sculpt faces the rays of the flagged Ptex faces can reach (a superset: those ComputeFaceKeys
+// sums for them), their vertices renumbered in ascending order: enough to trace those faces
+// exactly as against the whole sculpt.
+Mesh SculptWithinReach(const ExtractInputs& inputs, const ExtractSettings& settings,
+                       std::span<const std::uint8_t> faces);
 
 }  // namespace dispex::extract

@@ -117,8 +117,8 @@ StatusOr<ExtractAssetOptions> ReadExtractManifest(const std::string& path,
   out.manifest.clear();
   for (const auto& [key, value] : manifest.items()) {
     if (key != "output_dir" && key != "options" && key != "shapes") {
-      return Status::Error(fmt::format(
-          "{}: unknown key \"{}\" (known: output_dir, options, shapes)", path, key));
+      return Status::Error(
+          fmt::format("{}: unknown key \"{}\" (known: output_dir, options, shapes)", path, key));
     }
   }
   if (manifest.contains("output_dir") && out.output_dir.empty()) {
@@ -141,8 +141,8 @@ StatusOr<ExtractAssetOptions> ReadExtractManifest(const std::string& path,
     if (!entry.is_object()) return Status::Error(where + ": not an object");
     for (const auto& [key, value] : entry.items()) {
       if (key != "name" && key != "base" && key != "sculpt" && key != "options") {
-        return Status::Error(fmt::format(
-            "{}: unknown key \"{}\" (known: name, base, sculpt, options)", where, key));
+        return Status::Error(
+            fmt::format("{}: unknown key \"{}\" (known: name, base, sculpt, options)", where, key));
       }
     }
     AssetShapeSpec spec;

@@ -164,9 +164,10 @@ StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const Extract
   return out;
 }
 
-Status ReprocessFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
+Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
                       std::span<const int> faces, std::span<const std::array<int, 2>> least_log2,
                       ProcessedFaces& processed) {
+  DISPEX_RETURN_IF_ERROR(EnsureTraced(inputs, faces));
   tbb::enumerable_thread_specific<FaceScratch> scratches(
       [&] { return FaceScratch(inputs.surface); });
   auto process = [&](PtexFaceId face, FaceScratch& w) -> Status {

@@ -50,8 +50,10 @@ StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const Extract
                                       bool progress, PtexWriter& writer);
 
 // Runs ProcessFace again for `faces` with their least resolutions (`least_log2`, per Ptex
-// face), replacing their kept texels and statistics; the rays cast count in the totals.
-Status ReprocessFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
+// face), replacing their kept texels and statistics; the rays cast count in the totals. Swaps
+// in the whole sculpt's tracer first when the current one does not hold their reach
+// (EnsureTraced).
+Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
                       std::span<const int> faces, std::span<const std::array<int, 2>> least_log2,
                       ProcessedFaces& processed);
 

@@ -479,12 +479,17 @@ std::string SourceStem(const std::string& source) {
   return stem.empty() ? std::string("mesh") : stem;
 }
 
-// The shape of a mesh without groups or with one: the whole mesh.
-MeshShape WholeMesh(const Mesh& mesh, std::string name) {
+// The shape of a mesh without groups or with one: the whole mesh (moved from `owned` when
+// given, else copied).
+MeshShape WholeMesh(const Mesh& mesh, Mesh* owned, std::string name) {
   MeshShape shape;
   shape.file_name = ShapeFileNames(std::span<const std::string>(&name, 1))[0];
   shape.name = std::move(name);
-  shape.mesh = mesh;
+  if (owned != nullptr) {
+    shape.mesh = std::move(*owned);
+  } else {
+    shape.mesh = mesh;
+  }
   std::vector<std::int32_t>().swap(shape.mesh.face_groups);
   std::vector<std::string>().swap(shape.mesh.group_names);
   shape.mesh.positions.reserve(shape.mesh.positions.size() + 1);
@@ -555,18 +560,23 @@ Status CheckDistinctNames(std::span<const MeshShape> shapes, const std::string& 
 
 }  // namespace
 
-StatusOr<std::vector<MeshShape>> SplitShapes(const Mesh& mesh, bool require_disjoint) {
+namespace {
+
+// SplitShapes; `owned` (== &mesh, or null) lets a single shape take the mesh's arrays.
+StatusOr<std::vector<MeshShape>> SplitShapesImpl(const Mesh& mesh, bool require_disjoint,
+                                                 Mesh* owned) {
   const bool grouped = !mesh.face_groups.empty() || !mesh.group_names.empty();
   std::vector<MeshShape> shapes;
   if (!grouped) {
-    shapes.push_back(WholeMesh(mesh, SourceStem(mesh.source)));
+    shapes.push_back(WholeMesh(mesh, owned, SourceStem(mesh.source)));
     return shapes;
   }
   const std::size_t num_shapes = mesh.group_names.size();
   DISPEX_ASSIGN_OR_RETURN(const FacesByShape sorted,
                           SortFacesByShape(mesh, /*list=*/num_shapes > 1));
   if (num_shapes == 1) {
-    shapes.push_back(WholeMesh(mesh, mesh.group_names[0]));
+    std::string name = mesh.group_names[0];
+    shapes.push_back(WholeMesh(mesh, owned, std::move(name)));
     return shapes;
   }
 
@@ -611,6 +621,16 @@ StatusOr<std::vector<MeshShape>> SplitShapes(const Mesh& mesh, bool require_disj
     shape.mesh.tags = std::move(tags[g]);
   });
   return shapes;
+}
+
+}  // namespace
+
+StatusOr<std::vector<MeshShape>> SplitShapes(const Mesh& mesh, bool require_disjoint) {
+  return SplitShapesImpl(mesh, require_disjoint, nullptr);
+}
+
+StatusOr<std::vector<MeshShape>> SplitShapes(Mesh&& mesh, bool require_disjoint) {
+  return SplitShapesImpl(mesh, require_disjoint, &mesh);
 }
 
 std::vector<std::string> ShapeFileNames(std::span<const std::string> names) {

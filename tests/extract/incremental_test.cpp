@@ -36,6 +36,10 @@ struct Variant {
   // distances, to 4 bits): an edit that moves it re-extracts every face. Given, local edits
   // always stay local.
   bool auto_search_distance;
+  // A local edit extracts few enough faces for the re-run to trace only the sculpt within
+  // their reach (a BVH of part of it).
+  bool local_tracer = false;
+  double edit_radius = 0.04;  // of the base's diagonal
 };
 
 void PrintTo(const Variant& v, std::ostream* os) {
@@ -153,11 +157,14 @@ TEST_P(Incremental, EveryStepEqualsAFullExtraction) {
 
   const double diagonal = first.base_diagonal;
   for (unsigned seed : {1u, 2u, 3u}) {
-    EditSculptInBall(seed, 0.04 * diagonal, 0.002);
+    EditSculptInBall(seed, GetParam().edit_radius * diagonal, 0.002);
     ExtractReport r = Step("sculpt edited in a ball, seed " + std::to_string(seed));
     EXPECT_FALSE(r.unchanged);
     EXPECT_GT(r.faces_copied, 0) << "a local edit re-extracted every face";
     EXPECT_GT(r.faces_extracted, 0);
+    if (GetParam().local_tracer) {
+      EXPECT_NE(r.tracer.find(" sculpt faces"), std::string::npos) << r.tracer;
+    }
     EXPECT_EQ(r.redo_reason, "sculpt");
   }
 
@@ -205,6 +212,8 @@ INSTANTIATE_TEST_SUITE_P(
                               PtexDataType::kFloat, WatertightEdges::kFilter, false},
                       Variant{"spot_half_all", "keenan_spot/spot_control_mesh.obj", 3,
                               PtexDataType::kHalf, WatertightEdges::kAll, false},
+                      Variant{"spot2928_local_tracer", "keenan_spot/spot_quadrangulated.obj", 2,
+                              PtexDataType::kFloat, WatertightEdges::kFilter, false, true, 0.01},
                       Variant{"car_ngons_boundary_float_off", "opensubdiv/catmark_car.obj", 3,
                               PtexDataType::kFloat, WatertightEdges::kOff, true}),
     [](const auto& param_info) { return std::string(param_info.param.name); });
