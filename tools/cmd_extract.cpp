@@ -174,6 +174,24 @@ Status Resolve(ExtractArgs& a) {
   return ValidateExtractOptions(o);
 }
 
+// The exit status of a run: its error, or 0 once its JSON report is written and its summary
+// printed.
+template <class Report>
+int Conclude(const ExtractArgs& args, const StatusOr<Report>& report,
+             std::string (*json)(const Report&), std::string (*summary)(const Report&)) {
+  if (!report.ok()) {
+    int sig = CancelSignal();
+    return ReportFailure(report.status(), kExtractFlags, sig ? 128 + sig : 1);
+  }
+  if (!args.report_path.empty()) {
+    const std::string text = json(*report);
+    Status written = WriteFileAtomically(args.report_path, text.data(), text.size());
+    if (!written.ok()) return ReportFailure(written.WithPrefix("--report"));
+  }
+  if (!args.quiet) std::fputs(summary(*report).c_str(), stderr);
+  return 0;
+}
+
 // --out-dir or --manifest: one map per shape.
 int RunAsset(ExtractArgs& args) {
   ExtractAssetOptions asset;
@@ -191,18 +209,7 @@ int RunAsset(ExtractArgs& args) {
   } else if (args.options.base_path.empty() || args.options.sculpt_path.empty()) {
     return ReportFailure(Status::Error("give BASE and SCULPT (or --manifest)"), kExtractFlags, 2);
   }
-  auto report = ExtractAsset(asset);
-  if (!report.ok()) {
-    int sig = CancelSignal();
-    return ReportFailure(report.status(), kExtractFlags, sig ? 128 + sig : 1);
-  }
-  if (!args.report_path.empty()) {
-    std::string json = AssetReportJson(*report);
-    Status written = WriteFileAtomically(args.report_path, json.data(), json.size());
-    if (!written.ok()) return ReportFailure(written.WithPrefix("--report"));
-  }
-  if (!args.quiet) std::fputs(AssetReportSummary(*report).c_str(), stderr);
-  return 0;
+  return Conclude(args, ExtractAsset(asset), AssetReportJson, AssetReportSummary);
 }
 
 int RunExtract(ExtractArgs& args) {
@@ -210,17 +217,8 @@ int RunExtract(ExtractArgs& args) {
   if (!resolved.ok()) return ReportFailure(resolved, kExtractFlags, 2);
   InstallCancelSignalHandlers();
   if (args.asset()) return RunAsset(args);
-  auto report = Extract(args.options);
-  if (!report.ok()) {
-    int sig = CancelSignal();
-    return ReportFailure(report.status(), kExtractFlags, sig ? 128 + sig : 1);
-  }
-  if (!args.report_path.empty()) {
-    std::string json = ExtractReportJson(*report);
-    Status written = WriteFileAtomically(args.report_path, json.data(), json.size());
-    if (!written.ok()) return ReportFailure(written.WithPrefix("--report"));
-  }
-  if (!args.quiet) std::fputs(ExtractReportSummary(*report).c_str(), stderr);
+  const int status = Conclude(args, Extract(args.options), ExtractReportJson, ExtractReportSummary);
+  if (status != 0) return status;
   if (!args.preview_dir.empty()) {
     Status previews =
         WritePreviews(args.options.base_path, args.options.output_path, args.preview_dir);

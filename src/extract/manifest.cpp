@@ -30,6 +30,14 @@ StatusOr<std::string> TextValue(const json& v) {
   return v.get<std::string>();
 }
 
+// A field set from a name ("nearest", "fill"...) by its Parse function.
+template <class Field, class Parse>
+Status SetNamed(Field& field, const json& v, Parse parse) {
+  DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
+  DISPEX_ASSIGN_OR_RETURN(field, parse(s));
+  return Status::Ok();
+}
+
 // Sets one option by its ExtractOptions field name, from a value as the command line takes it.
 Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
   auto text = [&]() { return v.is_string() ? v.get<std::string>() : v.dump(); };
@@ -46,15 +54,13 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
   } else if (name == "search_distance") {
     DISPEX_ASSIGN_OR_RETURN(o.search_distance, ParseSearchDistance(text()));
   } else if (name == "ray_policy") {
-    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
-    DISPEX_ASSIGN_OR_RETURN(o.ray_policy, ParseHitPolicy(s));
+    return SetNamed(o.ray_policy, v, ParseHitPolicy);
   } else if (name == "tolerance") {
     DISPEX_ASSIGN_OR_RETURN(o.tolerance, NumberValue(v));
   } else if (name == "tolerance_fraction") {
     DISPEX_ASSIGN_OR_RETURN(o.tolerance_fraction, NumberValue(v));
   } else if (name == "resolution_rule") {
-    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
-    DISPEX_ASSIGN_OR_RETURN(o.resolution_rule, ParseResolutionRule(s));
+    return SetNamed(o.resolution_rule, v, ParseResolutionRule);
   } else if (name == "nonzero_threshold") {
     DISPEX_ASSIGN_OR_RETURN(o.nonzero_threshold, NumberValue(v));
   } else if (name == "data_type") {
@@ -64,16 +70,13 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
   } else if (name == "compression_level") {
     DISPEX_ASSIGN_OR_RETURN(o.compression_level, IntValue(v));
   } else if (name == "holes") {
-    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
-    DISPEX_ASSIGN_OR_RETURN(o.holes, ParseHolePolicy(s));
+    return SetNamed(o.holes, v, ParseHolePolicy);
   } else if (name == "watertight") {
-    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
-    DISPEX_ASSIGN_OR_RETURN(o.watertight, ParseWatertightEdges(s));
+    return SetNamed(o.watertight, v, ParseWatertightEdges);
   } else if (name == "max_miss_fraction") {
     DISPEX_ASSIGN_OR_RETURN(o.max_miss_fraction, NumberValue(v));
   } else if (name == "bvh_quality") {
-    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
-    DISPEX_ASSIGN_OR_RETURN(o.bvh_quality, ParseBuildQuality(s));
+    return SetNamed(o.bvh_quality, v, ParseBuildQuality);
   } else {
     return Status::Error(
         "unknown option (known: oversample, max_oversample, min_oversample, search_distance, "

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <sstream>
 
 #include "../extract/e2e_support.h"
 #include "dispex/mesh.h"
@@ -192,6 +193,56 @@ TEST_F(BadInput, OutputPaths) {
     ExpectFailure("extract " + cage_ + " " + sculpt_ + " -o " + (dir_ / "ro") + "/out.ptx",
                   "ro/out.ptx");
   }
+}
+
+// Assets of several shapes through the command line: the errors, and a run that works.
+TEST_F(BadInput, ShapesOptionsAndNames) {
+  // Two shapes of the same cage in one base; the sculpt names one of them in other letter case.
+  auto cage = ReadMesh(cage_);
+  auto sculpt = ReadMesh(sculpt_);
+  ASSERT_TRUE(cage.ok() && sculpt.ok());
+  // An OBJ of `mesh` once per name, each an `o` group.
+  auto groups = [](const Mesh& mesh, std::initializer_list<const char*> names) {
+    std::ostringstream out;
+    out.precision(9);
+    std::size_t offset = 1;
+    for (const char* name : names) {
+      out << "o " << name << "\n";
+      for (const Float3& p : mesh.positions) out << "v " << p.x << " " << p.y << " " << p.z << "\n";
+      for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+        out << "f";
+        for (std::int32_t v : mesh.face(f)) out << " " << offset + static_cast<std::size_t>(v);
+        out << "\n";
+      }
+      offset += mesh.num_vertices();
+    }
+    return out.str();
+  };
+  Write("asset.obj", groups(*cage, {"left", "right"}));
+  Write("asset_sculpt.obj", groups(*sculpt, {"Right"}));
+  const std::string base = dir_ / "asset.obj", asset_sculpt = dir_ / "asset_sculpt.obj";
+
+  ExpectFailure(Extract(base, asset_sculpt),
+                "2 shapes ('left', 'right'): write one map per "
+                "shape with --out-dir");
+  ExpectFailure("extract " + base + " " + asset_sculpt + " --out-dir " + (dir_ / "maps"),
+                "has no shape 'left'");
+  ExpectFailure(
+      "extract " + base + " " + asset_sculpt + " --out-dir " + (dir_ / "maps") + " --shapes right",
+      "differs from 'right' only in letter case or blanks");
+  ExpectFailure("extract " + base + " " + sculpt_ + " -o " + (dir_ / "out.ptx") + " --shapes left",
+                "--shapes needs --out-dir", 2);
+  ExpectFailure("extract --manifest " + (dir_ / "missing.json"), "missing.json: cannot be read", 2);
+
+  // With a sculpt of two matching shapes: one map per shape, and the selection.
+  Write("asset_sculpt.obj", groups(*sculpt, {"right", "left"}));
+  auto r = RunDispex("extract " + base + " " + asset_sculpt + " --out-dir " + (dir_ / "maps") +
+                         " --shapes right -q --report " + (dir_ / "asset.json"),
+                     dir_);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "maps/right.ptx"));
+  EXPECT_FALSE(fs::exists(dir_ / "maps/left.ptx"));
+  EXPECT_NE(testing::Slurp(dir_ / "asset.json").find("\"shape\": \"right\""), std::string::npos);
 }
 
 TEST_F(BadInput, TooLittleMemoryIsRefusedBeforeWork) {
