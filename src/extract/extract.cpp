@@ -114,10 +114,8 @@ Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previo
     ring = std::move(next);
   }
   const auto count = static_cast<std::size_t>(std::count(traced.begin(), traced.end(), 1));
-  inputs.tracer_options.quality = options.bvh_quality;
-  inputs.tracer_options.isa = options.embree_isa;
-  inputs.tracer_options.scale = TracerScale(inputs.base);
   if (2 * count > n) return BuildTracer(options, inputs, report);
+  SetTracerOptions(options, inputs);
   Stopwatch clock;
   Mesh part = SculptWithinReach(inputs, settings, traced);
   report.t_bvh = clock.seconds();
@@ -178,6 +176,7 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
       report.peak_rss_bytes = PeakResidentBytes();
       return report;
     }
+    previous.CheckFaceData();
     if (!previous.notice().empty()) report.warnings.push_back(previous.notice());
     report.redo_reason = RedoReason(previous, report);
   }

@@ -136,11 +136,15 @@ float TracerScale(const Mesh& base) {
   return largest > 0 ? std::exp2(std::ceil(std::log2(largest))) : 1.0f;
 }
 
-Status BuildTracer(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report) {
-  Stopwatch clock;
+void SetTracerOptions(const ExtractOptions& options, ExtractInputs& inputs) {
   inputs.tracer_options.quality = options.bvh_quality;
   inputs.tracer_options.isa = options.embree_isa;
   inputs.tracer_options.scale = TracerScale(inputs.base);
+}
+
+Status BuildTracer(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report) {
+  Stopwatch clock;
+  SetTracerOptions(options, inputs);
   inputs.traced.clear();
   DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, inputs.tracer_options));
   report.t_bvh += clock.seconds();

@@ -47,6 +47,9 @@ StatusOr<ExtractInputs> InputsFromMeshes(const ExtractOptions& options, Mesh bas
 // (TracerOptions::scale), the magnitude of the ray origins, and independent of the sculpt.
 float TracerScale(const Mesh& base);
 
+// The tracer's options from the extraction's (quality, ISA) and the base (TracerScale).
+void SetTracerOptions(const ExtractOptions& options, ExtractInputs& inputs);
+
 // The sculpt's BVH.
 Status BuildTracer(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report);
 

@@ -28,6 +28,10 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces) {
   const PtexMetaItem* keys = file->FindMetaData(kFaceKeysMetaKey);
   const PtexMetaItem* records = file->FindMetaData(kFaceRecordsMetaKey);
   if (keys == nullptr || records == nullptr) return ignore("has no face keys");
+  if (file->header().num_channels != 1 || (file->header().data_type != PtexDataType::kFloat &&
+                                           file->header().data_type != PtexDataType::kHalf)) {
+    return ignore("is not a one-channel float or half map");
+  }
   if (static_cast<std::size_t>(file->num_faces()) != num_faces) {
     return ignore(fmt::format("has {} faces, the base now {}", file->num_faces(), num_faces));
   }
@@ -38,6 +42,15 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces) {
   out.records_ = std::move(*decoded_records);
   out.file_.emplace(std::move(*file));
   return out;
+}
+
+void PreviousMap::CheckFaceData() {
+  if (!file_) return;
+  Status valid = file_->Validate();
+  if (valid.ok()) return;
+  notice_ = fmt::format("{}: corrupt face data ({}); not re-used, every face is extracted",
+                        file_->name(), valid.message());
+  file_.reset();
 }
 
 std::string PreviousMap::MetaString(const std::string& key) const {

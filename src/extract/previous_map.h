@@ -22,6 +22,9 @@ class PreviousMap {
   static PreviousMap Open(const std::string& path, std::size_t num_faces);
 
   bool usable() const { return file_.has_value(); }
+  // Inflates every face's data (Open checks the structure only): corrupt data makes the map
+  // unusable, with a notice, instead of failing the extraction when a face is copied.
+  void CheckFaceData();
   const std::string& notice() const { return notice_; }
   // The previous map's meta data string for `key` ("" when absent or unusable).
   std::string MetaString(const std::string& key) const;
