@@ -222,5 +222,36 @@ TEST_F(Shapes, IncrementalRedoesOnlyTheShapeThatChanged) {
   }
 }
 
+TEST_F(Shapes, AddedAndRemovedShapesLeaveTheOthersUntouched) {
+  ExtractAssetOptions o = Asset(dir_ / "maps");
+  o.options.incremental = true;
+  ASSERT_TRUE(ExtractAsset(o).ok());
+  const auto detail_time = fs::last_write_time(dir_ / "maps/detail.ptx");
+  const Mesh cage = Read(cage_);
+  // "flat" removed: "detail" is up to date; flat.ptx stays where it was.
+  WriteGroups(base_, {{"detail", cage}});
+  auto removed = ExtractAsset(o);
+  ASSERT_TRUE(removed.ok()) << removed.status().message();
+  ASSERT_EQ(removed->shapes.size(), 1u);
+  EXPECT_TRUE(removed->shapes[0].report.unchanged);
+  EXPECT_EQ(fs::last_write_time(dir_ / "maps/detail.ptx"), detail_time);
+  // "flat" back and a third shape added (a sculpt shape of the same name exists now).
+  WriteGroups(base_, {{"detail", cage}, {"flat", cage}, {"again", cage}});
+  WriteGroups(sculpt_,
+              {{"flat", Read(flat_)}, {"detail", Read(detail_)}, {"again", Read(detail_)}});
+  auto added = ExtractAsset(o);
+  ASSERT_TRUE(added.ok()) << added.status().message();
+  ASSERT_EQ(added->shapes.size(), 3u);
+  EXPECT_TRUE(added->shapes[0].report.unchanged);
+  EXPECT_TRUE(added->shapes[1].report.unchanged);
+  EXPECT_EQ(added->shapes[2].report.redo_reason, "no previous map");
+  ASSERT_TRUE(ExtractAsset(Asset(dir_ / "full")).ok());
+  for (const char* name : {"detail.ptx", "flat.ptx", "again.ptx"}) {
+    EXPECT_EQ(Slurp(dir_ / ("maps/" + std::string(name))),
+              Slurp(dir_ / ("full/" + std::string(name))))
+        << name;
+  }
+}
+
 }  // namespace
 }  // namespace dispex
