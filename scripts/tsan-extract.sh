@@ -27,4 +27,25 @@ cage="$root/tests/data/meshes/keenan_spot/spot_control_mesh.obj"
 # Watertight edges for both readers: faces re-extracted in rounds, edges measured in parallel.
 "$dispex" extract "$cage" "$work/sculpt.obj" -o "$work/all.ptx" --watertight all --threads 4 -q
 "$dispex" verify "$cage" "$work/all.ptx" --threads 4 -q
-echo "tsan-extract: make-sculpt, extract (filter and all) and verify at 4 threads ran without a data race"
+# Incremental: the previous map's faces copied in parallel, the local BVH (given search
+# distance) after an edit of the sculpt.
+"$dispex" extract "$cage" "$work/sculpt.obj" -o "$work/inc.ptx" --search-distance 1% \
+  --incremental --threads 4 -q
+sed -i '0,/^v /s/^v \([^ ]*\) /v 0.001 /' "$work/sculpt.obj"
+"$dispex" extract "$cage" "$work/sculpt.obj" -o "$work/inc.ptx" --search-distance 1% \
+  --incremental --threads 4 -q
+# An asset of two shapes: shapes in parallel, each extraction parallel inside.
+# Two copies of a mesh as the o groups $2 and $3 (faces without their /vt/vn parts).
+two_groups() {
+  local n
+  n=$(grep -c '^v ' "$1")
+  for k in 0 1; do
+    [[ $k == 0 ]] && echo "o $2" || echo "o $3"
+    grep '^v ' "$1"
+    awk -v n=$((k * n)) '/^f /{printf "f"; for (i = 2; i <= NF; ++i) printf " %d", $i + n; print ""}' "$1"
+  done
+}
+two_groups "$cage" one two > "$work/asset.obj"
+two_groups "$work/sculpt.obj" two one > "$work/asset_sculpt.obj"
+"$dispex" extract "$work/asset.obj" "$work/asset_sculpt.obj" --out-dir "$work/maps" --threads 4 -q
+echo "tsan-extract: make-sculpt, extract (filter and all, incremental, two shapes) and verify at 4 threads ran without a data race"
