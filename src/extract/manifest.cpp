@@ -1,6 +1,8 @@
 // ReadExtractManifest: an asset's shapes from several files, each with its own options.
 #include <fmt/format.h>
 
+#include <bit>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -61,6 +63,16 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
     DISPEX_ASSIGN_OR_RETURN(o.tolerance_fraction, NumberValue(v));
   } else if (name == "resolution_rule") {
     return SetNamed(o.resolution_rule, v, ParseResolutionRule);
+  } else if (name == "fixed_resolution") {
+    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
+    unsigned w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(s.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || x != 'x' ||
+        !std::has_single_bit(w) || !std::has_single_bit(h)) {
+      return Status::Error(fmt::format("'{}': WxH with powers of two, e.g. 64x64", s));
+    }
+    o.fixed_ulog2 = std::countr_zero(w);
+    o.fixed_vlog2 = std::countr_zero(h);
   } else if (name == "nonzero_threshold") {
     DISPEX_ASSIGN_OR_RETURN(o.nonzero_threshold, NumberValue(v));
   } else if (name == "data_type") {
@@ -80,7 +92,8 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
   } else {
     return Status::Error(
         "unknown option (known: oversample, max_oversample, min_oversample, search_distance, "
-        "ray_policy, tolerance, tolerance_fraction, resolution_rule, nonzero_threshold, "
+        "ray_policy, tolerance, tolerance_fraction, resolution_rule, fixed_resolution, "
+        "nonzero_threshold, "
         "data_type, compression_level, holes, watertight, max_miss_fraction, bvh_quality)");
   }
   return Status::Ok();

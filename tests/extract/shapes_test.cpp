@@ -177,7 +177,8 @@ TEST_F(Shapes, ManifestNamesShapesInSeveralFilesWithTheirOwnOptions) {
       {"name": "detail", "base": ")"
                           << cage_ << R"(", "sculpt": "detail_sculpt.obj",
        "options": {"tolerance": 0.002, "watertight": "off"}},
-      {"name": "flat", "base": "asset.obj", "sculpt": "asset_sculpt.obj"}
+      {"name": "flat", "base": "asset.obj", "sculpt": "asset_sculpt.obj",
+       "options": {"resolution_rule": "fixed", "fixed_resolution": "8x16"}}
     ]
   })";
   auto options = ReadExtractManifest(manifest, ExtractAssetOptions{});
@@ -188,6 +189,8 @@ TEST_F(Shapes, ManifestNamesShapesInSeveralFilesWithTheirOwnOptions) {
   EXPECT_EQ(report->shapes[0].report.tolerance, 0.002);
   EXPECT_EQ(report->shapes[0].report.watertight, WatertightEdges::kOff);
   EXPECT_EQ(report->shapes[1].report.options.max_oversample, 64);
+  EXPECT_EQ(report->shapes[1].report.spectral.ulog2_faces[3], 252);
+  EXPECT_EQ(report->shapes[1].report.spectral.vlog2_faces[4], 252);
   EXPECT_TRUE(fs::exists(dir_ / "from_manifest/detail.ptx"));
   EXPECT_TRUE(fs::exists(dir_ / "from_manifest/flat.ptx"));
 
