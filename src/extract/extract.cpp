@@ -89,14 +89,13 @@ constexpr int kLocalRings = 2;
 // the faces whose first pass runs (not copied) and of the faces kLocalRings around them; the
 // whole sculpt when that is most of it.
 Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previous,
-                        std::span<const Hash128> keys, const ExtractSettings& settings,
-                        ExtractInputs& inputs, ExtractReport& report) {
+                        const FaceKeys& keys, ExtractInputs& inputs, ExtractReport& report) {
   const auto n = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
   std::vector<std::uint8_t> traced(n, 0);
   std::vector<int> ring;
   for (std::size_t f = 0; f < n; ++f) {
     if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
-    if (!previous.Reusable(f, keys[f])) {
+    if (!previous.Reusable(f, keys.keys[f])) {
       traced[f] = 1;
       ring.push_back(static_cast<int>(f));
     }
@@ -117,7 +116,7 @@ Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previo
   if (2 * count > n) return BuildTracer(options, inputs, report);
   SetTracerOptions(options, inputs);
   Stopwatch clock;
-  Mesh part = SculptWithinReach(inputs, settings, traced);
+  Mesh part = SculptWithinReach(inputs, keys, traced);
   report.t_bvh = clock.seconds();
   report.tracer_faces = static_cast<std::int64_t>(count);
   return BuildPartTracer(std::move(part), std::move(traced), inputs, report);
@@ -187,10 +186,10 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   if (!local) DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
   DISPEX_ASSIGN_OR_RETURN(ExtractSettings settings, ResolveSettings(options, inputs, report));
   Stopwatch keys_clock;
-  const std::vector<Hash128> keys = ComputeFaceKeys(inputs, settings);
+  const FaceKeys face_keys = ComputeFaceKeys(inputs, settings);
+  const std::vector<Hash128>& keys = face_keys.keys;
   report.t_keys = keys_clock.seconds();
-  if (local)
-    DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, keys, settings, inputs, report));
+  if (local) DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, face_keys, inputs, report));
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateMap(options, inputs));
 
   Stopwatch faces_clock;

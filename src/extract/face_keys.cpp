@@ -3,7 +3,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
@@ -15,10 +14,6 @@
 namespace dispex::extract {
 
 namespace {
-
-struct Box {
-  std::array<float, 3> lower{}, upper{};
-};
 
 // The region each Ptex face's rays can reach: its patch's box grown by the longest search,
 // plus a margin for the limit surface's approximation near extraordinary vertices and for
@@ -117,15 +112,22 @@ struct FaceBounds {
   float half_extent = 0;  // rounded up: the centre may sit an ulp off the middle
 };
 
-FaceBounds Bounds(const Mesh& sculpt, std::size_t s) {
-  std::array<float, 3> lower{INFINITY, INFINITY, INFINITY};
-  std::array<float, 3> upper{-INFINITY, -INFINITY, -INFINITY};
+// The corners of sculpt face `s`, xyz after xyz, into `xyz`.
+void Corners(const Mesh& sculpt, std::size_t s, std::vector<float>& xyz) {
+  xyz.clear();
   for (std::int32_t v : sculpt.face(s)) {
     const Float3& p = sculpt.positions[static_cast<std::size_t>(v)];
-    const std::array<float, 3> xyz{p.x, p.y, p.z};
-    for (int k = 0; k < 3; ++k) {
-      lower[k] = std::min(lower[k], xyz[k]);
-      upper[k] = std::max(upper[k], xyz[k]);
+    xyz.insert(xyz.end(), {p.x, p.y, p.z});
+  }
+}
+
+FaceBounds Bounds(std::span<const float> xyz) {
+  std::array<float, 3> lower{INFINITY, INFINITY, INFINITY};
+  std::array<float, 3> upper{-INFINITY, -INFINITY, -INFINITY};
+  for (std::size_t i = 0; i < xyz.size(); i += 3) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      lower[k] = std::min(lower[k], xyz[i + k]);
+      upper[k] = std::max(upper[k], xyz[i + k]);
     }
   }
   FaceBounds b;
@@ -148,8 +150,9 @@ double Reach(const ExtractSettings& settings) {
 // largest half-extent of a sculpt face from it (every face whose bounding box meets the box has
 // its centroid there; faces in those cells that do not meet it only make the key change more
 // often than it must).
+// Also returns the largest half-extent of a sculpt face.
 std::vector<Hash128> SculptReachKeys(const Mesh& sculpt, const std::vector<Box>& boxes,
-                                     const std::vector<std::uint8_t>& skip) {
+                                     const std::vector<std::uint8_t>& skip, float& half_extent) {
   const CellGrid grid(boxes, skip, /*per_side=*/2);
   struct Sums {
     std::vector<Hash128> cells;
@@ -161,19 +164,15 @@ std::vector<Hash128> SculptReachKeys(const Mesh& sculpt, const std::vector<Box>&
                       Sums& local = sums.local();
                       std::vector<float> corners;
                       for (std::size_t s = range.begin(); s != range.end(); ++s) {
-                        corners.clear();
-                        for (std::int32_t v : sculpt.face(s)) {
-                          const Float3& p = sculpt.positions[static_cast<std::size_t>(v)];
-                          corners.insert(corners.end(), {p.x, p.y, p.z});
-                        }
-                        const FaceBounds b = Bounds(sculpt, s);
+                        Corners(sculpt, s, corners);
+                        const FaceBounds b = Bounds(corners);
                         local.half_extent = std::max(local.half_extent, b.half_extent);
                         local.cells[grid.CellOf(b.centre)] +=
                             HashBytes(std::as_bytes(std::span(corners)));
                       }
                     });
   std::vector<Hash128> cells(grid.num_cells());
-  float half_extent = 0;
+  half_extent = 0;
   sums.combine_each([&](const Sums& part) {
     for (std::size_t c = 0; c < cells.size(); ++c) cells[c] += part.cells[c];
     half_extent = std::max(half_extent, part.half_extent);
@@ -218,19 +217,21 @@ Hash128 SettingsKey(const ExtractSettings& s) {
   return h.Digest();
 }
 
-std::vector<Hash128> ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings) {
+FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings) {
   const LimitSurface& surface = inputs.surface;
   const auto num_faces = static_cast<std::size_t>(surface.num_ptex_faces());
   const std::vector<BaseFacePatch> patches = BaseFacePatches(surface);
-  const std::vector<Box> boxes = ReachBoxes(surface, patches, Reach(settings));
+  FaceKeys out;
+  out.reach_boxes = ReachBoxes(surface, patches, Reach(settings));
   std::vector<std::uint8_t> skip(num_faces);
   for (std::size_t f = 0; f < num_faces; ++f) skip[f] = surface.is_hole(PtexFaceId(int(f)));
-  const std::vector<Hash128> sculpt = SculptReachKeys(inputs.sculpt, boxes, skip);
+  const std::vector<Hash128> sculpt =
+      SculptReachKeys(inputs.sculpt, out.reach_boxes, skip, out.sculpt_half_extent);
   Hasher global;
   global.Add(SettingsKey(settings)).Add(TracerScale(inputs.base));
   const Hash128 settings_key = global.Digest();
 
-  std::vector<Hash128> keys(num_faces);
+  out.keys.resize(num_faces);
   tbb::parallel_for(std::size_t{0}, num_faces, [&](std::size_t f) {
     const PtexFaceId face(static_cast<int>(f));
     const BaseFacePatch& patch = patches[static_cast<std::size_t>(surface.base_face(face).value)];
@@ -239,41 +240,37 @@ std::vector<Hash128> ComputeFaceKeys(const ExtractInputs& inputs, const ExtractS
     h.Add(patch.key[0]).Add(patch.key[1]);
     h.Add(surface.sub_face(face)).Add(skip[f]).Add(settings.plan.log2[f]);
     h.Add(sculpt[f]);
-    keys[f] = h.Digest();
+    out.keys[f] = h.Digest();
   });
-  return keys;
+  return out;
 }
 
-Mesh SculptWithinReach(const ExtractInputs& inputs, const ExtractSettings& settings,
+Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
                        std::span<const std::uint8_t> faces) {
   const LimitSurface& surface = inputs.surface;
   const Mesh& sculpt = inputs.sculpt;
-  const std::vector<Box> boxes = ReachBoxes(surface, BaseFacePatches(surface), Reach(settings));
+  const std::vector<Box>& boxes = keys.reach_boxes;
+  const float half_extent = keys.sculpt_half_extent;
   std::vector<std::uint8_t> skip(boxes.size());
   for (std::size_t f = 0; f < boxes.size(); ++f) {
     skip[f] = !faces[f] || surface.is_hole(PtexFaceId(static_cast<int>(f)));
   }
-  // Finer than the keys' grid: the part of the sculpt to build a BVH of is found once.
+  // Finer than the keys' grid: the part of the sculpt to build a BVH of is found once. Every
+  // face whose centre's cell a box, grown by the largest half-extent, reaches.
   const CellGrid grid(boxes, skip, /*per_side=*/6);
-  // The largest half-extent of a sculpt face, then every face whose centre's cell a box reaches.
-  const float half_extent = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, sculpt.num_faces(), 1 << 14), 0.0f,
-      [&](const tbb::blocked_range<std::size_t>& range, float largest) {
-        for (std::size_t s = range.begin(); s != range.end(); ++s) {
-          const FaceBounds b = Bounds(sculpt, s);
-          largest = std::max(largest, b.half_extent);
-        }
-        return largest;
-      },
-      [](float a, float b) { return std::max(a, b); });
   std::vector<std::uint8_t> marked(grid.num_cells(), 0);
   for (std::size_t f = 0; f < boxes.size(); ++f) {
     if (!skip[f]) grid.ForEachCell(boxes[f], half_extent, [&](std::size_t c) { marked[c] = 1; });
   }
   std::vector<std::uint8_t> keep(sculpt.num_faces());
-  tbb::parallel_for(std::size_t{0}, sculpt.num_faces(), [&](std::size_t s) {
-    keep[s] = marked[grid.CellOf(Bounds(sculpt, s).centre)];
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sculpt.num_faces(), 1 << 14),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      std::vector<float> corners;
+                      for (std::size_t s = range.begin(); s != range.end(); ++s) {
+                        Corners(sculpt, s, corners);
+                        keep[s] = marked[grid.CellOf(Bounds(corners).centre)];
+                      }
+                    });
   // The kept faces in their order, their vertices renumbered in ascending order.
   std::vector<std::int32_t> vertex(sculpt.num_vertices(), -1);
   Mesh part;

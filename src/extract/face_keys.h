@@ -2,6 +2,7 @@
 // key: incremental extraction re-uses a face whose key is unchanged.
 #pragma once
 
+#include <array>
 #include <span>
 #include <vector>
 
@@ -24,12 +25,21 @@ Hash128 SettingsKey(const ExtractSettings& settings);
 // those whose bounding box meets the face's reach box (the patch's box grown by the longest search
 // distance and a margin), as an order-free sum of each sculpt face's key (its corners' positions,
 // in order). The keys do not depend on the thread count.
-std::vector<Hash128> ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings);
+struct Box {
+  std::array<float, 3> lower{}, upper{};
+};
+
+struct FaceKeys {
+  std::vector<Hash128> keys;     // per Ptex face
+  std::vector<Box> reach_boxes;  // per Ptex face: where its rays can go
+  float sculpt_half_extent = 0;  // the largest half-size of a sculpt face's bounding box
+};
+FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings);
 
 // The sculpt faces the rays of the flagged Ptex faces can reach (a superset: those ComputeFaceKeys
 // sums for them), their vertices renumbered in ascending order: enough to trace those faces
 // exactly as against the whole sculpt.
-Mesh SculptWithinReach(const ExtractInputs& inputs, const ExtractSettings& settings,
+Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
                        std::span<const std::uint8_t> faces);
 
 }  // namespace dispex::extract
