@@ -184,6 +184,16 @@ class LimitEvaluator {
   Status EvaluatePoints(PtexFaceId face, std::span<const float> uv, std::span<float> positions,
                         std::span<float> normals);
 
+  // Limit points with their frames: unit normals and the partial derivatives dP/du and dP/dv
+  // with respect to the Ptex face's own (u,v) -- on an n-gon's sub-faces too, where
+  // OpenSubdiv differentiates in its own sub-face coordinates (half the span, twice the
+  // derivative). 3 floats per point in each output. Same grid, points and errors as above.
+  struct Frames {
+    std::span<float> positions, normals, du, dv;
+  };
+  Status EvaluateGridFrames(PtexFaceId face, int rx, int ry, Frames out);
+  Status EvaluatePointFrames(PtexFaceId face, std::span<const float> uv, Frames out);
+
   const LimitEvaluatorStats& stats() const;
 
   struct Impl;

@@ -63,6 +63,7 @@ FaceSampler::BindResult FaceSampler::Bind(int ptex) {
     surface_base_face_ = base;
   }
   sub_face_ = s_.ptex_sub[ptex];
+  deriv_scale_ = s_.face_size(base) == 4 ? 1.0 : 0.5;
   bound_ptex_ = ptex;
   ++stats_.faces;
   stats_.regular_faces += regular_ ? 1 : 0;
@@ -86,30 +87,43 @@ void FaceSampler::EvalDerivs(double u, double v, double p[3], double du[3], doub
   surface_.Evaluate(uv, patch_points_.data(), PointDescriptor(3), p, du, dv);
 }
 
-void FaceSampler::Point(double u, double v, float position[3], float normal[3]) {
+void FaceSampler::Point(double u, double v, float position[3], float normal[3], float du_out[3],
+                        float dv_out[3]) {
   double p[3], du[3], dv[3];
   EvalDerivs(u, v, p, du, dv);
   for (int k = 0; k < 3; ++k) position[k] = static_cast<float>(p[k]);
   if (normal != nullptr && !UnitNormal(du, dv, normal)) FallbackNormal(u, v, normal);
+  StoreDerivs(du, dv, du_out, dv_out);
   ++stats_.samples;
 }
 
-void FaceSampler::Grid(int rx, int ry, float* positions, float* normals) {
+void FaceSampler::StoreDerivs(const double du[3], const double dv[3], float* du_out,
+                              float* dv_out) const {
+  if (du_out == nullptr) return;
+  for (int k = 0; k < 3; ++k) {
+    du_out[k] = static_cast<float>(du[k] * deriv_scale_);
+    dv_out[k] = static_cast<float>(dv[k] * deriv_scale_);
+  }
+}
+
+void FaceSampler::Grid(int rx, int ry, float* positions, float* normals, float* du, float* dv) {
   if (regular_) {
-    GridRegular(rx, ry, positions, normals);
+    GridRegular(rx, ry, positions, normals, du, dv);
   } else {
-    GridBfr(rx, ry, positions, normals);
+    GridBfr(rx, ry, positions, normals, du, dv);
   }
   stats_.samples += static_cast<std::int64_t>(rx) * ry;
 }
 
-void FaceSampler::GridBfr(int rx, int ry, float* positions, float* normals) {
+void FaceSampler::GridBfr(int rx, int ry, float* positions, float* normals, float* du_out,
+                          float* dv_out) {
   if (use_table_) {
     for (int j = 0; j < ry; ++j) {
       for (int i = 0; i < rx; ++i) {
         const std::size_t k = 3 * (static_cast<std::size_t>(j) * rx + i);
         Point((i + 0.5) / rx, (j + 0.5) / ry, positions + k,
-              normals == nullptr ? nullptr : normals + k);
+              normals == nullptr ? nullptr : normals + k, du_out == nullptr ? nullptr : du_out + k,
+              dv_out == nullptr ? nullptr : dv_out + k);
       }
     }
     stats_.samples -= static_cast<std::int64_t>(rx) * ry;  // Point() counted them
@@ -131,8 +145,9 @@ void FaceSampler::GridBfr(int rx, int ry, float* positions, float* normals) {
         surface_.Evaluate(uv, points, PointDescriptor(3), p);
       } else {
         surface_.Evaluate(uv, points, PointDescriptor(3), p, du, dv);
-        float* out_n = normals + 3 * (static_cast<std::size_t>(j) * rx + i);
-        if (!UnitNormal(du, dv, out_n)) FallbackNormal(u, v, out_n);
+        const std::size_t k = 3 * (static_cast<std::size_t>(j) * rx + i);
+        if (!UnitNormal(du, dv, normals + k)) FallbackNormal(u, v, normals + k);
+        if (du_out != nullptr) StoreDerivs(du, dv, du_out + k, dv_out + k);
       }
       out_p[0] = static_cast<float>(p[0]);
       out_p[1] = static_cast<float>(p[1]);
@@ -141,7 +156,8 @@ void FaceSampler::GridBfr(int rx, int ry, float* positions, float* normals) {
   }
 }
 
-void FaceSampler::GridRegular(int rx, int ry, float* positions, float* normals) {
+void FaceSampler::GridRegular(int rx, int ry, float* positions, float* normals, float* du_out,
+                              float* dv_out) {
   if (basis_u_.n != rx) basis_u_.Build(rx);
   if (basis_v_.n != ry) basis_v_.Build(ry);
   row_.Resize(rx);
@@ -210,6 +226,15 @@ void FaceSampler::GridRegular(int rx, int ry, float* positions, float* normals) 
     }
     for (int i = 0; i < rx; ++i) {
       if (bad[i]) FallbackNormal((i + 0.5) / rx, (j + 0.5) / ry, out_n + 3 * i);
+    }
+    if (du_out == nullptr) continue;
+    float* out_du = du_out + 3 * static_cast<std::size_t>(j) * rx;
+    float* out_dv = dv_out + 3 * static_cast<std::size_t>(j) * rx;
+    for (int i = 0; i < rx; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        out_du[3 * i + k] = static_cast<float>(du[k][i]);
+        out_dv[3 * i + k] = static_cast<float>(dv[k][i]);
+      }
     }
   }
 }

@@ -30,20 +30,25 @@ class FaceSampler {
   const std::string& error() const { return error_; }
 
   // The rx x ry texel centres of the bound face, texel (i,j) at j*rx+i, xyz interleaved.
-  // `normals` may be null.
-  void Grid(int rx, int ry, float* positions, float* normals);
+  // `normals` may be null; `du` and `dv` (dP/du and dP/dv in the Ptex face's own (u,v)) may
+  // be null, and need `normals`.
+  void Grid(int rx, int ry, float* positions, float* normals, float* du = nullptr,
+            float* dv = nullptr);
 
-  // One point of the bound face at Ptex (u,v). `normal` may be null.
-  void Point(double u, double v, float position[3], float normal[3]);
+  // One point of the bound face at Ptex (u,v). `normal`, `du` and `dv` may be null.
+  void Point(double u, double v, float position[3], float normal[3], float du[3] = nullptr,
+             float dv[3] = nullptr);
 
   const LimitEvaluatorStats& stats() const { return stats_; }
 
  private:
   // Position and derivatives of the bound face at Ptex (u,v); derivatives are with respect
-  // to the Ptex face's own (u,v) up to a positive scale (the sub-face factor).
+  // to the Ptex face's own (u,v) up to a positive scale (deriv_scale_ undoes it).
   void EvalDerivs(double u, double v, double p[3], double du[3], double dv[3]);
-  void GridRegular(int rx, int ry, float* positions, float* normals);
-  void GridBfr(int rx, int ry, float* positions, float* normals);
+  void GridRegular(int rx, int ry, float* positions, float* normals, float* du, float* dv);
+  void GridBfr(int rx, int ry, float* positions, float* normals, float* du, float* dv);
+  // du and dv times deriv_scale_ into du_out and dv_out (nothing when du_out is null).
+  void StoreDerivs(const double du[3], const double dv[3], float* du_out, float* dv_out) const;
   // Writes the normal for a sample whose derivatives were degenerate (see subdiv.h).
   void FallbackNormal(double u, double v, float normal[3]);
 
@@ -60,6 +65,9 @@ class FaceSampler {
   bool use_table_ = false;  // the bound face is evaluated through s_.patch_table
   int sub_face_ = 0;
   int bound_ptex_ = -1;
+  // EvalDerivs' derivatives times this are the Ptex face's: on an n-gon's sub-faces Bfr and
+  // Far differentiate in their own sub-face coordinates, half the Ptex sub-face's span.
+  double deriv_scale_ = 1.0;
   BezierPatch bezier_{};
   CubicBasisTable basis_u_, basis_v_;
   // One row of the regular fast path, structure of arrays.
