@@ -197,4 +197,44 @@ class SpectralAnalyzer {
   std::unique_ptr<Impl> impl_;
 };
 
+// ---- Vector faces ------------------------------------------------------------------------------
+
+// The analysis of one face of a 3-channel (vector) displacement: the rules above with every
+// error the Euclidean norm over the channels -- the largest |vector read-back - vector sample|
+// -- and the truncation bound sqrt(E_0^2 + E_1^2 + E_2^2) of the channels' bounds (each channel
+// moves by at most its E, so the vector by at most that).
+struct SpectralVectorFace {
+  int ulog2 = 0;
+  int vlog2 = 0;
+  bool constant = false;
+  std::array<float, 3> constant_value{};  // the channels' means when constant
+  // rx * ry texels of 3 interleaved channels, row-major, u fastest. Points into the
+  // analyzer's scratch: valid until its next call.
+  std::span<const float> texels;
+  SpectralFaceStats stats;  // errors and bound of the vector
+};
+
+// Per-thread analysis of vector faces, like SpectralAnalyzer (same plans, same determinism).
+// Supports every ResolutionRule (kNonzero: the largest of the channels' resolutions) and the
+// resolution floor; not the edge options (edge_tolerance, pin_edges), which fail.
+class SpectralVectorAnalyzer {
+ public:
+  SpectralVectorAnalyzer();
+  ~SpectralVectorAnalyzer();
+  SpectralVectorAnalyzer(SpectralVectorAnalyzer&&) noexcept;
+  SpectralVectorAnalyzer& operator=(SpectralVectorAnalyzer&&) noexcept;
+  SpectralVectorAnalyzer(const SpectralVectorAnalyzer&) = delete;
+  SpectralVectorAnalyzer& operator=(const SpectralVectorAnalyzer&) = delete;
+
+  // `samples` holds 3 * nx * ny finite values, the channels interleaved. Errors as for
+  // SpectralAnalyzer::Analyze. Guarantee with kErrorBound and verify: stats.measured_error <=
+  // tolerance.
+  StatusOr<SpectralVectorFace> Analyze(std::span<const float> samples, int nx, int ny,
+                                       const SpectralOptions& options);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 }  // namespace dispex

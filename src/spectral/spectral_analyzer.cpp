@@ -13,8 +13,6 @@
 //   4. the error a renderer sees (bilinear read-back, bilinear_readback.h) is measured, and u
 //      or v, whichever lowers it more, is doubled until it is within the tolerance. The full
 //      resolution stores the samples themselves, so the loop always ends.
-// In terms of FFTW's unnormalised transforms the resampling factor is the same for every
-// coefficient: Y(u,v) / (4 nx ny) fed to REDFT01 at rx x ry, a power of two, so exact.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -29,6 +27,7 @@
 #include "spectral/bilinear_readback.h"
 #include "spectral/block_shape.h"
 #include "spectral/dct2d.h"
+#include "spectral/dct_resample.h"
 #include "spectral/dct_scale.h"
 #include "spectral/edge_readback.h"
 #include "spectral/nonzero_rule.h"
@@ -124,27 +123,7 @@ StatusOr<SpectralAnalyzer::Impl::Summary> SpectralAnalyzer::Impl::Load(std::span
 float* SpectralAnalyzer::Impl::ResampleLoaded(const BlockShape& shape, const BlockShape& res,
                                               float mean, int slot) {
   float* out = texels[slot].Reserve(res.count());
-  if (res.nx == shape.nx && res.ny == shape.ny) {
-    std::memcpy(out, samples.data(), shape.count() * sizeof(float));
-    return out;
-  }
-  if (res.count() == 1) {  // the DC term alone: the mean (computed in double by Load)
-    out[0] = mean;
-    return out;
-  }
-  float* z = padded.Reserve(res.count());
-  const float scale = 1.0f / (4.0f * static_cast<float>(shape.count()));  // 2^-k: exact
-  const int keep_u = std::min(res.nx, shape.nx);
-  const int keep_v = std::min(res.ny, shape.ny);
-  const float* y = coefficients.data();
-  for (int v = 0; v < keep_v; ++v) {
-    const float* src = y + static_cast<std::size_t>(v) * shape.nx;
-    float* row = z + static_cast<std::size_t>(v) * res.nx;
-    for (int u = 0; u < keep_u; ++u) row[u] = src[u] * scale;
-    std::fill(row + keep_u, row + res.nx, 0.0f);
-  }
-  std::fill(z + static_cast<std::size_t>(keep_v) * res.nx, z + res.count(), 0.0f);
-  dct.Inverse(res.lx, res.ly, z, out);
+  spectral::ResampleBlock(dct, samples.data(), coefficients.data(), shape, res, mean, padded, out);
   return out;
 }
 
