@@ -29,6 +29,9 @@ struct PatternMapOptions {
   std::optional<VectorSpace> label;
   bool swap_tangential = false;
   float scale = 1;
+  // Channels 0 and 1 set to 0: in the tangent and parametric spaces D = (D.N) N, what a scalar
+  // map of the same D moves a point by.
+  bool drop_tangential = false;
 };
 
 // D at a limit point p with unit normal n.
@@ -88,6 +91,7 @@ inline void WriteVectorFieldMap(const std::string& cage_path, const VectorField&
                               {n[3 * t], n[3 * t + 1], n[3 * t + 2]}};
         VectorToChannels(*o.space, at, vector, c);
         if (o.swap_tangential) std::swap(c[0], c[1]);
+        if (o.drop_tangential) c[0] = c[1] = 0;
       }
       for (int k = 0; k < options.num_channels; ++k) values.push_back(o.scale * c[k]);
     }

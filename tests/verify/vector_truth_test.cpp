@@ -584,5 +584,182 @@ TEST_F(VectorMaps, WrongMapsFailTheTruthBounds) {
   }
 }
 
+// ---- Edge steps and errors ------------------------------------------------------------------
+
+VerifyReport VerifyEdges(const std::string& cage, const std::string& map) {
+  VerifyOptions verify;
+  verify.base_path = cage;
+  verify.map_path = map;
+  auto report = Verify(verify);
+  EXPECT_TRUE(report.ok()) << report.status().message();
+  return report.ok() ? *report : VerifyReport{};
+}
+
+// A vector map's edge steps are steps of D in object space. A tangent map of one object-space
+// vector D0 has none (to rounding), though its channel 0 steps by up to |D0| where the faces'
+// u axes turn; an object map whose face 0 is off by (3k, 4k, 0) steps by 5k there, the length
+// of the step. Rejects a verify that measures a tangent map's raw channels, or that takes the
+// largest component's step for the vector's.
+TEST(VectorEdges, StepsAreOfDInObjectSpace) {
+  TempDir dir;
+  const std::string cage = DataPath(kSpot);
+  const double d0[3] = {0.02, -0.03, 0.015};
+  PatternMapOptions o;
+  o.log2 = 3;
+  testing::WriteVectorFieldMap(
+      cage, [&](const float*, const float*, double d[3]) { std::copy(d0, d0 + 3, d); },
+      dir / "tangent.ptx", o);
+  VerifyReport r = VerifyEdges(cage, dir / "tangent.ptx");
+  EXPECT_TRUE(r.edges_object_space);
+  EXPECT_GT(r.edge_per_face.count, 1000u);
+  EXPECT_LT(r.edge_per_face.max, 1e-6);
+  EXPECT_LT(r.edge_across_faces.max, 1e-6);
+  // The same map's channel 0, measured as a scalar field, steps by a good part of |D0|.
+  auto map = PtexFile::Open(dir / "tangent.ptx");
+  auto base = ReadMesh(cage);
+  auto surface = LimitSurface::Build(*base);
+  ASSERT_TRUE(map.ok() && surface.ok());
+  std::vector<PtexFaceInfo> faces(static_cast<std::size_t>(map->num_faces()));
+  std::vector<std::vector<float>> channel0(faces.size());
+  std::vector<float> texels;
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    faces[f] = map->face_info(PtexFaceId(static_cast<int>(f)));
+    ASSERT_TRUE(map->ReadFace(PtexFaceId(static_cast<int>(f)), 0, texels).ok());
+    for (std::size_t i = 0; i < texels.size(); i += 3) channel0[f].push_back(texels[i]);
+  }
+  const std::vector<std::uint8_t> none(faces.size(), 0);
+  PtexEdgeSteps raw = MeasurePtexEdgeSteps(faces, channel0, none, none);
+  float raw_max = 0;
+  for (float x : raw.per_face) raw_max = std::max(raw_max, x);
+  EXPECT_GT(raw_max, 0.3 * Norm(d0));
+
+  // An object map, face 0 off by (3k, 4k, 0).
+  const float k = 0.001f;
+  o.space = VectorSpace::kObject;
+  testing::WriteVectorFieldMap(
+      cage, [&](const float*, const float*, double d[3]) { std::copy(d0, d0 + 3, d); },
+      dir / "object.ptx", o);
+  auto object = PtexFile::Open(dir / "object.ptx");
+  ASSERT_TRUE(object.ok());
+  PtexWriterOptions w;
+  w.num_channels = 3;
+  auto writer = PtexWriter::Create(dir / "stepped.ptx", w, object->num_faces());
+  ASSERT_TRUE(writer.ok());
+  ASSERT_TRUE(writer->AddMetaData(std::string(kVectorSpaceMetaKey), "object").ok());
+  for (int f = 0; f < object->num_faces(); ++f) {
+    ASSERT_TRUE(object->ReadFace(PtexFaceId(f), 0, texels).ok());
+    for (std::size_t i = 0; f == 0 && i < texels.size(); i += 3) {
+      texels[i] += 3 * k;
+      texels[i + 1] += 4 * k;
+    }
+    ASSERT_TRUE(writer->SetFace(PtexFaceId(f), object->face_info(PtexFaceId(f)), texels).ok());
+  }
+  ASSERT_TRUE(writer->Finish().ok());
+  VerifyReport stepped = VerifyEdges(cage, dir / "stepped.ptx");
+  EXPECT_NEAR(stepped.edge_per_face.max, 5 * k, 1e-6);
+  ASSERT_FALSE(stepped.worst_edges.empty());
+  EXPECT_TRUE(stepped.worst_edges[0].face == 0 || stepped.worst_edges[0].neighbour == 0);
+  EXPECT_NEAR(stepped.worst_edges[0].step, 5 * k, 1e-6);
+}
+
+// A map verify cannot read as scalar or vector is an error naming it, from the library and on
+// the command line (one line, exit 1); so is a vector map whose space is not known. The report
+// says which kind of map it measured. Rejects a verify that reads channel 0 of any map.
+TEST(VectorMapErrors, MapsThatAreNeitherScalarNorVector) {
+  TempDir dir;
+  const std::string cage = DataPath(kSpot);
+  auto base = ReadMesh(cage);
+  auto surface = LimitSurface::Build(*base);
+  ASSERT_TRUE(surface.ok());
+  const int faces = surface->num_ptex_faces();
+  auto write = [&](const std::string& name, int channels, const char* space) {
+    PtexWriterOptions w;
+    w.num_channels = channels;
+    auto writer = PtexWriter::Create(dir / name, w, faces);
+    ASSERT_TRUE(writer.ok());
+    if (space) {
+      ASSERT_TRUE(writer->AddMetaData(std::string(kVectorSpaceMetaKey), space).ok());
+    }
+    const std::vector<float> value(static_cast<std::size_t>(channels), 0.01f);
+    for (int f = 0; f < faces; ++f) {
+      ASSERT_TRUE(writer->SetConstantFace(PtexFaceId(f), PtexFaceInfo{}, value).ok());
+    }
+    ASSERT_TRUE(writer->Finish().ok());
+  };
+  write("three.ptx", 3, nullptr);
+  write("two.ptx", 2, nullptr);
+  write("world.ptx", 3, "world");
+  write("object.ptx", 3, "object");
+  const std::pair<const char*, const char*> cases[] = {
+      {"three.ptx", "three.ptx: 3 channels but no dispex:vector_space meta data"},
+      {"two.ptx", "two.ptx: 2 channels: a displacement map has 1 (scalar) or 3 (vector"},
+      {"world.ptx", "world.ptx: dispex:vector_space: unknown vector space 'world'"}};
+  for (const auto& [name, message] : cases) {
+    VerifyOptions verify;
+    verify.base_path = cage;
+    verify.map_path = dir / name;
+    auto report = Verify(verify);
+    ASSERT_FALSE(report.ok()) << name;
+    EXPECT_NE(report.status().message().find(message), std::string::npos)
+        << report.status().message();
+    auto cli = RunDispex("verify " + cage + " " + (dir / name), dir);
+    EXPECT_EQ(cli.exit_code, 1) << cli.err;
+    EXPECT_EQ(std::count(cli.err.begin(), cli.err.end(), '\n'), 1) << cli.err;
+    EXPECT_NE(cli.err.find(message), std::string::npos) << cli.err;
+  }
+  // The kind of map, in the summary and the JSON report.
+  auto cli = RunDispex(
+      "verify " + cage + " " + (dir / "object.ptx") + " --report " + (dir / "v.json"), dir);
+  EXPECT_EQ(cli.exit_code, 0) << cli.err;
+  EXPECT_NE(cli.out.find("vector map (object space: P + D)"), std::string::npos) << cli.out;
+  EXPECT_NE(cli.out.find("edge steps of |D| in object space"), std::string::npos) << cli.out;
+  const std::string json = Slurp(dir / "v.json");
+  EXPECT_NE(json.find("\"map_kind\": \"vector\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"vector_space\": \"object\""), std::string::npos) << json;
+}
+
+// The command line end to end: make-sculpt lists and makes the vector patterns (both layouts),
+// and verify takes a vector map with no new flag, against the sculpt and the truth.
+TEST(VectorCli, MakeSculptAndVerify) {
+  TempDir dir;
+  const std::string cage = DataPath(kSpot);
+  auto help = RunDispex("make-sculpt --help", dir);
+  EXPECT_NE(help.out.find("sideways"), std::string::npos);
+  EXPECT_NE(help.out.find("overhang"), std::string::npos);
+  for (const char* layout : {"--levels 3", "--layout jittered --density 6"}) {
+    auto made = RunDispex("make-sculpt " + cage + " " + layout +
+                              " --pattern overhang --amplitude 0.01 -o " + (dir / "s.obj"),
+                          dir);
+    EXPECT_EQ(made.exit_code, 0) << made.err;
+    EXPECT_NE(made.err.find("max tangential |D|"), std::string::npos) << made.err;
+    auto truth = ReadGroundTruth(dir / "s.obj.truth");
+    ASSERT_TRUE(truth.ok());
+    EXPECT_EQ(truth->version(), 3);
+  }
+  // The jittered overhang (the last one made), its object map at 64 x 64 texels per face.
+  MakeSculptOptions make =
+      testing::JitteredSculptOptions(cage, dir / "s.obj", 6, Pattern::kOverhang, 0.01);
+  auto made = MakeSculpt(make);
+  ASSERT_TRUE(made.ok());
+  PatternMapOptions o;
+  o.log2 = 6;
+  o.space = VectorSpace::kObject;
+  WritePatternMap(cage, Pattern::kOverhang, made->frame, dir / "v.ptx", o);
+  const std::string tau = std::to_string(0.1 * made->max_displacement);
+  auto verified = RunDispex("verify " + cage + " " + (dir / "s.obj") + " " + (dir / "v.ptx") +
+                                " --truth " + (dir / "s.obj.truth") + " --tolerance " + tau,
+                            dir);
+  EXPECT_EQ(verified.exit_code, 0) << verified.err << verified.out;
+  EXPECT_NE(verified.out.find("truth (version 3) measured as |D_map - D|"), std::string::npos)
+      << verified.out;
+  o.space = std::nullopt;
+  WritePatternMap(cage, Pattern::kOverhang, made->frame, dir / "h.ptx", o);
+  auto scalar = RunDispex("verify " + cage + " " + (dir / "h.ptx") + " --truth " +
+                              (dir / "s.obj.truth") + " --tolerance " + tau + " -q",
+                          dir);
+  EXPECT_EQ(scalar.exit_code, 3) << scalar.err;
+  EXPECT_NE(scalar.err.find("in |map N - D|"), std::string::npos) << scalar.err;
+}
+
 }  // namespace
 }  // namespace dispex
