@@ -207,7 +207,8 @@ struct VerifyOptions {
   // Bounds against the truth, scaled by the tolerance tau: this one, or 0 for the map's own
   // (its dispex:statistics meta data); with neither they are not checked.
   double tolerance = 0;
-  // Per record of a version-2 truth file: fail when |map - h| > k tau + 2 e_v at any record,
+  // Per record of a version-2 or -3 truth file: fail when the record's error
+  // (VerifyReport::truth_quantity, e.g. |map - h|) > k tau + 2 e_v at any record,
   // k = truth_local_tolerance_factor and e_v the sculpt's linear error near the vertex
   // (GroundTruth). k > 1: extract holds tau at its samples only; between them (read on a
   // coarser texel grid) and within half a sample of a face edge (where the read is clamped)
@@ -260,9 +261,9 @@ struct VerifyReport {
   // The mean signed error of the normal part: map - h, or (D_map - D).N.
   double truth_signed_mean = 0;
   double truth_tolerance = 0;               // tau of the truth bounds (0: they were not checked)
-  bool truth_local_checked = false;         // the per-record bound (a version-2 truth file)
-  std::size_t truth_over_bound = 0;         // records with |map - h| > k tau + 2 e_v
-  double truth_worst_ratio = 0;             // the largest |map - h| / (k tau + 2 e_v)
+  bool truth_local_checked = false;         // the per-record bound (a version-2 or -3 truth file)
+  std::size_t truth_over_bound = 0;         // records whose error exceeds k tau + 2 e_v
+  double truth_worst_ratio = 0;             // the largest error / (k tau + 2 e_v)
   double truth_local_tolerance_factor = 0;  // k
   std::size_t truth_unbounded = 0;  // records near folded sculpt faces (e_v infinite): unchecked
   struct TruthRecord {
@@ -313,9 +314,10 @@ struct VerifyReport {
   double seconds = 0;
 };
 
-// Re-displaces the base limit surface with the map (read bilinearly, as a renderer would) and
-// measures it against the sculpt both ways, and/or against a truth file; measures the steps
-// at shared face edges always.
+// Re-displaces the base limit surface with the map (read bilinearly, as a renderer would: P + h
+// N, or P + D for a vector map) and measures it against the sculpt both ways, and/or against a
+// truth file; measures the steps at shared face edges always. Fails, naming the map, for a map
+// that is neither scalar nor vector (DisplacementMapSpace).
 StatusOr<VerifyReport> Verify(const VerifyOptions& options);
 
 std::string VerifyReportJson(const VerifyReport& report);
