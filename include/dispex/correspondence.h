@@ -88,14 +88,16 @@ Float3 SculptPointAt(const SculptCorrespondence& correspondence, const Mesh& scu
 // base refined: the sculpt has a face that is not a quad, or a vertex no face uses; its counts
 // fit no level; an edge of it has more than two faces, or two faces run it the same way; its
 // connected components differ from the base's; vertex V has valence k where base vertex W has
-// k'; face F does not fit the grid of Ptex face P; the position check failed (vertex V is D
-// from its home on Ptex face P, more than the limit). A cage the match cannot work on fails
-// with a message starting with the cage's source: an edge with more than two faces, or two
-// faces running an edge the same way. Bad options fail too.
+// k'; face F does not fit the grid of Ptex face P; every face winds the other way (flipped
+// normals: the sculpt is matched once more with its faces reversed to tell so); the position
+// check failed (vertex V is D from its home on Ptex face P, more than the limit, or no vertex
+// of a base vertex's valence is within the limit of its limit point). A cage the match cannot
+// work on fails with a message starting with the cage's source: an edge with more than two
+// faces, or two faces running an edge the same way. Bad options fail too.
 //
 // Topology decides; positions only choose among the refinement's symmetries (the labelling
 // whose offsets at the base vertices, across the limit normal above all, are least) and bound
-// the result. A sculpt whose faces all wind the other way is not matched.
+// the result.
 //
 // Runs in a TBB arena of options.threads; the result is the same for any thread count. Memory
 // besides the sculpt: about 60 bytes per sculpt face at the peak (its half-edge adjacency),

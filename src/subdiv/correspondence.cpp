@@ -98,7 +98,6 @@ struct BaseComponent {
 struct SeedAttempt {
   bool complete = false;   // every Ptex face of the component seeded, all checks passed
   bool pruned = false;     // stopped: already worse than the best complete one
-  bool position = false;   // the failure is the position check (not the topology)
   std::size_t seeded = 0;  // Ptex faces seeded before it stopped
   double score = 0;        // SeedScore summed over the base vertices met
   Status failure;
@@ -121,6 +120,7 @@ class Matcher {
     DISPEX_RETURN_IF_ERROR(MatchComponents());
     DISPEX_RETURN_IF_ERROR(EvaluateBaseVertices());
     IndexSculptVertexClasses();
+    labelling_ = true;
     for (const BaseComponent& component : components_) {
       DISPEX_RETURN_IF_ERROR(SeedComponent(component));
     }
@@ -136,6 +136,10 @@ class Matcher {
     out_.seconds = clock.seconds();
     return std::move(out_);
   }
+
+  // Whether Run got as far as labelling the quads: then a failure may be a sculpt whose faces
+  // all wind the other way, which the counts, edges and components cannot tell.
+  bool labelling() const { return labelling_; }
 
  private:
   // ---- 1. Inputs and level ------------------------------------------------------------------
@@ -184,6 +188,10 @@ class Matcher {
 
   Status FindLevel() {
     const std::uint64_t faces = sculpt_.num_faces(), vertices = sculpt_.num_vertices();
+    const auto gap = [&](int level) {
+      const std::uint64_t f = cage_.CountFaces(level);
+      return f > faces ? f - faces : faces - f;
+    };
     int nearest = -1;
     for (int level = 0; level <= options_.max_levels; ++level) {
       const std::uint64_t level_faces = cage_.CountFaces(level);
@@ -200,17 +208,13 @@ class Matcher {
         out_.levels = level;
         return Status::Ok();
       }
-      const auto gap = [&](int l) {
-        const std::uint64_t f = cage_.CountFaces(l);
-        return f > faces ? f - faces : faces - f;
-      };
       if (nearest < 0 || gap(level) < gap(nearest)) nearest = level;
     }
     if (nearest < 0) {
       return Status::Error(fmt::format(
-          "{}: counts fit no level of {}: it has faces other than quads, so levels 1..{} are "
-          "needed",
-          where_, s_.source, options_.max_levels));
+          "{}: counts fit no level of {}: it has faces other than quads, so no level 0, and "
+          "max_levels is 0",
+          where_, s_.source));
     }
     return Status::Error(fmt::format(
         "{}: counts fit no level of {} (0..{}): {} faces and {} vertices; the nearest, level "
@@ -266,17 +270,16 @@ class Matcher {
     std::sort(base_sizes.begin(), base_sizes.end());
     std::sort(sculpt_sizes.begin(), sculpt_sizes.end());
     if (base_sizes != sculpt_sizes) {
-      const auto list = [](const std::vector<std::uint64_t>& sizes) {
+      const auto describe = [](const std::vector<std::uint64_t>& sizes) {
         constexpr std::size_t kShown = 6;
-        std::string text = fmt::format(
-            "{}", fmt::join(sizes.begin(), sizes.begin() + std::min(sizes.size(), kShown), ", "));
-        return sizes.size() > kShown ? text + ", ..." : text;
+        return fmt::format(
+            "{} connected component{} of {}{} faces", sizes.size(), sizes.size() == 1 ? "" : "s",
+            fmt::join(sizes.begin(), sizes.begin() + std::min(sizes.size(), kShown), ", "),
+            sizes.size() > kShown ? ", ..." : "");
       };
       return Status::Error(fmt::format(
-          "{}: the components differ: the sculpt has {} connected component{} of {} faces, {} "
-          "refined {} times {} of {}",
-          where_, sculpt_sizes.size(), sculpt_sizes.size() == 1 ? "" : "s", list(sculpt_sizes),
-          s_.source, out_.levels, base_sizes.size(), list(base_sizes)));
+          "{}: the components differ: the sculpt has {}; {} refined {} times has {}", where_,
+          describe(sculpt_sizes), s_.source, out_.levels, describe(base_sizes)));
     }
     return Status::Ok();
   }
@@ -367,23 +370,25 @@ class Matcher {
     return (g & ~3u) | ((g - static_cast<std::uint32_t>(their_edge)) & 3u);
   }
   Label Step(Label label, int edge) const { return Cross(label, edge, (edge + 2) & 3); }
-  // From cell `from` to cell `to` of one grid, along u first; stuck_ keeps the label of the
-  // cell it could not leave.
+  // From cell `from` to cell `to` of one grid, along u first; stuck_ keeps the cell it could
+  // not leave and the edge it could not cross.
   Label Walk(Label label, GridPoint from, GridPoint to) {
     for (int i = from.i; i != to.i; i += to.i > i ? 1 : -1) {
-      const Label next = Step(label, to.i > i ? 1 : 3);
-      if (next == kNoLabel) return Stuck(label);
+      const int edge = to.i > i ? 1 : 3;
+      const Label next = Step(label, edge);
+      if (next == kNoLabel) return Stuck(label, edge);
       label = next;
     }
     for (int j = from.j; j != to.j; j += to.j > j ? 1 : -1) {
-      const Label next = Step(label, to.j > j ? 2 : 0);
-      if (next == kNoLabel) return Stuck(label);
+      const int edge = to.j > j ? 2 : 0;
+      const Label next = Step(label, edge);
+      if (next == kNoLabel) return Stuck(label, edge);
       label = next;
     }
     return label;
   }
-  Label Stuck(Label label) {
-    stuck_ = label;
+  Label Stuck(Label label, int edge) {
+    stuck_ = {label, edge};
     return kNoLabel;
   }
   std::int32_t VertexAt(Label label, int corner) const {
@@ -391,12 +396,16 @@ class Matcher {
   }
   Vec3d Position(std::int32_t vertex) const { return ToVec3d(sculpt_.positions[vertex]); }
 
-  std::string NoNeighbourMessage(Label label, int ptex) const {
+  // Face `label` / 4 in Ptex face `ptex` has no neighbour across the cell's edge `edge`.
+  std::string NoNeighbourMessage(Label label, int edge, int ptex) const {
     const int n = cage_.grid_size(ptex);
     return fmt::format(
         "{}: face {} does not fit the grid of Ptex face {} ({}x{}): it has no neighbour across "
         "its edge {}-{}, where the refined base has one",
-        where_, label / 4, ptex, n, n, VertexAt(label, 0), VertexAt(label, 1));
+        where_, label / 4, ptex, n, n, VertexAt(label, edge), VertexAt(label, edge + 1));
+  }
+  std::string NoNeighbourMessage(int ptex) const {
+    return NoNeighbourMessage(stuck_.label, stuck_.edge, ptex);
   }
 
   // The labelling with `start` in Ptex face p0's cell at `corner`, spread over the component.
@@ -435,7 +444,6 @@ class Matcher {
       base_sculpt_[w] = x;
       const double d2 = Distance2(Position(x), base_limit_[w]);
       if (d2 > offset_limit_ * offset_limit_) {
-        attempt.position = true;
         attempt.failure = Status::Error(fmt::format(
             "{}: the position check failed: vertex {} is {:.6g} from its home at base vertex {} "
             "(Ptex face {}), more than max_offset {:.6g}",
@@ -453,7 +461,7 @@ class Matcher {
     queue_.clear();
     const int n0 = cage_.grid_size(p0);
     const Label origin0 = Walk(start, CornerCell(n0, corner), {0, 0});
-    if (origin0 == kNoLabel) return fail(NoNeighbourMessage(stuck_, p0));
+    if (origin0 == kNoLabel) return fail(NoNeighbourMessage(p0));
     if (!seed(p0, origin0)) return attempt;
     for (std::size_t next = 0; next < queue_.size(); ++next) {
       const int p = queue_[next];
@@ -464,16 +472,16 @@ class Matcher {
         const PtexEdgePlace across = cage_.Across(p, edge, position, true);
         if (across.face < 0 || seeds_[across.face] != kNoLabel) continue;
         const Label here = Walk(seeds_[p], {0, 0}, RefinedCage::OnEdge(n, edge, position, true));
-        if (here == kNoLabel) return fail(NoNeighbourMessage(stuck_, p));
+        if (here == kNoLabel) return fail(NoNeighbourMessage(p));
         const Label there = Cross(here, edge, across.edge);
         if (there == kNoLabel) {
           return fail(
-              fmt::format("{} (in Ptex face {})", NoNeighbourMessage(here, p), across.face));
+              fmt::format("{} (in Ptex face {})", NoNeighbourMessage(here, edge, p), across.face));
         }
         const int m = cage_.grid_size(across.face);
         const Label origin =
             Walk(there, RefinedCage::OnEdge(m, across.edge, across.position, true), {0, 0});
-        if (origin == kNoLabel) return fail(NoNeighbourMessage(stuck_, across.face));
+        if (origin == kNoLabel) return fail(NoNeighbourMessage(across.face));
         if (!seed(across.face, origin)) return attempt;
       }
     }
@@ -671,7 +679,8 @@ class Matcher {
       if (j > 0) {
         const Label up = Step(row, 2);
         if (up == kNoLabel) {
-          error.Record(cell_offsets_[p] + (j - 1) * n, Status::Error(NoNeighbourMessage(row, p)));
+          error.Record(cell_offsets_[p] + (j - 1) * n,
+                       Status::Error(NoNeighbourMessage(row, 2, p)));
           return;
         }
         row = up;
@@ -682,7 +691,7 @@ class Matcher {
           const Label right = Step(label, 1);
           if (right == kNoLabel) {
             error.Record(cell_offsets_[p] + j * n + i - 1,
-                         Status::Error(NoNeighbourMessage(label, p)));
+                         Status::Error(NoNeighbourMessage(label, 1, p)));
             return;
           }
           label = right;
@@ -953,6 +962,7 @@ class Matcher {
     return Status::Ok();
   }
 
+  bool labelling_ = false;
   const LimitSurface& surface_;
   const LimitSurface::Impl& s_;
   const Mesh& sculpt_;
@@ -976,7 +986,10 @@ class Matcher {
   std::vector<Label> seeds_;
   std::vector<std::int32_t> base_sculpt_;
   std::vector<int> queue_;
-  Label stuck_ = kNoLabel;
+  struct {
+    Label label = kNoLabel;
+    int edge = 0;
+  } stuck_;
 
   std::vector<std::int64_t> cell_offsets_;  // per Ptex face, into cells_
   std::vector<Label> cells_;
@@ -1008,7 +1021,31 @@ StatusOr<SculptCorrespondence> MatchRefinedSculpt(const LimitSurface& surface, c
                                                   const MatchOptions& options) {
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   std::optional<StatusOr<SculptCorrespondence>> result;
-  arena.execute([&] { result.emplace(Matcher(surface, sculpt, options).Run()); });
+  arena.execute([&] {
+    bool labelling = false;
+    {
+      Matcher matcher(surface, sculpt, options);
+      result.emplace(matcher.Run());
+      labelling = matcher.labelling();
+    }
+    if (result->ok() || !labelling) return;
+    // Flipped normals: say so rather than which quad the labelling stumbled on.
+    Mesh reversed;
+    reversed.source = sculpt.source;
+    reversed.positions = sculpt.positions;
+    reversed.face_offsets = sculpt.face_offsets;
+    reversed.face_indices = sculpt.face_indices;
+    for (std::size_t f = 0; f < reversed.num_faces(); ++f) {
+      std::swap(reversed.face_indices[4 * f + 1], reversed.face_indices[4 * f + 3]);
+    }
+    auto mirrored = Matcher(surface, reversed, options).Run();
+    if (mirrored.ok()) {
+      result.emplace(Status::Error(fmt::format(
+          "{}: every face winds the other way from the cage's (flipped normals); reversed, it "
+          "is the cage refined {} times",
+          sculpt.source.empty() ? "sculpt" : sculpt.source, mirrored->levels)));
+    }
+  });
   return std::move(*result);
 }
 
