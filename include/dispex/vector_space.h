@@ -22,6 +22,8 @@ namespace dispex {
 enum class VectorSpace : std::uint8_t { kTangent, kParametric, kObject };
 // "tangent", "parametric", "object".
 std::string_view VectorSpaceName(VectorSpace space);
+// The frame's definition in one line, as maps record it (dispex:frame).
+std::string_view VectorSpaceFrame(VectorSpace space);
 StatusOr<VectorSpace> ParseVectorSpace(std::string_view name);
 // The channel names in order, comma-separated: "T,B,N", "a,b,n", "x,y,z".
 std::string_view VectorSpaceChannels(VectorSpace space);

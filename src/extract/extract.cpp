@@ -25,6 +25,7 @@
 #include "extract/parallel_errors.h"
 #include "extract/previous_map.h"
 #include "extract/process_faces.h"
+#include "extract/vector_faces.h"
 
 namespace dispex::extract {
 
@@ -168,16 +169,27 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   const auto num_faces = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
   PreviousMap previous;
   if (options.incremental) {
-    previous = PreviousMap::Open(options.output_path, num_faces);
-    if (previous.usable() && previous.MetaString(kInputsKeyMetaKey) == report.inputs_key) {
+    // Vector maps are made whole; an up-to-date map of either kind is left as it is.
+    if (!options.vector) previous = PreviousMap::Open(options.output_path, num_faces);
+    const std::string stored = options.vector      ? StoredInputsKey(options.output_path)
+                               : previous.usable() ? previous.MetaString(kInputsKeyMetaKey)
+                                                   : "";
+    if (stored == report.inputs_key) {
       report.unchanged = true;
       report.t_total = total_clock.seconds();
       report.peak_rss_bytes = PeakResidentBytes();
       return report;
     }
+  }
+  if (options.incremental && options.vector) {
+    report.redo_reason = "a vector map is extracted whole when anything changed";
+  } else if (options.incremental) {
     previous.CheckFaceData();
     if (!previous.notice().empty()) report.warnings.push_back(previous.notice());
     report.redo_reason = RedoReason(previous, report);
+  }
+  if (options.vector) {
+    return ExtractVectorShape(options, std::move(inputs), std::move(report), total_clock);
   }
   // The automatic search distance is estimated with rays over the whole surface; a given one
   // lets a re-run trace only the sculpt within reach of the faces it extracts.

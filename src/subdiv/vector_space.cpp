@@ -47,6 +47,22 @@ StatusOr<VectorSpace> ParseVectorSpace(std::string_view name) {
       fmt::format("unknown vector space '{}' (valid: tangent, parametric, object)", name));
 }
 
+std::string_view VectorSpaceFrame(VectorSpace space) {
+  switch (space) {
+    case VectorSpace::kTangent:
+      return "D = c0 T + c1 B + c2 N; T = normalize(dP/du), N = the unit limit normal "
+             "normalize(dP/du x dP/dv), B = N x T; P the Catmull-Clark limit surface, (u, v) "
+             "the Ptex face's own coordinates in [0, 1]";
+    case VectorSpace::kParametric:
+      return "D = c0 dP/du + c1 dP/dv + c2 N; N = the unit limit normal normalize(dP/du x "
+             "dP/dv); P the Catmull-Clark limit surface, (u, v) the Ptex face's own "
+             "coordinates in [0, 1]";
+    case VectorSpace::kObject:
+      break;
+  }
+  return "D = (c0, c1, c2) in the base mesh's object space";
+}
+
 std::string_view VectorSpaceChannels(VectorSpace space) {
   switch (space) {
     case VectorSpace::kTangent:
