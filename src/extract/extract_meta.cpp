@@ -45,11 +45,14 @@ nlohmann::json ExtractOptionsJson(const ExtractOptions& o) {
   j["max_miss_fraction"] = o.max_miss_fraction;
   j["bvh_quality"] = std::string(BuildQualityName(o.bvh_quality));
   j["watertight"] = std::string(WatertightEdgesName(o.watertight));
+  // Only when given: maps made before the option existed keep their keys.
+  if (o.method != ExtractMethod::kAuto) j["method"] = std::string(ExtractMethodName(o.method));
   return j;
 }
 
 nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
   nlohmann::json j;
+  j["method"] = std::string(ExtractMethodName(r.method));
   j["tolerance"] = r.tolerance;
   j["tolerance_auto"] = r.tolerance_auto;
   j["sculpt_median_edge"] = r.sculpt_median_edge;

@@ -89,12 +89,15 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
     DISPEX_ASSIGN_OR_RETURN(o.max_miss_fraction, NumberValue(v));
   } else if (name == "bvh_quality") {
     return SetNamed(o.bvh_quality, v, ParseBuildQuality);
+  } else if (name == "method") {
+    return SetNamed(o.method, v, ParseExtractMethod);
   } else {
     return Status::Error(
         "unknown option (known: oversample, max_oversample, min_oversample, search_distance, "
         "ray_policy, tolerance, tolerance_fraction, resolution_rule, fixed_resolution, "
         "nonzero_threshold, "
-        "data_type, compression_level, holes, watertight, max_miss_fraction, bvh_quality)");
+        "data_type, compression_level, holes, watertight, max_miss_fraction, bvh_quality, "
+        "method)");
   }
   return Status::Ok();
 }
