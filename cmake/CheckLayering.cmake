@@ -13,7 +13,7 @@ set(levels core 0 mesh 1 subdiv 2 trace 3 spectral 4 ptex 5 extract 6 verify 7 r
 set(owners
   status core ids core version core files core cancel core
   mesh mesh shapes mesh
-  subdiv subdiv vector_space subdiv
+  subdiv subdiv vector_space subdiv correspondence subdiv
   trace trace
   spectral spectral
   ptex ptex ptex_sampler ptex ptex_describe ptex

@@ -64,6 +64,9 @@ run "zero search distance" extract "$cage" sculpt.obj -o out.ptx --search-distan
 run "negative tolerance" extract "$cage" sculpt.obj -o out.ptx --tolerance -1
 run "zero tolerance" extract "$cage" sculpt.obj -o out.ptx --tolerance 0
 run "zero amplitude" make-sculpt "$cage" -o s.obj --amplitude 0
+run "sculpt of another cage (match)" match "$root/tests/data/meshes/keenan_spot/spot_control_mesh.obj" sculpt.obj
+run "sculpt off the limit surface (match)" match "$cage" sculpt.obj --max-offset 1e-9
+run "non-manifold base (match)" match nonmanifold.obj sculpt.obj
 run "unknown option" extract "$cage" sculpt.obj -o out.ptx --frobnicate
 run "too little memory" extract "$cage" sculpt.obj -o out.ptx --max-memory 1K
 run "output in a missing directory" extract "$cage" sculpt.obj -o nodir/out.ptx

@@ -195,6 +195,27 @@ TEST_F(BadInput, OutputPaths) {
   }
 }
 
+// `dispex match`: a sculpt that is the base refined is matched (facts on stdout, JSON on
+// request); one of another cage, or too far from the limit surface, is refused with the reason.
+TEST_F(BadInput, MatchRefusesWithTheReasonAndAcceptsTheRefinedBase) {
+  const std::string spot = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
+  ExpectFailure("match " + spot + " " + sculpt_ + " --json " + (dir_ / "m.json"),
+                "counts fit no level of");
+  ExpectFailure("match " + cage_ + " " + sculpt_ + " --max-offset 1e-9 --json " + (dir_ / "m.json"),
+                "the position check failed");
+  ExpectFailure("match " + cage_ + " " + sculpt_ + " --max-offset 0", "--max-offset", 2);
+  ExpectFailure("match " + cage_ + " " + sculpt_ + " --max-levels 8", "--max-levels", 2);
+  auto r = RunDispex("match " + cage_ + " " + sculpt_ + " --json " + (dir_ / "m.json"), dir_);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_NE(r.out.find("level 2 (the sculpt is"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("components 1\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("max offset "), std::string::npos) << r.out;
+  std::ifstream json(dir_ / "m.json");
+  const std::string text((std::istreambuf_iterator<char>(json)), {});
+  EXPECT_NE(text.find("\"levels\": 2"), std::string::npos) << text;
+}
+
 // Assets of several shapes through the command line: the errors, and a run that works.
 TEST_F(BadInput, ShapesOptionsAndNames) {
   // Two shapes of the same cage in one base; the sculpt names one of them in other letter case.

@@ -1,0 +1,108 @@
+// Subdivision correspondence: whether a sculpt is the base cage refined L times (Catmull-Clark,
+// quads) with its vertices moved, and if so where every sculpt vertex sits on the base.
+//
+// Sculpting tools number vertices and faces their own way and may start each face's corner
+// list at any corner, but they keep the topology of the refinement and the winding of the
+// faces. The match is decided on the topology alone: the sculpt must be isomorphic, face for
+// face and vertex for vertex with the winding kept, to the cage refined L times (holes
+// dropped, as RefineUniform and MakeSculpt drop them). Positions only pick, among the
+// refinement's symmetries, the labelling closest to the limit surface, and check the result.
+//
+// Grids (the Ptex conventions of dispex/subdiv.h): after L refinements a quad Ptex face is
+// n x n sculpt quads, n = 2^L; a sub-face of an n-gon is 2^(L-1) x 2^(L-1) (so L = 0 is only
+// possible when every face with a surface is a quad); a hole face has none. Grid vertex (i, j)
+// of a face of size n sits at Ptex (u, v) = (i / n, j / n); vertices on a Ptex face's border
+// belong to the grids of every face that meets there.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "dispex/ids.h"
+#include "dispex/mesh.h"
+#include "dispex/status.h"
+#include "dispex/subdiv.h"
+
+namespace dispex {
+
+struct MatchOptions {
+  // Levels tried, 0..max_levels; valid 0..7.
+  int max_levels = 7;
+  // The position check: a sculpt vertex farther than this from its home point on the limit
+  // surface rejects the match (object units; 0: 15% of the base's bounding-box diagonal).
+  double max_offset = 0;
+  int threads = 0;  // 0: TBB's default; the result does not depend on it
+};
+
+struct SculptCorrespondence {
+  int levels = 0;  // the sculpt is the cage refined this many times
+
+  // Per Ptex face f: its (n+1) x (n+1) grid of sculpt vertex ids, n = grid_sizes[f]; vertex
+  // (i, j), at Ptex (u, v) = (i / n, j / n), is grid_vertices[grid_offsets[f] + j * (n+1) + i].
+  // Hole faces have n = 0 and no entries.
+  std::vector<std::int64_t> grid_offsets;  // num_ptex_faces + 1
+  std::vector<VertexId> grid_vertices;
+  std::vector<std::int32_t> grid_sizes;  // per Ptex face: n
+
+  // Per sculpt vertex: one home, in the first Ptex face (by id) whose grid holds it, and its
+  // (u, v) there (2 floats per vertex, exact: multiples of 1 / n).
+  std::vector<PtexFaceId> vertex_faces;
+  std::vector<float> vertex_uvs;
+
+  // Per sculpt face: its Ptex face, its cell (i, j) there as face_cell = i + j * n, and which
+  // of its corners sits at the cell's (i, j) corner: the cell's corners (i,j), (i+1,j),
+  // (i+1,j+1), (i,j+1) are the face's corners r, r+1, r+2, r+3 (mod 4), r = face_rotation.
+  std::vector<PtexFaceId> face_ptex;
+  std::vector<std::int32_t> face_cell;
+  std::vector<std::uint8_t> face_rotation;
+
+  std::size_t components = 0;  // connected components matched (edge-connected)
+
+  // The position check: |sculpt vertex - limit point at its home| over the vertices checked,
+  // each once, at its home: every vertex of grids up to 8 x 8; on larger grids those on the
+  // border and on every (n / 8)-th row and column (a quarter of them on large grids).
+  std::size_t checked_vertices = 0;
+  double max_offset = 0, rms_offset = 0;
+  VertexId worst_vertex;    // the vertex of max_offset
+  double offset_limit = 0;  // the bound in use (MatchOptions::max_offset or its default)
+  double seconds = 0;
+
+  int grid_size(PtexFaceId face) const { return grid_sizes[face.value]; }
+  // Precondition: 0 <= i, j <= grid_size(face).
+  VertexId vertex(PtexFaceId face, int i, int j) const {
+    const int n = grid_sizes[face.value];
+    return grid_vertices[grid_offsets[face.value] + static_cast<std::int64_t>(j) * (n + 1) + i];
+  }
+};
+
+// The sculpt surface at (u, v) of Ptex face `face`: bilinear interpolation over the sculpt
+// quad of the face's grid that contains (u, v): cell i = min(floor(u n), n - 1), local
+// s = u n - i, likewise j and t from v. (u, v) are clamped to [0, 1]. Preconditions: `face`
+// is not a hole (grid_size > 0) and `sculpt` is the mesh that was matched.
+Float3 SculptPointAt(const SculptCorrespondence& correspondence, const Mesh& sculpt,
+                     PtexFaceId face, float u, float v);
+
+// The correspondence of `sculpt` to `surface` (the base cage's limit surface), or a Status
+// whose one-line message starts with the sculpt's source and says why the sculpt is not the
+// base refined: the sculpt has a face that is not a quad, or a vertex no face uses; its counts
+// fit no level; an edge of it has more than two faces, or two faces run it the same way; its
+// connected components differ from the base's; vertex V has valence k where base vertex W has
+// k'; face F does not fit the grid of Ptex face P; every face winds the other way (flipped
+// normals: the sculpt is matched once more with its faces reversed to tell so); the position
+// check failed (vertex V is D from its home on Ptex face P, more than the limit, or no vertex
+// of a base vertex's valence is within the limit of its limit point). A cage the match cannot
+// work on fails with a message starting with the cage's source: an edge with more than two
+// faces, or two faces running an edge the same way. Bad options fail too.
+//
+// Topology decides; positions only choose among the refinement's symmetries (the labelling
+// whose offsets at the base vertices, across the limit normal above all, are least) and bound
+// the result.
+//
+// Runs in a TBB arena of options.threads; the result is the same for any thread count. Memory
+// besides the sculpt: about 60 bytes per sculpt face at the peak (its half-edge adjacency),
+// of which the result keeps about 26.
+StatusOr<SculptCorrespondence> MatchRefinedSculpt(const LimitSurface& surface, const Mesh& sculpt,
+                                                  const MatchOptions& options = {});
+
+}  // namespace dispex

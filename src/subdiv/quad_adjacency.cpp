@@ -1,0 +1,224 @@
+#include "subdiv/quad_adjacency.h"
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+
+#include "core/check.h"
+
+namespace dispex::subdiv {
+namespace {
+
+using Range = tbb::blocked_range<std::size_t>;
+
+std::uint32_t Load(std::uint32_t& slot) {
+  return std::atomic_ref<std::uint32_t>(slot).load(std::memory_order_relaxed);
+}
+
+// The lowest index for which `bad` holds, or `none`.
+template <class Bad>
+std::size_t LowestWhere(std::size_t count, std::size_t none, Bad bad) {
+  tbb::combinable<std::size_t> lowest([none] { return none; });
+  tbb::parallel_for(Range(0, count, 4096), [&](const Range& r) {
+    std::size_t& mine = lowest.local();
+    for (std::size_t i = r.begin(); i < r.end() && i < mine; ++i) {
+      if (bad(i)) {
+        mine = i;
+        break;
+      }
+    }
+  });
+  return lowest.combine([](std::size_t a, std::size_t b) { return std::min(a, b); });
+}
+
+}  // namespace
+
+StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
+  DISPEX_CHECK(mesh.all_quads());
+  const std::size_t num_faces = mesh.num_faces();
+  const std::size_t num_vertices = mesh.num_vertices();
+  const std::size_t num_half_edges = 4 * num_faces;
+  DISPEX_CHECK_LT(num_half_edges, std::size_t{kNoHalfEdge});
+  const std::int32_t* start = mesh.face_indices.data();
+  auto end = [start](std::size_t h) { return start[QuadAdjacency::Next(h)]; };
+
+  const std::size_t repeating = LowestWhere(num_faces, num_faces, [&](std::size_t f) {
+    const std::int32_t* q = start + 4 * f;
+    return q[0] == q[1] || q[0] == q[2] || q[0] == q[3] || q[1] == q[2] || q[1] == q[3] ||
+           q[2] == q[3];
+  });
+  if (repeating != num_faces) {
+    const std::int32_t* q = start + 4 * repeating;
+    const std::int32_t twice = (q[0] == q[1] || q[0] == q[2] || q[0] == q[3]) ? q[0]
+                               : (q[1] == q[2] || q[1] == q[3])               ? q[1]
+                                                                              : q[2];
+    return Status::Error(
+        fmt::format("{}: face {} uses vertex {} twice", mesh.source, repeating, twice));
+  }
+
+  // Half-edges bucketed by their start vertex, in order: bucket[v] spans [first[v],
+  // first[v + 1]). Each task owns a range of vertices and scans every half-edge for those it
+  // owns, so that the scattered updates need no atomics (which would serialise the cache
+  // misses of a sculpt numbered at random). Counted, summed into bucket ends, then filled
+  // from the last half-edge down so that the ends become the starts.
+  const auto for_each_owned = [&](bool downwards, auto&& visit) {
+    const std::size_t parts = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+    tbb::parallel_for(std::size_t{0}, parts, [&](std::size_t part) {
+      const auto lo = static_cast<std::uint32_t>(num_vertices * part / parts);
+      const auto hi = static_cast<std::uint32_t>(num_vertices * (part + 1) / parts);
+      for (std::size_t k = 0; k < num_half_edges; ++k) {
+        const std::size_t h = downwards ? num_half_edges - 1 - k : k;
+        const auto v = static_cast<std::uint32_t>(start[h]);
+        if (v - lo < hi - lo) visit(v, h);
+      }
+    });
+  };
+  std::vector<std::uint32_t> first(num_vertices + 1, 0);
+  for_each_owned(false, [&](std::uint32_t v, std::size_t) { ++first[v]; });
+  const std::size_t unused =
+      LowestWhere(num_vertices, num_vertices, [&](std::size_t v) { return first[v] == 0; });
+  if (unused != num_vertices) {
+    return Status::Error(fmt::format("{}: vertex {} is used by no face", mesh.source, unused));
+  }
+  QuadAdjacency out;
+  out.valence.resize(num_vertices);
+  for (std::size_t v = 0; v < num_vertices; ++v) {
+    out.valence[v] = static_cast<std::uint16_t>(std::min<std::uint32_t>(first[v], 65535));
+  }
+  std::uint32_t sum = 0;
+  for (std::size_t v = 0; v < num_vertices; ++v) first[v] = sum += first[v];
+  first[num_vertices] = sum;
+  // Each entry packs the half-edge's end vertex (high half) with the half-edge (low half), so
+  // that the scans below read buckets only, not the faces.
+  std::vector<std::uint64_t> bucket(num_half_edges);
+  for_each_owned(true, [&](std::uint32_t v, std::size_t h) {
+    bucket[--first[v]] = static_cast<std::uint64_t>(end(h)) << 32 | h;
+  });
+  const auto end_of = [](std::uint64_t entry) { return static_cast<std::int32_t>(entry >> 32); };
+  const auto half_edge_of = [](std::uint64_t entry) { return static_cast<std::uint32_t>(entry); };
+
+  // Per half-edge a -> b: the half-edges a -> b (itself only) and, from the lower of a and b
+  // only, b -> a (its opposite, at most one; both are set from there). The lowest half-edge
+  // breaking either rule names the error.
+  out.opposite.assign(num_half_edges, kNoHalfEdge);
+  out.first_half_edge.resize(num_vertices);
+  tbb::combinable<std::uint32_t> lowest_bad([] { return kNoHalfEdge; });
+  tbb::parallel_for(Range(0, num_vertices, 2048), [&](const Range& r) {
+    std::uint32_t& bad = lowest_bad.local();
+    for (std::size_t a = r.begin(); a < r.end(); ++a) {
+      for (std::uint32_t i = first[a]; i < first[a + 1]; ++i) {
+        const std::uint32_t h = half_edge_of(bucket[i]);
+        const std::int32_t b = end_of(bucket[i]);
+        int same_way = 0;
+        for (std::uint32_t k = first[a]; k < first[a + 1]; ++k) same_way += end_of(bucket[k]) == b;
+        if (same_way > 1) bad = std::min(bad, h);
+        if (b < static_cast<std::int32_t>(a)) continue;
+        int other_way = 0;
+        std::uint32_t g = kNoHalfEdge;
+        for (std::uint32_t k = first[b]; k < first[b + 1]; ++k) {
+          if (end_of(bucket[k]) == static_cast<std::int32_t>(a)) {
+            ++other_way;
+            g = half_edge_of(bucket[k]);
+          }
+        }
+        if (other_way > 1) {
+          bad = std::min(bad, h);
+        } else if (other_way == 1 && same_way == 1) {
+          out.opposite[h] = g;
+          out.opposite[g] = h;
+        }
+      }
+      out.first_half_edge[a] = half_edge_of(bucket[first[a]]);
+    }
+  });
+  const std::uint32_t bad =
+      lowest_bad.combine([](std::uint32_t x, std::uint32_t y) { return std::min(x, y); });
+  if (bad != kNoHalfEdge) {
+    const std::int32_t a = start[bad], b = end(bad);
+    std::vector<std::uint32_t> same_way, other_way;
+    for (std::uint32_t k = first[a]; k < first[a + 1]; ++k) {
+      if (end_of(bucket[k]) == b) same_way.push_back(half_edge_of(bucket[k]) / 4);
+    }
+    for (std::uint32_t k = first[b]; k < first[b + 1]; ++k) {
+      if (end_of(bucket[k]) == a) other_way.push_back(half_edge_of(bucket[k]) / 4);
+    }
+    std::sort(same_way.begin(), same_way.end());
+    if (same_way.size() + other_way.size() > 2) {
+      std::vector<std::uint32_t> faces = same_way;
+      faces.insert(faces.end(), other_way.begin(), other_way.end());
+      std::sort(faces.begin(), faces.end());
+      return Status::Error(fmt::format("{}: edge {}-{} has more than two faces ({})", mesh.source,
+                                       a, b, fmt::join(faces, ", ")));
+    }
+    return Status::Error(fmt::format(
+        "{}: faces {} and {} both run edge {}-{} from {} to {} (their windings disagree)",
+        mesh.source, same_way[0], same_way[1], a, b, a, b));
+  }
+  out.boundary.assign(num_vertices, 0);
+  tbb::parallel_for(Range(0, num_half_edges, 1 << 14), [&](const Range& r) {
+    for (std::size_t h = r.begin(); h < r.end(); ++h) {
+      if (out.opposite[h] != kNoHalfEdge) continue;
+      std::atomic_ref<std::uint8_t>(out.boundary[start[h]]).store(1, std::memory_order_relaxed);
+      std::atomic_ref<std::uint8_t>(out.boundary[end(h)]).store(1, std::memory_order_relaxed);
+    }
+  });
+  return out;
+}
+
+std::vector<std::uint32_t> QuadComponents(const QuadAdjacency& adjacency,
+                                          std::uint32_t& num_components) {
+  const std::size_t num_faces = adjacency.opposite.size() / 4;
+  std::vector<std::uint32_t> parent(num_faces);
+  // Union-find with links from the larger root to the smaller, so that every root is the
+  // lowest quad of its component whatever the order of the unions.
+  auto find = [&](std::uint32_t x) {
+    for (;;) {
+      const std::uint32_t p = Load(parent[x]);
+      if (p == x) return x;
+      const std::uint32_t grand = Load(parent[p]);
+      std::atomic_ref<std::uint32_t>(parent[x]).store(grand, std::memory_order_relaxed);
+      x = grand;
+    }
+  };
+  tbb::parallel_for(Range(0, num_faces, 1 << 14), [&](const Range& r) {
+    for (std::size_t f = r.begin(); f < r.end(); ++f) parent[f] = static_cast<std::uint32_t>(f);
+  });
+  tbb::parallel_for(Range(0, num_faces, 1 << 12), [&](const Range& r) {
+    for (std::size_t f = r.begin(); f < r.end(); ++f) {
+      for (int k = 0; k < 4; ++k) {
+        const std::uint32_t g = adjacency.opposite[4 * f + k];
+        if (g == kNoHalfEdge || g / 4 < f) continue;
+        std::uint32_t a = static_cast<std::uint32_t>(f), b = g / 4;
+        for (;;) {
+          a = find(a);
+          b = find(b);
+          if (a == b) break;
+          if (a < b) std::swap(a, b);
+          std::uint32_t expected = a;
+          if (std::atomic_ref<std::uint32_t>(parent[a]).compare_exchange_strong(
+                  expected, b, std::memory_order_relaxed)) {
+            break;
+          }
+        }
+      }
+    }
+  });
+  tbb::parallel_for(Range(0, num_faces, 1 << 14), [&](const Range& r) {
+    for (std::size_t f = r.begin(); f < r.end(); ++f) {
+      parent[f] = find(static_cast<std::uint32_t>(f));
+    }
+  });
+  // Roots precede their members, so one pass in order renumbers them.
+  num_components = 0;
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    parent[f] = parent[f] == f ? num_components++ : parent[parent[f]];
+  }
+  return parent;
+}
+
+}  // namespace dispex::subdiv
