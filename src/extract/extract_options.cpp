@@ -63,8 +63,7 @@ StatusOr<ExtractMethod> ParseExtractMethod(std::string_view name) {
   for (ExtractMethod m : {ExtractMethod::kAuto, ExtractMethod::kRays, ExtractMethod::kMapping}) {
     if (name == ExtractMethodName(m)) return m;
   }
-  return Status::Error(
-      fmt::format("unknown method '{}' (expected auto, rays or mapping)", name));
+  return Status::Error(fmt::format("unknown method '{}' (expected auto, rays or mapping)", name));
 }
 
 namespace {

@@ -54,10 +54,10 @@ Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs
                               const CoarseSampling& coarse, ExtractReport& report) {
   report.search_distance_auto = options.search_distance.kind == SearchDistanceSpec::Kind::kAuto;
   if (report.search_distance_auto) {
-    auto estimate =
-        inputs.mapping ? EstimateSearchDistanceMapped(inputs, coarse, report.base_diagonal)
-                       : EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals,
-                                                report.base_diagonal);
+    auto estimate = inputs.mapping
+                        ? EstimateSearchDistanceMapped(inputs, coarse, report.base_diagonal)
+                        : EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals,
+                                                 report.base_diagonal);
     if (!estimate.ok()) {
       return Status::Error(fmt::format("{} and {} do not overlap: {}", options.base_path,
                                        options.sculpt_path, estimate.status().message()));

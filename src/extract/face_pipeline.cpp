@@ -60,8 +60,8 @@ const Tracer* TracerFor(const ExtractInputs& inputs, PtexFaceId face) {
 // The same through the mapping; the samples it leaves undecided go to `tracer` as TraceRays
 // traces them, or, without one, the face is left for later (result.needs_tracer).
 std::int32_t TraceMappedSamples(PtexFaceId face, int n, const ExtractInputs& inputs,
-                                const ExtractSettings& settings, std::size_t count,
-                                FaceScratch& w, FaceResult& result) {
+                                const ExtractSettings& settings, std::size_t count, FaceScratch& w,
+                                FaceResult& result) {
   const auto origins = AsFloat3(w.positions, count), normals = AsFloat3(w.normals, count);
   w.undecided.resize(count);
   TraceMapped(*inputs.mapping, inputs.sculpt, face, n, {}, origins, normals, settings.query,
