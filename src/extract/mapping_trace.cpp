@@ -309,7 +309,46 @@ CornerKind WalkCorner(const SculptMapping& mapping, int face, int c,
   return CornerKind::kFan;
 }
 
-void LayOut(const SculptMapping& mapping, int face, MappingScratch& w) {
+// The positions of the apron's corners, relative to the face's middle vertex, for the float
+// filter: each slot's corners, its face's corner `slot.corner + k` at its corner k.
+void FillLattice(const Mesh& sculpt, MappingScratch& w) {
+  const int m = w.m, width = m + 2 * kMargin, points = width + 1;
+  w.lattice.assign(3 * static_cast<std::size_t>(points) * points, 0.0f);
+  const int mid = m / 2;
+  // The middle vertex: corner 0 of cell (mid, mid) (for m = 1, the face's corner 0).
+  const MappingScratch::Slot& ms =
+      w.apron[static_cast<std::size_t>((mid + kMargin) * width + mid + kMargin)];
+  const Float3& c = sculpt.positions[static_cast<std::size_t>(
+      sculpt.face_indices[4 * static_cast<std::size_t>(ms.face) + ms.corner])];
+  w.centre[0] = c.x;
+  w.centre[1] = c.y;
+  w.centre[2] = c.z;
+  float extent = 0;
+  // Each point from one slot that has it as a corner.
+  static constexpr int kDx[4] = {0, -1, -1, 0}, kDy[4] = {0, 0, -1, -1};
+  for (int b = 0; b < points; ++b) {
+    for (int a = 0; a < points; ++a) {
+      for (int k = 0; k < 4; ++k) {
+        const int sa = a + kDx[k], sb = b + kDy[k];
+        if (sa < 0 || sb < 0 || sa >= width || sb >= width) continue;
+        const MappingScratch::Slot& slot = w.apron[static_cast<std::size_t>(sb * width + sa)];
+        if (slot.state != kCell) continue;
+        const std::int32_t* ids =
+            sculpt.face_indices.data() + 4 * static_cast<std::size_t>(slot.face);
+        const Float3& v = sculpt.positions[static_cast<std::size_t>(ids[(slot.corner + k) & 3])];
+        float* q = &w.lattice[3 * static_cast<std::size_t>(b * points + a)];
+        q[0] = static_cast<float>(double(v.x) - w.centre[0]);
+        q[1] = static_cast<float>(double(v.y) - w.centre[1]);
+        q[2] = static_cast<float>(double(v.z) - w.centre[2]);
+        extent = std::max({extent, std::fabs(q[0]), std::fabs(q[1]), std::fabs(q[2])});
+        break;
+      }
+    }
+  }
+  w.extent = extent;
+}
+
+void LayOut(const SculptMapping& mapping, const Mesh& sculpt, int face, MappingScratch& w) {
   const int m = mapping.grid_size(face);
   const int width = m + 2 * kMargin;
   w.face = face;
@@ -367,6 +406,7 @@ void LayOut(const SculptMapping& mapping, int face, MappingScratch& w) {
               static_cast<std::uint8_t>((k + SculptMapping::RotationOf(cell)) & 3), kCell};
     }
   }
+  FillLattice(sculpt, w);
 }
 
 // ---- Lines against quads -------------------------------------------------------------------
@@ -390,6 +430,7 @@ struct Line {
   Float3 o, d;
   Vec3d origin, e1, e2;
 
+  Line() = default;
   Line(const Float3& o_in, const Float3& d_in) : o(o_in), d(d_in), origin(ToVec3d(o_in)) {
     const Vec3d dir = ToVec3d(d);
     const double ax = std::fabs(dir.x), ay = std::fabs(dir.y), az = std::fabs(dir.z);
@@ -562,25 +603,212 @@ bool TestRing(const MappingScratch& w, const Mesh& sculpt, const Line& line, int
 // Whether a quad of the face or of its apron is turned over against the limit normal of the
 // sample nearest to it: the sculpt folds there, and a folded sheet can reach over samples far
 // outside the rings they test.
-bool Folded(const MappingScratch& w, const Mesh& sculpt, int n, std::span<const Float3> normals) {
-  const int m = w.m, width = m + 2 * kMargin;
-  const Float3* p = sculpt.positions.data();
-  for (int b = -kMargin; b < m + kMargin; ++b) {
-    const int j = std::clamp(static_cast<int>((std::int64_t{2} * b + 1) * n / (2 * m)), 0, n - 1);
-    for (int a = -kMargin; a < m + kMargin; ++a) {
-      const MappingScratch::Slot& slot =
-          w.apron[static_cast<std::size_t>((b + kMargin) * width + a + kMargin)];
-      if (slot.state != kCell) continue;
-      const int i = std::clamp(static_cast<int>((std::int64_t{2} * a + 1) * n / (2 * m)), 0, n - 1);
+bool Folded(const MappingScratch& w, int n, std::span<const Float3> normals) {
+  const int m = w.m, width = m + 2 * kMargin, points = width + 1;
+  auto at = [&](int a, int b) { return &w.lattice[3 * static_cast<std::size_t>(b * points + a)]; };
+  for (int b = 0; b < width; ++b) {
+    const int j =
+        std::clamp(static_cast<int>((std::int64_t{2} * (b - kMargin) + 1) * n / (2 * m)), 0, n - 1);
+    for (int a = 0; a < width; ++a) {
+      if (w.apron[static_cast<std::size_t>(b * width + a)].state != kCell) continue;
+      const int i = std::clamp(
+          static_cast<int>((std::int64_t{2} * (a - kMargin) + 1) * n / (2 * m)), 0, n - 1);
       const Float3& nrm = normals[static_cast<std::size_t>(j) * n + i];
-      const std::int32_t* ids =
-          sculpt.face_indices.data() + 4 * static_cast<std::size_t>(slot.face);
-      const Vec3d d02 = ToVec3d(p[ids[2]]) - ToVec3d(p[ids[0]]);
-      const Vec3d d13 = ToVec3d(p[ids[3]]) - ToVec3d(p[ids[1]]);
-      if (!(Dot(Cross(d02, d13), ToVec3d(nrm)) > 0)) return true;
+      const float *c0 = at(a, b), *c1 = at(a + 1, b), *c2 = at(a + 1, b + 1), *c3 = at(a, b + 1);
+      const float d02[3] = {c2[0] - c0[0], c2[1] - c0[1], c2[2] - c0[2]};
+      const float d13[3] = {c3[0] - c1[0], c3[1] - c1[1], c3[2] - c1[2]};
+      const float cx = d02[1] * d13[2] - d02[2] * d13[1];
+      const float cy = d02[2] * d13[0] - d02[0] * d13[2];
+      const float cz = d02[0] * d13[1] - d02[1] * d13[0];
+      if (!(cx * nrm.x + cy * nrm.y + cz * nrm.z > 0)) return true;
     }
   }
   return false;
+}
+
+// ---- One sample, ring after ring -----------------------------------------------------------
+
+// Writes sample k's answer when rings 0..r decide it; false when they do not yet.
+bool Decide(const Crossings& x, int r, HitPolicy policy, std::size_t k, const NormalHits& out) {
+  bool negative = false;
+  const Candidate* kept = Kept(x, policy, negative);
+  if (kept != nullptr && kept->ring <= r - 1) {
+    out.t[k] = kept->t;
+    const bool back = negative ? kept->front_plus : !kept->front_plus;
+    out.flags[k] = static_cast<std::uint8_t>(HitFlags::kHit | (negative ? HitFlags::kNegative : 0) |
+                                             (back ? HitFlags::kBackFace : 0));
+    if (!out.prim.empty()) out.prim[k] = SculptPrimId(kept->face);
+    return true;
+  }
+  if (kept == nullptr && x.any_ring <= r - 1) {
+    out.t[k] = std::numeric_limits<float>::quiet_NaN();
+    out.flags[k] = 0;
+    if (!out.prim.empty()) out.prim[k] = SculptPrimId();
+    return true;
+  }
+  return false;
+}
+
+// Sample k over cell (ci, cj), rings 0 to kMaxRings; whether it was decided.
+bool TraceRings(const MappingScratch& w, const Mesh& sculpt, const Line& line, int ci, int cj,
+                const NormalQuery& query, std::size_t k, const NormalHits& out,
+                std::uint64_t& quads) {
+  Crossings x;
+  x.distance = query.distance;
+  for (int r = 0; r <= kMaxRings; ++r) {
+    if (!TestRing(w, sculpt, line, ci, cj, r, x, quads) || x.degenerate || x.orientations == 3) {
+      return false;
+    }
+    if (Decide(x, r, query.policy, k, out)) return true;
+  }
+  return false;
+}
+
+// ---- The samples of one cell at once -------------------------------------------------------
+// The cell's 3 x 3 slots (rings 0 and 1) against up to kLanes samples: the lattice's 16 points
+// projected along each sample's normal in float, each edge's value once, and a triangle
+// classified as surely met, surely missed (beyond a bound on the float error) or unsure; the
+// met and the unsure go to the exact test in double (the same as TestQuad's).
+
+constexpr int kLanes = 4;
+using f4 = float __attribute__((vector_size(16)));
+using i4 = std::int32_t __attribute__((vector_size(16)));
+
+f4 Abs(f4 a) {
+  return a < 0 ? -a : a;
+}
+f4 Max(f4 a, f4 b) {
+  return a > b ? a : b;
+}
+f4 Min(f4 a, f4 b) {
+  return a < b ? a : b;
+}
+unsigned Bits(i4 mask) {
+#if defined(__SSE__)
+  return static_cast<unsigned>(__builtin_ia32_movmskps(reinterpret_cast<f4>(mask)));
+#else
+  return (mask[0] & 1u) | (mask[1] & 2u) | (mask[2] & 4u) | (mask[3] & 8u);
+#endif
+}
+
+struct Lanes {
+  int count = 0;
+  std::size_t k[kLanes] = {};
+  Line lines[kLanes];
+  f4 ox = {}, oy = {}, oz = {};  // origins relative to the lattice's centre
+  f4 e1x = {}, e1y = {}, e1z = {}, e2x = {}, e2y = {}, e2z = {};
+};
+
+void AddLane(const MappingScratch& w, std::size_t k, const Float3& o, const Float3& d, Lanes& b) {
+  const int l = b.count++;
+  b.k[l] = k;
+  b.lines[l] = Line(o, d);
+  b.ox[l] = static_cast<float>(double(o.x) - w.centre[0]);
+  b.oy[l] = static_cast<float>(double(o.y) - w.centre[1]);
+  b.oz[l] = static_cast<float>(double(o.z) - w.centre[2]);
+  const Line& line = b.lines[l];
+  b.e1x[l] = static_cast<float>(line.e1.x);
+  b.e1y[l] = static_cast<float>(line.e1.y);
+  b.e1z[l] = static_cast<float>(line.e1.z);
+  b.e2x[l] = static_cast<float>(line.e2.x);
+  b.e2y[l] = static_cast<float>(line.e2.y);
+  b.e2z[l] = static_cast<float>(line.e2.z);
+}
+
+// Triangle (a, b, c) of a face by the exact test: whether the line meets it.
+bool ExactInside(const Line& line, const Float3& fa, const Float3& fb, const Float3& fc) {
+  double xa, ya, xb, yb, xc, yc;
+  line.Project(fa, xa, ya);
+  line.Project(fb, xb, yb);
+  line.Project(fc, xc, yc);
+  return Inside(EdgeValue(xa, ya, xb, yb), EdgeValue(xb, yb, xc, yc), EdgeValue(xc, yc, xa, ya));
+}
+
+// Rings 0 and 1 of cell (ci, cj), whose 9 slots are all quads, for the lanes: decided[l] when
+// they decide lane l, settled[l] when it is undecided whatever more rings hold (a fold, a
+// degenerate triangle); the others need more rings.
+void TraceBlock(const MappingScratch& w, const Mesh& sculpt, int ci, int cj, const Lanes& b,
+                const NormalQuery& query, const NormalHits& out, bool decided[kLanes],
+                bool settled[kLanes]) {
+  const int width = w.m + 2 * kMargin, points = width + 1;
+  f4 px[16], py[16];
+  f4 reach = {};
+  for (int q = 0; q < 16; ++q) {
+    const int x = ci - 1 + (q & 3) + kMargin, y = cj - 1 + (q >> 2) + kMargin;
+    const float* v = &w.lattice[3 * static_cast<std::size_t>(y * points + x)];
+    const f4 wx = v[0] - b.ox, wy = v[1] - b.oy, wz = v[2] - b.oz;
+    px[q] = wx * b.e1x + wy * b.e1y + wz * b.e1z;
+    py[q] = wx * b.e2x + wy * b.e2y + wz * b.e2z;
+    reach = Max(reach, Abs(px[q]) + Abs(py[q]));
+  }
+  // An edge value's error: the projections are within 2^-19 of the coordinates' magnitude
+  // (lattice and origin, relative to the centre; each step rounds to float once) and an edge
+  // value multiplies projections of at most `reach`.
+  const f4 magnitude = Max(Max(Abs(b.ox), Abs(b.oy)), Max(Abs(b.oz), f4{} + w.extent));
+  const f4 tol = 4 * reach * magnitude * 0x1p-19f + reach * reach * 0x1p-19f;
+  auto edge = [&](int a, int c) { return px[a] * py[c] - py[a] * px[c]; };
+  f4 h[4][3], v[3][4];
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 3; ++x) h[y][x] = edge(y * 4 + x, y * 4 + x + 1);
+  }
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 4; ++x) v[y][x] = edge(y * 4 + x, (y + 1) * 4 + x);
+  }
+  const unsigned active = (1u << b.count) - 1;
+  Crossings x[kLanes];
+  for (int l = 0; l < kLanes; ++l) x[l].distance = query.distance;
+  i4 counter_clockwise = {}, clockwise = {};
+  const Float3* p = sculpt.positions.data();
+  for (int sy = 0; sy < 3; ++sy) {
+    for (int sx = 0; sx < 3; ++sx) {
+      const MappingScratch::Slot& slot = w.apron[static_cast<std::size_t>(
+          (cj - 1 + sy + kMargin) * width + ci - 1 + sx + kMargin)];
+      const int ring = sx == 1 && sy == 1 ? 0 : 1;
+      const int c0 = sy * 4 + sx, c1 = c0 + 1, c2 = c0 + 5, c3 = c0 + 4;
+      // The face's corner 2 at this slot corner; its triangle (v0 v1 v3) lies opposite it.
+      const int corner2 = (2 - slot.corner) & 3;
+      const bool main = (corner2 & 1) != 0;  // the diagonal runs through slot corners 0 and 2
+      const f4 dg = main ? edge(c0, c2) : edge(c1, c3);
+      const f4 bottom = h[sy][sx], right = v[sy][sx + 1], top = -h[sy + 1][sx], left = -v[sy][sx];
+      const i4 ccw = bottom + right + top + left > 0;
+      counter_clockwise |= ccw;
+      clockwise |= ~ccw;
+      // The slot's two triangles, each by its edge values and the slot corner it leaves out.
+      const f4 tri[2][3] = {{bottom, main ? right : dg, main ? -dg : left},
+                            {main ? dg : right, top, main ? left : -dg}};
+      const int left_out[2] = {main ? 3 : 2, main ? 1 : 0};
+      const std::int32_t* ids =
+          sculpt.face_indices.data() + 4 * static_cast<std::size_t>(slot.face);
+      for (int t = 0; t < 2; ++t) {
+        const f4 low = Min(Min(tri[t][0], tri[t][1]), tri[t][2]);
+        const f4 high = Max(Max(tri[t][0], tri[t][1]), tri[t][2]);
+        const unsigned maybe = Bits((low >= -tol) | (high <= tol)) & active;
+        if (maybe == 0) continue;
+        const unsigned sure = Bits((low > tol) | (high < -tol));
+        const bool first = left_out[t] == corner2;  // the face's (v0, v1, v3)
+        const Float3& fa = p[ids[first ? 0 : 2]];
+        const Float3& fb = p[ids[first ? 1 : 3]];
+        const Float3& fc = p[ids[first ? 3 : 1]];
+        for (int l = 0; l < b.count; ++l) {
+          if (!(maybe & (1u << l))) continue;
+          const Line& line = b.lines[l];
+          if (!(sure & (1u << l)) && !ExactInside(line, fa, fb, fc)) continue;
+          double den = 0;
+          const double tt = PlaneT(fa, fb, fc, line.o, line.d, den);
+          if (!std::isfinite(tt)) {
+            x[l].degenerate = true;
+          } else {
+            x[l].Add(static_cast<float>(tt), den, ring, slot.face);
+          }
+        }
+      }
+    }
+  }
+  const unsigned both = Bits(counter_clockwise) & Bits(clockwise);
+  for (int l = 0; l < b.count; ++l) {
+    settled[l] = x[l].degenerate || (both & (1u << l)) != 0;
+    decided[l] = !settled[l] && Decide(x[l], 1, query.policy, b.k[l], out);
+  }
 }
 
 }  // namespace
@@ -589,64 +817,107 @@ void TraceMapped(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId fa
                  std::span<const std::int32_t> samples, std::span<const Float3> origins,
                  std::span<const Float3> normals, const NormalQuery& query, const NormalHits& out,
                  std::span<std::uint8_t> undecided, MappingScratch& w, MappingCounters& counters) {
-  if (w.face != face.value) LayOut(mapping, face.value, w);
+  if (w.face != face.value) LayOut(mapping, sculpt, face.value, w);
   const int m = w.m;
   const std::size_t count = samples.empty() ? static_cast<std::size_t>(n) * n : samples.size();
-  const bool with_prims = !out.prim.empty();
-  const float nan = std::numeric_limits<float>::quiet_NaN();
   counters.queries += count;
-  if (Folded(w, sculpt, n, normals)) {
+  if (Folded(w, n, normals)) {
     for (std::size_t s = 0; s < count; ++s) {
       undecided[samples.empty() ? s : static_cast<std::size_t>(samples[s])] = 1;
     }
     return;
   }
-  for (std::size_t s = 0; s < count; ++s) {
-    const auto k = samples.empty() ? s : static_cast<std::size_t>(samples[s]);
+  auto cell_of = [&](int i) {
+    return static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));
+  };
+  // Invalid queries are misses; the others get their cell's rings, one by one.
+  auto valid = [&](std::size_t k) {
     const Float3& o = origins[k];
-    const Float3& nrm = normals[k];
-    undecided[k] = 1;
-    if (!Finite(o) || !Finite(nrm) || (nrm.x == 0 && nrm.y == 0 && nrm.z == 0)) {
-      out.t[k] = nan;
-      out.flags[k] = 0;
-      if (with_prims) out.prim[k] = SculptPrimId();
-      undecided[k] = 0;
-      ++counters.decided;
-      continue;
+    const Float3& d = normals[k];
+    if (Finite(o) && Finite(d) && (d.x != 0 || d.y != 0 || d.z != 0)) return true;
+    out.t[k] = std::numeric_limits<float>::quiet_NaN();
+    out.flags[k] = 0;
+    if (!out.prim.empty()) out.prim[k] = SculptPrimId();
+    undecided[k] = 0;
+    ++counters.decided;
+    return false;
+  };
+  auto one = [&](std::size_t k, int ci, int cj) {
+    const bool done = TraceRings(w, sculpt, Line(origins[k], FlushTiny(normals[k])), ci, cj, query,
+                                 k, out, counters.quads);
+    undecided[k] = !done;
+    counters.decided += done;
+  };
+  if (!samples.empty()) {
+    for (const std::int32_t s : samples) {
+      const auto k = static_cast<std::size_t>(s);
+      if (valid(k)) one(k, cell_of(s % n), cell_of(s / n));
     }
-    const Line line(o, FlushTiny(nrm));
-    const int i = static_cast<int>(k % static_cast<std::size_t>(n));
-    const int j = static_cast<int>(k / static_cast<std::size_t>(n));
-    const int ci = static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));
-    const int cj = static_cast<int>((std::int64_t{2} * j + 1) * m / (std::int64_t{2} * n));
-    Crossings x;
-    x.distance = query.distance;
-    for (int r = 0; r <= kMaxRings; ++r) {
-      if (!TestRing(w, sculpt, line, ci, cj, r, x, counters.quads) || x.degenerate ||
-          x.orientations == 3) {
-        break;
-      }
-      bool negative = false;
-      const Candidate* kept = Kept(x, query.policy, negative);
-      if (kept != nullptr && kept->ring <= r - 1) {
-        out.t[k] = kept->t;
-        const bool back = negative ? kept->front_plus : !kept->front_plus;
-        out.flags[k] =
-            static_cast<std::uint8_t>(HitFlags::kHit | (negative ? HitFlags::kNegative : 0) |
-                                      (back ? HitFlags::kBackFace : 0));
-        if (with_prims) out.prim[k] = SculptPrimId(kept->face);
-        undecided[k] = 0;
-        break;
-      }
-      if (kept == nullptr && x.any_ring <= r - 1) {
-        out.t[k] = nan;
-        out.flags[k] = 0;
-        if (with_prims) out.prim[k] = SculptPrimId();
-        undecided[k] = 0;
-        break;
+    return;
+  }
+  // The whole grid, cell by cell: where rings 0 and 1 are all quads of the lattice (no
+  // extraordinary corner), the cell's samples go through TraceBlock together.
+  const int width = m + 2 * kMargin;
+  auto plain = [&](int ci, int cj) {
+    for (int c = 0; c < 4; ++c) {
+      if (w.fan_corner[c] && CornerDistance(ci, cj, m, c) == 0) return false;
+    }
+    for (int b = cj - 1; b <= cj + 1; ++b) {
+      for (int a = ci - 1; a <= ci + 1; ++a) {
+        if (w.apron[static_cast<std::size_t>((b + kMargin) * width + a + kMargin)].state != kCell) {
+          return false;
+        }
       }
     }
-    counters.decided += undecided[k] == 0;
+    return true;
+  };
+  Lanes lanes{};
+  auto flush = [&](int ci, int cj) {
+    if (lanes.count == 0) return;
+    bool decided[kLanes], settled[kLanes];
+    TraceBlock(w, sculpt, ci, cj, lanes, query, out, decided, settled);
+    for (int l = 0; l < lanes.count; ++l) {
+      const std::size_t k = lanes.k[l];
+      counters.quads += 9;
+      if (decided[l]) {
+        undecided[k] = 0;
+        ++counters.decided;
+      } else if (settled[l]) {
+        undecided[k] = 1;
+      } else {
+        one(k, ci, cj);
+      }
+    }
+    lanes.count = 0;
+  };
+  // The first sample row (column) of each cell row (column); n at the end.
+  w.first_sample.assign(static_cast<std::size_t>(m) + 1, n);
+  for (int i = n - 1; i >= 0; --i) w.first_sample[static_cast<std::size_t>(cell_of(i))] = i;
+  for (int c = m - 1; c >= 0; --c) {
+    const auto at = static_cast<std::size_t>(c);
+    w.first_sample[at] = std::min(w.first_sample[at], w.first_sample[at + 1]);
+  }
+  for (int cj = 0; cj < m; ++cj) {
+    const int j_begin = w.first_sample[static_cast<std::size_t>(cj)];
+    const int j_end = w.first_sample[static_cast<std::size_t>(cj) + 1];
+    for (int ci = 0; ci < m; ++ci) {
+      const int i_begin = w.first_sample[static_cast<std::size_t>(ci)];
+      const int i_end = w.first_sample[static_cast<std::size_t>(ci) + 1];
+      const bool block = j_end > j_begin && i_end > i_begin && plain(ci, cj);
+      for (int j = j_begin; j < j_end; ++j) {
+        for (int i = i_begin; i < i_end; ++i) {
+          const std::size_t k = static_cast<std::size_t>(j) * n + i;
+          if (!valid(k)) continue;
+          if (!block) {
+            one(k, ci, cj);
+            continue;
+          }
+          AddLane(w, k, origins[k], FlushTiny(normals[k]), lanes);
+          if (lanes.count == kLanes) flush(ci, cj);
+        }
+      }
+      flush(ci, cj);
+    }
   }
 }
 

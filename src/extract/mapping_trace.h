@@ -114,6 +114,12 @@ struct MappingScratch {
   std::vector<FanCell> fans[4];  // per corner of the face: cells of every face around it
   bool fan_corner[4] = {false, false, false, false};
   std::vector<std::pair<int, int>> around;  // faces around a corner, while laying out
+  // The apron's vertices, (m + 2 kMaxRings + 1)^2 points xyz, relative to `centre` (a vertex
+  // of the face), for the float filter; `extent`: their largest |coordinate|.
+  std::vector<float> lattice;
+  double centre[3] = {0, 0, 0};
+  float extent = 0;
+  std::vector<int> first_sample;  // per cell row: its first sample row
 };
 
 // The normal queries of samples `samples` (grid indices j * n + i of face `face`'s n x n
