@@ -348,7 +348,7 @@ void FillLattice(const Mesh& sculpt, MappingScratch& w) {
   w.extent = extent;
 }
 
-void LayOut(const SculptMapping& mapping, const Mesh& sculpt, int face, MappingScratch& w) {
+void LayOut(const SculptMapping& mapping, int face, MappingScratch& w) {
   const int m = mapping.grid_size(face);
   const int width = m + 2 * kMargin;
   w.face = face;
@@ -406,7 +406,7 @@ void LayOut(const SculptMapping& mapping, const Mesh& sculpt, int face, MappingS
               static_cast<std::uint8_t>((k + SculptMapping::RotationOf(cell)) & 3), kCell};
     }
   }
-  FillLattice(sculpt, w);
+  w.lattice_face = -1;
 }
 
 // ---- Lines against quads -------------------------------------------------------------------
@@ -694,25 +694,33 @@ unsigned Bits(i4 mask) {
 struct Lanes {
   int count = 0;
   std::size_t k[kLanes] = {};
-  Line lines[kLanes];
+  Float3 o[kLanes], d[kLanes];   // d FlushTiny'd
   f4 ox = {}, oy = {}, oz = {};  // origins relative to the lattice's centre
-  f4 e1x = {}, e1y = {}, e1z = {}, e2x = {}, e2y = {}, e2z = {};
+  f4 e1x = {}, e1y = {}, e1z = {}, e2x = {}, e2y = {}, e2z = {};  // Line's basis, in float
 };
 
 void AddLane(const MappingScratch& w, std::size_t k, const Float3& o, const Float3& d, Lanes& b) {
   const int l = b.count++;
   b.k[l] = k;
-  b.lines[l] = Line(o, d);
+  b.o[l] = o;
+  b.d[l] = d;
   b.ox[l] = static_cast<float>(double(o.x) - w.centre[0]);
   b.oy[l] = static_cast<float>(double(o.y) - w.centre[1]);
   b.oz[l] = static_cast<float>(double(o.z) - w.centre[2]);
-  const Line& line = b.lines[l];
-  b.e1x[l] = static_cast<float>(line.e1.x);
-  b.e1y[l] = static_cast<float>(line.e1.y);
-  b.e1z[l] = static_cast<float>(line.e1.z);
-  b.e2x[l] = static_cast<float>(line.e2.x);
-  b.e2y[l] = static_cast<float>(line.e2.y);
-  b.e2z[l] = static_cast<float>(line.e2.z);
+  const float ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
+  const float e1[3] = {ax <= ay && ax <= az ? 0
+                       : ay <= az           ? -d.z
+                                            : d.y,
+                       ax <= ay && ax <= az ? d.z
+                       : ay <= az           ? 0
+                                            : -d.x,
+                       ax <= ay && ax <= az ? -d.y
+                       : ay <= az           ? d.x
+                                            : 0};
+  b.e1x[l] = e1[0], b.e1y[l] = e1[1], b.e1z[l] = e1[2];
+  b.e2x[l] = d.y * e1[2] - d.z * e1[1];
+  b.e2y[l] = d.z * e1[0] - d.x * e1[2];
+  b.e2z[l] = d.x * e1[1] - d.y * e1[0];
 }
 
 // Triangle (a, b, c) of a face by the exact test: whether the line meets it.
@@ -791,10 +799,9 @@ void TraceBlock(const MappingScratch& w, const Mesh& sculpt, int ci, int cj, con
         const Float3& fc = p[ids[first ? 3 : 1]];
         for (int l = 0; l < b.count; ++l) {
           if (!(maybe & (1u << l))) continue;
-          const Line& line = b.lines[l];
-          if (!(sure & (1u << l)) && !ExactInside(line, fa, fb, fc)) continue;
+          if (!(sure & (1u << l)) && !ExactInside(Line(b.o[l], b.d[l]), fa, fb, fc)) continue;
           double den = 0;
-          const double tt = PlaneT(fa, fb, fc, line.o, line.d, den);
+          const double tt = PlaneT(fa, fb, fc, b.o[l], b.d[l], den);
           if (!std::isfinite(tt)) {
             x[l].degenerate = true;
           } else {
@@ -817,15 +824,20 @@ void TraceMapped(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId fa
                  std::span<const std::int32_t> samples, std::span<const Float3> origins,
                  std::span<const Float3> normals, const NormalQuery& query, const NormalHits& out,
                  std::span<std::uint8_t> undecided, MappingScratch& w, MappingCounters& counters) {
-  if (w.face != face.value) LayOut(mapping, sculpt, face.value, w);
+  if (w.face != face.value) LayOut(mapping, face.value, w);
   const int m = w.m;
   const std::size_t count = samples.empty() ? static_cast<std::size_t>(n) * n : samples.size();
   counters.queries += count;
-  if (Folded(w, n, normals)) {
-    for (std::size_t s = 0; s < count; ++s) {
-      undecided[samples.empty() ? s : static_cast<std::size_t>(samples[s])] = 1;
+  // The whole grid: the lattice, and whether the face's neighbourhood folds.
+  if (samples.empty()) {
+    if (w.lattice_face != face.value) {
+      FillLattice(sculpt, w);
+      w.lattice_face = face.value;
     }
-    return;
+    if (Folded(w, n, normals)) {
+      std::fill(undecided.begin(), undecided.begin() + static_cast<std::ptrdiff_t>(count), 1);
+      return;
+    }
   }
   auto cell_of = [&](int i) {
     return static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));

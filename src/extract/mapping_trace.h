@@ -109,6 +109,7 @@ struct MappingScratch {
     std::int32_t offset = 0;  // Chebyshev distance of the cell from the vertex, in cells
   };
   int face = -1;                 // the face the apron is laid out for (-1: none)
+  int lattice_face = -1;         // the face `lattice` holds (-1: none)
   int m = 0;                     // its grid size
   std::vector<Slot> apron;       // (m + 2 kMaxRings)^2 slots, row by row
   std::vector<FanCell> fans[4];  // per corner of the face: cells of every face around it
@@ -127,7 +128,9 @@ struct MappingScratch {
 // unit `normals` (both n * n, indexed by grid index) against the sculpt through `mapping`.
 // Decided samples get out.t / out.flags (and out.prim when not empty) at their grid index as
 // Tracer::TraceNormals sets them and undecided[k] = 0; the others undecided[k] = 1, out
-// untouched. `sculpt` is the matched mesh.
+// untouched. `sculpt` is the matched mesh. A call for the whole grid (`samples` empty) first
+// checks the face's neighbourhood for folds and leaves every sample undecided where it folds;
+// a call for some samples (a second search of the same grid, a sparse sampling) does not.
 void TraceMapped(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId face, int n,
                  std::span<const std::int32_t> samples, std::span<const Float3> origins,
                  std::span<const Float3> normals, const NormalQuery& query, const NormalHits& out,
