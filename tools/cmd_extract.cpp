@@ -33,6 +33,7 @@ constexpr FlagName kExtractFlags[] = {
     {"threads", "--threads"},
     {"max_memory", "--max-memory"},
     {"output_dir", "--out-dir"},
+    {"method", "--method"},
 };
 
 struct ExtractArgs {

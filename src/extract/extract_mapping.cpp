@@ -42,7 +42,7 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   inputs.mapping = std::make_unique<SculptMapping>(std::move(mapping));
   report.t_match = clock.seconds();
   report.method = ExtractMethod::kMapping;
-  return Status::Ok();
+  return CancelRequested() ? Cancelled() : Status::Ok();
 }
 
 StatusOr<SearchDistanceEstimate> EstimateSearchDistanceMapped(const ExtractInputs& inputs,
