@@ -77,6 +77,12 @@ int main(int argc, char** argv) {
   extract::SculptMapping mapping =
       Must(extract::SculptMapping::Build(correspondence, sculpt, faces));
   const double t_table = clock.seconds();
+  clock.Reset();
+  if (Status s = mapping.MarkFolds(surface, sculpt, faces); !s.ok()) {
+    fmt::print(stderr, "mapping_bench: {}\n", s.message());
+    return 1;
+  }
+  const double t_folds = clock.seconds();
   const int levels = correspondence.levels;
   correspondence = SculptCorrespondence{};
   std::unique_ptr<Tracer> tracer;
@@ -169,8 +175,10 @@ int main(int argc, char** argv) {
   const Totals& all = best;
   const double s = double(all.samples);
   fmt::print(
-      "read {:.2f}s  match {:.2f}s  cell table {:.2f}s ({:.0f} MB)  bvh {:.2f}s  loop {:.2f}s\n",
-      t_read, t_match, t_table, double(mapping.bytes()) / 1e6, t_bvh, t_loop);
+      "read {:.2f}s  match {:.2f}s  cell table {:.2f}s ({:.0f} MB)  folds {:.2f}s ({} faces at "
+      "risk)  bvh {:.2f}s  loop {:.2f}s\n",
+      t_read, t_match, t_table, double(mapping.bytes()) / 1e6, t_folds, mapping.fold_risk_faces(),
+      t_bvh, t_loop);
   fmt::print("{} samples (level {}), search distance {:.4g}\n", all.samples, levels, distance);
   fmt::print("mapping: {:.2f} CPU s, {:.1f} ns/sample, {:.2f} quads/sample, {} undecided\n",
              all.cpu_mapping, 1e9 * all.cpu_mapping / s, double(all.quads) / s, all.undecided);

@@ -39,6 +39,7 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   report.mapping_rms_offset = correspondence->rms_offset;
   DISPEX_ASSIGN_OR_RETURN(SculptMapping mapping,
                           SculptMapping::Build(*correspondence, inputs.sculpt, inputs.faces));
+  DISPEX_RETURN_IF_ERROR(mapping.MarkFolds(inputs.surface, inputs.sculpt, inputs.faces));
   inputs.mapping = std::make_unique<SculptMapping>(std::move(mapping));
   report.t_match = clock.seconds();
   report.method = ExtractMethod::kMapping;

@@ -2,15 +2,18 @@
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <climits>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "core/vec3.h"
 #include "dispex/ptex_sampler.h"
+#include "extract/parallel_errors.h"
 
 namespace dispex::extract {
 
@@ -207,6 +210,69 @@ std::size_t SculptMapping::bytes() const {
   return grid_sizes_.capacity() * sizeof(std::int32_t) +
          cell_offsets_.capacity() * sizeof(std::int64_t) +
          cells_.capacity() * sizeof(std::uint32_t) + crossings_.capacity() * sizeof(Crossing);
+}
+
+Status SculptMapping::MarkFolds(const LimitSurface& surface, const Mesh& sculpt,
+                                std::span<const PtexFaceInfo> faces) {
+  const std::size_t num_ptex = grid_sizes_.size();
+  std::vector<std::uint8_t> folded(num_ptex, 0);
+  struct Scratch {
+    std::optional<LimitEvaluator> evaluator;
+    std::vector<float> positions, normals;
+  };
+  tbb::enumerable_thread_specific<Scratch> scratches;
+  FirstError error;
+  tbb::parallel_for(std::size_t{0}, num_ptex, [&](std::size_t f) {
+    const int m = grid_sizes_[f];
+    if (m == 0 || error.failed()) return;
+    Scratch& w = scratches.local();
+    if (!w.evaluator) w.evaluator.emplace(surface);
+    // The limit normal at the centre of each block of up to 4 x 4 cells (every cell on grids
+    // of up to 4 x 4): within a few degrees of every cell's own on fine grids, and a quad
+    // turned over is far beyond that.
+    const int g = std::min(m, std::max(4, m / 4));
+    const std::size_t blocks = static_cast<std::size_t>(g) * g;
+    w.positions.resize(3 * blocks);
+    w.normals.resize(3 * blocks);
+    const Status s =
+        w.evaluator->EvaluateGrid(PtexFaceId(static_cast<int>(f)), g, g, w.positions, w.normals);
+    if (!s.ok()) return error.Record(static_cast<int>(f), s);
+    const Float3* p = sculpt.positions.data();
+    for (int j = 0; j < m && !folded[f]; ++j) {
+      for (int i = 0; i < m; ++i) {
+        const std::int32_t* ids =
+            sculpt.face_indices.data() +
+            4 * static_cast<std::size_t>(FaceOf(cells_[static_cast<std::size_t>(
+                    cell_offsets_[f] + static_cast<std::int64_t>(j) * m + i)]));
+        const Vec3d n =
+            Cross(ToVec3d(p[ids[2]]) - ToVec3d(p[ids[0]]), ToVec3d(p[ids[3]]) - ToVec3d(p[ids[1]]));
+        const std::size_t b = static_cast<std::size_t>(j * g / m) * g + i * g / m;
+        const Vec3d limit{w.normals[3 * b], w.normals[3 * b + 1], w.normals[3 * b + 2]};
+        if (!(Dot(n, limit) > 0)) {
+          folded[f] = 1;
+          break;
+        }
+      }
+    }
+  });
+  if (error.failed()) return error.status();
+  // Two rings of faces across edges around each.
+  fold_risk_ = folded;
+  for (int ring = 0; ring < 2; ++ring) {
+    std::vector<std::uint8_t> next = fold_risk_;
+    for (std::size_t f = 0; f < num_ptex; ++f) {
+      if (!fold_risk_[f]) continue;
+      for (std::int32_t g : faces[f].adjfaces) {
+        if (g >= 0) next[static_cast<std::size_t>(g)] = 1;
+      }
+    }
+    fold_risk_ = std::move(next);
+  }
+  return Status::Ok();
+}
+
+std::size_t SculptMapping::fold_risk_faces() const {
+  return static_cast<std::size_t>(std::count(fold_risk_.begin(), fold_risk_.end(), 1));
 }
 
 MappingCounters& MappingCounters::operator+=(const MappingCounters& other) {
@@ -600,32 +666,6 @@ bool TestRing(const MappingScratch& w, const Mesh& sculpt, const Line& line, int
   return complete;
 }
 
-// Whether a quad of the face or of its apron is turned over against the limit normal of the
-// sample nearest to it: the sculpt folds there, and a folded sheet can reach over samples far
-// outside the rings they test.
-bool Folded(const MappingScratch& w, int n, std::span<const Float3> normals) {
-  const int m = w.m, width = m + 2 * kMargin, points = width + 1;
-  auto at = [&](int a, int b) { return &w.lattice[3 * static_cast<std::size_t>(b * points + a)]; };
-  for (int b = 0; b < width; ++b) {
-    const int j =
-        std::clamp(static_cast<int>((std::int64_t{2} * (b - kMargin) + 1) * n / (2 * m)), 0, n - 1);
-    for (int a = 0; a < width; ++a) {
-      if (w.apron[static_cast<std::size_t>(b * width + a)].state != kCell) continue;
-      const int i = std::clamp(
-          static_cast<int>((std::int64_t{2} * (a - kMargin) + 1) * n / (2 * m)), 0, n - 1);
-      const Float3& nrm = normals[static_cast<std::size_t>(j) * n + i];
-      const float *c0 = at(a, b), *c1 = at(a + 1, b), *c2 = at(a + 1, b + 1), *c3 = at(a, b + 1);
-      const float d02[3] = {c2[0] - c0[0], c2[1] - c0[1], c2[2] - c0[2]};
-      const float d13[3] = {c3[0] - c1[0], c3[1] - c1[1], c3[2] - c1[2]};
-      const float cx = d02[1] * d13[2] - d02[2] * d13[1];
-      const float cy = d02[2] * d13[0] - d02[0] * d13[2];
-      const float cz = d02[0] * d13[1] - d02[1] * d13[0];
-      if (!(cx * nrm.x + cy * nrm.y + cz * nrm.z > 0)) return true;
-    }
-  }
-  return false;
-}
-
 // ---- One sample, ring after ring -----------------------------------------------------------
 
 // Writes sample k's answer when rings 0..r decide it; false when they do not yet.
@@ -824,20 +864,19 @@ void TraceMapped(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId fa
                  std::span<const std::int32_t> samples, std::span<const Float3> origins,
                  std::span<const Float3> normals, const NormalQuery& query, const NormalHits& out,
                  std::span<std::uint8_t> undecided, MappingScratch& w, MappingCounters& counters) {
-  if (w.face != face.value) LayOut(mapping, face.value, w);
-  const int m = w.m;
   const std::size_t count = samples.empty() ? static_cast<std::size_t>(n) * n : samples.size();
   counters.queries += count;
-  // The whole grid: the lattice, and whether the face's neighbourhood folds.
-  if (samples.empty()) {
-    if (w.lattice_face != face.value) {
-      FillLattice(sculpt, w);
-      w.lattice_face = face.value;
+  if (mapping.fold_risk(face.value)) {
+    for (std::size_t s = 0; s < count; ++s) {
+      undecided[samples.empty() ? s : static_cast<std::size_t>(samples[s])] = 1;
     }
-    if (Folded(w, n, normals)) {
-      std::fill(undecided.begin(), undecided.begin() + static_cast<std::ptrdiff_t>(count), 1);
-      return;
-    }
+    return;
+  }
+  if (w.face != face.value) LayOut(mapping, face.value, w);
+  const int m = w.m;
+  if (samples.empty() && w.lattice_face != face.value) {
+    FillLattice(sculpt, w);
+    w.lattice_face = face.value;
   }
   auto cell_of = [&](int i) {
     return static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));

@@ -38,6 +38,7 @@
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
 #include "dispex/status.h"
+#include "dispex/subdiv.h"
 #include "dispex/trace.h"
 
 namespace dispex::extract {
@@ -67,6 +68,18 @@ class SculptMapping {
   static int RotationOf(std::uint32_t cell) { return static_cast<int>(cell >> 30); }
   std::size_t bytes() const;
 
+  // Ptex faces whose samples all go to a BVH: within two faces of a sculpt quad turned over
+  // against the limit normal (MarkFolds), where a folded sheet can lie over samples far outside
+  // their rings.
+  bool fold_risk(int face) const {
+    return !fold_risk_.empty() && fold_risk_[static_cast<std::size_t>(face)] != 0;
+  }
+  // Finds them: the limit normal at every cell's centre against its quad's normal (the cross
+  // product of its diagonals). The same for any thread count.
+  Status MarkFolds(const LimitSurface& surface, const Mesh& sculpt,
+                   std::span<const PtexFaceInfo> faces);
+  std::size_t fold_risk_faces() const;
+
   // Edge `edge` of Ptex face `face` into its neighbour's grid: points p of the face's grid in
   // half-cell units (vertex (i, j) at (2i, 2j)) are R p + (tx, ty) there, R a rotation by q
   // quarter turns.
@@ -85,7 +98,8 @@ class SculptMapping {
   std::vector<std::int32_t> grid_sizes_;
   std::vector<std::int64_t> cell_offsets_;
   std::vector<std::uint32_t> cells_;
-  std::vector<Crossing> crossings_;  // 4 per Ptex face
+  std::vector<Crossing> crossings_;      // 4 per Ptex face
+  std::vector<std::uint8_t> fold_risk_;  // per Ptex face, once MarkFolds ran
 };
 
 // What TraceMapped did, added up per thread.
@@ -128,9 +142,8 @@ struct MappingScratch {
 // unit `normals` (both n * n, indexed by grid index) against the sculpt through `mapping`.
 // Decided samples get out.t / out.flags (and out.prim when not empty) at their grid index as
 // Tracer::TraceNormals sets them and undecided[k] = 0; the others undecided[k] = 1, out
-// untouched. `sculpt` is the matched mesh. A call for the whole grid (`samples` empty) first
-// checks the face's neighbourhood for folds and leaves every sample undecided where it folds;
-// a call for some samples (a second search of the same grid, a sparse sampling) does not.
+// untouched. `sculpt` is the matched mesh. Every sample of a face at risk of folds
+// (SculptMapping::fold_risk) is undecided.
 void TraceMapped(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId face, int n,
                  std::span<const std::int32_t> samples, std::span<const Float3> origins,
                  std::span<const Float3> normals, const NormalQuery& query, const NormalHits& out,

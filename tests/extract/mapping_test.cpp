@@ -76,6 +76,8 @@ KernelResult CompareKernel(const std::string& cage, const std::string& sculpt_pa
   EXPECT_TRUE(correspondence.ok()) << correspondence.status().message();
   auto mapping = SculptMapping::Build(*correspondence, *sculpt, faces);
   EXPECT_TRUE(mapping.ok()) << mapping.status().message();
+  EXPECT_TRUE(mapping->MarkFolds(*surface, *sculpt, faces).ok());
+  EXPECT_EQ(mapping->fold_risk_faces(), 0u) << "these sculpts do not fold";
   TracerOptions options;
   options.scale = TracerScale(*base);
   auto tracer = MakeEmbreeTracer(*sculpt, options);
