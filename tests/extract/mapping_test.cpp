@@ -476,6 +476,26 @@ TEST(MappingFallback, DefaultPipelineIsTheSameAtAnyThreadCount) {
   EXPECT_EQ(dispex::testing::Slurp(dir / "one.ptx"), dispex::testing::Slurp(dir / "two.ptx"));
 }
 
+// Spot at level 3 with the detail pattern folds (MakeSculpt counts quads turned over): the faces
+// around the folds go to the BVH whole. Rejects a fold check that never fires, and a map that
+// then differs from the ray map in any face's resolution or beyond a few texels (the samples a
+// sheet from farther away reaches over, outside the faces marked, keep the mapping's own hit).
+TEST(MappingFallback, FoldsGoToTheBvh) {
+  TempDir dir;
+  const std::string cage = DataPath("meshes/keenan_spot/spot_quadrangulated.obj");
+  const std::string sculpt = dir / "sculpt.obj";
+  auto made = MakeSculpt(dispex::testing::SculptOptions(cage, sculpt, 3, Pattern::kDetail, 0));
+  ASSERT_TRUE(made.ok());
+  ASSERT_GT(made->folded_faces, 0u);
+  auto mapping = Extract(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kMapping));
+  auto rays = Extract(Options(cage, sculpt, dir / "rays.ptx", ExtractMethod::kRays));
+  ASSERT_TRUE(mapping.ok() && rays.ok());
+  EXPECT_GT(mapping->mapping_fallback_faces, 0);
+  const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", 1.0);
+  EXPECT_TRUE(t.same_resolutions);
+  EXPECT_LE(t.differ, t.texels / 1000) << t.differ << " of " << t.texels << " texels differ";
+}
+
 // ---- The command line -----------------------------------------------------------------------
 
 // Rejects a --method the command line does not take, or one whose failure is not one line.
