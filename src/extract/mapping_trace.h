@@ -7,9 +7,11 @@
 // line o + t d against the plane of the hit triangle -- v0 v1 v3 or v2 v3 v1 of the sculpt
 // face's own corners, as Embree splits quads -- in double, rounded to float once; windows are
 // closed; a triangle is met where the line's projection along d lies inside it or on its edges
-// (edge functions of the projected corners, each edge's value computed once per line so that
-// two triangles sharing an edge never both reject a line through it); the policies, kNegative
-// and kBackFace as TraceNormals sets them.
+// (edge values of the corners projected in double, each edge's from the same two projections
+// whichever triangle asks, so two triangles sharing an edge never both reject a line through
+// it); the policies, kNegative and kBackFace as TraceNormals sets them. Where the line passes
+// within rounding of an edge, the triangle kept may be the other one than Embree's: t then
+// differs by rounding (both planes hold the edge).
 //
 // Rings. Ring r is the cells at Chebyshev distance r from the sample's cell, continued across
 // Ptex face edges (PtexAcrossEdge: faces, sub-faces, and the quad <-> sub-face halves) into the
@@ -23,10 +25,18 @@
 // (a miss: no hit in the window, and the line crosses a tested quad beyond the window at least
 // one ring inside), up to ring kMaxRings. Samples not decided that way -- hits or crossings
 // only in the outermost ring, no crossing at all, a ring reaching where the neighbourhood
-// cannot be laid out, a degenerate triangle -- are marked undecided for a BVH to answer. The
-// rule assumes the sculpt is one sheet near the sample: a surface of another part of the
-// sculpt that comes nearer along the normal than the local one (a fold over, a thin part's
-// other side within the search distance) is seen only if it lies in the rings tested.
+// cannot be laid out, a degenerate triangle, quads tested that face the line both ways (the
+// sheet folds or stands edge-on there) -- are left undecided for a BVH to answer, and so are
+// all samples of faces near a quad turned over against the limit normal (MarkFolds). The rule
+// assumes the sculpt is one sheet near the sample: another part of the sculpt that comes nearer
+// along the normal than the local sheet (a thin part's other side within the search distance,
+// a fold farther than two faces) is seen only where it lies in the rings tested.
+//
+// Speed. The samples of one cell go through rings 0 and 1 together (4 lanes): the cell's 4 x 4
+// lattice of corners projected in float, each edge's value once, and a triangle classified as
+// surely met, surely missed or unsure by a bound on the float error; only the met and the
+// unsure are tested (and t computed) in double. Other samples, and those rings 0 and 1 do not
+// decide, go ring by ring in double.
 #pragma once
 
 #include <cstdint>
