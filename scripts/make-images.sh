@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Regenerates the README images docs/images/spot_atlas.png and docs/images/spot_compare.png
 # from the demo asset: Spot's cage, a sculpt of it made by `dispex make-sculpt` (4 levels,
-# 'detail' pattern, amplitude 0.005) and the map `dispex extract` takes from that sculpt.
+# 'detail' pattern, amplitude 0.005) and the map `dispex extract` takes from that sculpt; and
+# docs/images/overhang_scalar.png, overhang_vector.png (docs/VECTOR.md): the 'overhang' sculpt
+# (4 levels, amplitude 0.01) beside the base displaced by its scalar and its vector map.
 # Usage: scripts/make-images.sh [build-dir]   (default: build; the dispex binary must exist)
 set -euo pipefail
 build="${1:-build}"
@@ -19,4 +21,13 @@ mkdir -p "$images"
 "$dispex" preview "$work/spot.ptx" -o "$images/spot_atlas.png" --mode signed
 "$dispex" render "$cage" "$work/spot.ptx" --compare --sculpt "$work/spot_sculpt.obj" \
   --size 960x360 --view iso --ao 16 -o "$images/spot_compare.png"
-ls -l "$images/spot_atlas.png" "$images/spot_compare.png"
+
+"$dispex" make-sculpt "$cage" --levels 4 --pattern overhang --amplitude 0.01 \
+  -o "$work/overhang.obj" -q
+"$dispex" extract "$cage" "$work/overhang.obj" -o "$work/overhang_scalar.ptx" -q
+"$dispex" extract "$cage" "$work/overhang.obj" --vector object -o "$work/overhang_vector.ptx" -q
+for kind in scalar vector; do
+  "$dispex" render "$cage" "$work/overhang_$kind.ptx" --compare --sculpt "$work/overhang.obj" \
+    --size 1050x350 --view left --elevation 10 -o "$images/overhang_$kind.png"
+done
+ls -l "$images/spot_atlas.png" "$images/spot_compare.png" "$images"/overhang_*.png

@@ -49,6 +49,7 @@ struct ExtractArgs {
   std::string watertight = "filter";
   std::string bvh_quality = "low";
   std::string method = "auto";
+  std::string vector;
   std::string report_path;
   std::string preview_dir;
   std::string max_memory;
@@ -146,6 +147,11 @@ Status Resolve(ExtractArgs& a) {
   auto watertight = ParseWatertightEdges(a.watertight);
   if (!watertight.ok()) return watertight.status().WithPrefix("--watertight");
   o.watertight = *watertight;
+  if (!a.vector.empty()) {
+    auto space = ParseVectorSpace(a.vector);
+    if (!space.ok()) return space.status().WithPrefix("--vector");
+    o.vector = *space;
+  }
   auto quality = ParseBuildQuality(a.bvh_quality);
   if (!quality.ok()) return quality.status().WithPrefix("--bvh-quality");
   o.bvh_quality = *quality;
@@ -315,6 +321,10 @@ void SetupExtract(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-memory", args->max_memory,
                   "refuse work estimated to need more memory than this (e.g. 8G; default: the "
                   "memory available)");
+  cmd->add_option("--vector", args->vector,
+                  "write a vector displacement map (3 channels: sculpt - limit surface) in this "
+                  "space: tangent (T, B, N), parametric (dP/du, dP/dv, N) or object (x, y, z); "
+                  "the sculpt must be the base refined (see `dispex match`)");
   cmd->add_flag("--incremental", o.incremental,
                 "re-use the map at the output path: left as it is when made from the same "
                 "inputs and options, else only the faces whose inputs changed are extracted "

@@ -1,5 +1,5 @@
 // dispex make-sculpt CAGE --levels L | --layout jittered --density N --pattern P|image:FILE.png
-//   [--amplitude A] -o SCULPT.obj
+//   [--amplitude A] -o SCULPT.obj   (P: smooth, detail, ridges, noise, none, sideways, overhang)
 #include <fmt/format.h>
 
 #include "command.h"
@@ -46,14 +46,18 @@ int RunMakeSculpt(MakeSculptArgs& args) {
     for (const std::string& w : report->warnings) fmt::print(stderr, "dispex: warning: {}\n", w);
     std::string truth = args.options.truth_path.empty() ? args.options.output_path + ".truth"
                                                         : args.options.truth_path;
-    fmt::print(
-        stderr,
-        "dispex: {} ({} vertices, {} {}; pattern {}, amplitude {:.4g}, h in "
-        "[{:.4g}, {:.4g}], piecewise-linear error {:.3g}, {} folded faces) and {} in {:.2f}s\n",
-        args.options.output_path, report->vertices, report->faces,
-        args.options.layout == SculptLayout::kJittered ? "triangles" : "quads", args.pattern,
-        report->amplitude, report->h_min, report->h_max, report->linear_error, report->folded_faces,
-        truth, report->seconds);
+    const std::string vector = IsVectorPattern(args.options.pattern)
+                                   ? fmt::format(", max |D| {:.4g}, max tangential |D| {:.4g}",
+                                                 report->max_displacement, report->max_tangential)
+                                   : "";
+    fmt::print(stderr,
+               "dispex: {} ({} vertices, {} {}; pattern {}, amplitude {:.4g}, h in "
+               "[{:.4g}, {:.4g}]{}, piecewise-linear error {:.3g}, {} folded faces) and {} in "
+               "{:.2f}s\n",
+               args.options.output_path, report->vertices, report->faces,
+               args.options.layout == SculptLayout::kJittered ? "triangles" : "quads", args.pattern,
+               report->amplitude, report->h_min, report->h_max, vector, report->linear_error,
+               report->folded_faces, truth, report->seconds);
   }
   return 0;
 }
@@ -63,8 +67,9 @@ void SetupMakeSculpt(CLI::App& app, int& exit_code) {
   MakeSculptOptions& o = args->options;
   CLI::App* cmd = app.add_subcommand(
       "make-sculpt",
-      "Make a test sculpt with known displacement: the cage refined L times, displaced along "
-      "the limit normal by a pattern; writes SCULPT.obj and SCULPT.obj.truth");
+      "Make a test sculpt with known displacement: the cage refined L times (or a jittered "
+      "grid), displaced along the limit normal by a pattern (or by a vector pattern's D); "
+      "writes SCULPT.obj and SCULPT.obj.truth");
   cmd->add_option("cage", o.cage_path, "base cage (.obj, .ply)")->required();
   cmd->add_option("-o,--output", o.output_path, "sculpt to write (.obj)")->required();
   cmd->add_option("--levels", o.levels, "Catmull-Clark refinement levels (1..8; layout refined)")
@@ -77,7 +82,10 @@ void SetupMakeSculpt(CLI::App& app, int& exit_code) {
   cmd->add_option("--density", o.density, "cells per Ptex face side of --layout jittered (2..256)");
   cmd->add_option("--pattern", args->pattern,
                   "smooth, detail, ridges, noise, none, or image:FILE.png (h = A (2 L - 1), L "
-                  "the PNG's luminance at the cage's UVs; v = 0 at the image's bottom row)")
+                  "the PNG's luminance at the cage's UVs; v = 0 at the image's bottom row); "
+                  "vector patterns: sideways (tangential waves only, D.N = 0) or overhang "
+                  "(bumps sheared along the surface until they fold back over themselves: no "
+                  "scalar map holds them)")
       ->capture_default_str();
   cmd->add_option("--amplitude", o.amplitude,
                   "pattern amplitude in object units (default: 1% of the bounding-box diagonal)")

@@ -106,8 +106,9 @@ void SetupRender(CLI::App& app, int& exit_code) {
   SurfaceRenderOptions& o = args->options;
   CLI::App* cmd = app.add_subcommand(
       "render",
-      "Ray-cast the base mesh's limit surface, displaced by MAP when given, to a PNG; "
-      "--compare puts base, base + map (and --sculpt) side by side");
+      "Ray-cast the base mesh's limit surface, displaced by MAP when given (a scalar map along "
+      "the normal, a vector map by its vectors), to a PNG; --compare puts base, base + map (and "
+      "--sculpt) side by side");
   cmd->add_option("files", args->files, "BASE [MAP.ptx]")->required()->expected(1, 2);
   cmd->add_option("-o,--output", args->output_path, "PNG to write")->required();
   cmd->add_flag("--compare", args->compare, "panels side by side: base, base + map (needs MAP)");
@@ -147,7 +148,9 @@ void SetupRender(CLI::App& app, int& exit_code) {
   cmd->add_flag("--per-face", o.per_face_displacement,
                 "displace each face by its own map value where faces meet, as a renderer "
                 "reading faces on their own does (cracks and steps show), instead of the mean");
-  cmd->add_option("--channel", o.channel, "map channel used as the displacement")
+  cmd->add_option("--channel", o.channel,
+                  "displace along the normal by this map channel (-1: the map says: 1 channel "
+                  "is a scalar map, 3 with dispex:vector_space a vector map, P + D)")
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
       ->check(NonNegative())

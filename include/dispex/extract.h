@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "dispex/status.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
+#include "dispex/vector_space.h"
 
 namespace dispex {
 
@@ -114,6 +116,14 @@ struct ExtractOptions {
   // same file a full extraction writes. A map that is missing, unreadable, or written by
   // another version is not re-used (a warning says why).
   bool incremental = false;
+
+  // Vector displacement (docs/VECTOR.md): a 3-channel map of D = sculpt - limit surface in this
+  // space (include/dispex/vector_space.h), the sculpt read exactly at each sample through its
+  // correspondence with the base -- it must be the base refined (MatchRefinedSculpt) -- with
+  // no rays. Empty: the scalar map along the limit normal. The search distance, when given,
+  // bounds how far a sculpt vertex may lie from its point on the limit surface
+  // (MatchOptions::max_offset); ray, hole and watertight options do not apply.
+  std::optional<VectorSpace> vector;
 };
 
 // The face table of every map of `surface`, taken from the limit surface (OpenSubdiv's Ptex
@@ -153,13 +163,11 @@ struct ExtractReport {
   double t_read_base = 0, t_read_sculpt = 0, t_topology = 0, t_bvh = 0, t_search = 0,
          t_sample_trace = 0, t_write = 0, t_total = 0;
 
-  // The subdivision correspondence (ExtractMethod): the method that ran (kRays or kMapping),
-  // and when it was looked for, how long the match took and what it found.
+  // Scalar maps (ExtractMethod): the method that ran (kRays or kMapping); when the
+  // correspondence was looked for, the match as below (mapping_levels, offsets, t_match), or
+  // why the sculpt is not the base refined.
   ExtractMethod method = ExtractMethod::kRays;
-  double t_match = 0;
-  int mapping_levels = -1;  // the sculpt is the base refined this many times; -1: not matched
-  double mapping_max_offset = 0, mapping_rms_offset = 0;  // sculpt vertices from their homes
-  std::string mapping_reason;  // why the sculpt is not the base refined (empty when it is)
+  std::string mapping_reason;
   // Samples the mapping could not decide, answered by a BVH of the sculpt within their reach,
   // and the Ptex faces they are in (of the faces extracted in this run).
   std::int64_t mapping_fallback_samples = 0, mapping_fallback_faces = 0;
@@ -225,6 +233,16 @@ struct ExtractReport {
   // With a given search distance: the Ptex faces whose reach the BVH holds when it holds only
   // part of the sculpt (docs/INCREMENTAL.md); 0 when it holds all of it.
   std::int64_t tracer_faces = 0;
+
+  // Vector maps (ExtractOptions::vector): the space; the correspondence (the sculpt is the base
+  // refined mapping_levels times, -1 when not matched; how far its vertices lie from their
+  // points on the limit surface; scalar maps through the mapping too); the largest |D| and its
+  // largest part across the normal (displacement_min, _max hold D . N, displacement_rms |D|).
+  std::string vector_space;  // empty for a scalar map
+  int mapping_levels = -1;
+  double mapping_max_offset = 0, mapping_rms_offset = 0;
+  double t_match = 0;
+  double vector_length_max = 0, vector_tangential_max = 0;
 
   // Output.
   std::uint64_t bytes_written = 0;

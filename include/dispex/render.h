@@ -199,8 +199,11 @@ struct SurfaceRenderOptions {
   int supersample = 2;        // s x s rays per pixel on a fixed grid (1..4)
   int ao_samples = 0;         // ambient occlusion rays per hit (0 = off, up to 64)
   double ao_distance = 0.05;  // AO ray length, fraction of the framed points' bounding diagonal
-  int channel = 0;            // map channel used as the displacement
-  int threads = 0;            // 0: all cores
+  // -1: the map says what it holds: 1 channel, a scalar map (P + h N); 3 channels with
+  // dispex:vector_space meta data, a vector map (P + D, include/dispex/vector_space.h); any
+  // other map is an error naming it. 0 or more: that channel as a scalar map, whatever the map.
+  int channel = -1;
+  int threads = 0;  // 0: all cores
   // Where faces meet, displace each face by its own map value instead of the faces' mean, as
   // a renderer that reads each face on its own (PtexFile::Sample, no filtering across edges)
   // does: every face gets its own copy of the shared points (same undisplaced limit position
@@ -217,12 +220,14 @@ Status ValidateSurfaceRenderOptions(const SurfaceRenderOptions& options);
 
 // Renders the limit surface of the Catmull-Clark cage `base`, displaced along its limit normal
 // by `map` (read bilinearly per face, as a renderer reads it; values averaged where faces
-// meet, so no cracks open, unless options.per_face_displacement) when map is not null, framed
+// meet, so no cracks open, unless options.per_face_displacement) when map is not null -- by
+// the vector D of a vector map (options.channel) --, framed
 // on the cage's vertices. Shading: clay albedo lit by a headlight and a two-light rig (key and
 // fill), smooth normals averaged from the displaced tessellation; hidden holes show the
 // background. Fails when the cage is not a valid Catmull-Clark mesh, the map's face count
 // differs from the cage's Ptex face count (naming both), the map is a triangle Ptex or lacks
-// the channel, its data is corrupt or not finite, or options are out of range.
+// the channel, is neither a scalar nor a vector map (options.channel = -1), its data is
+// corrupt or not finite, or options are out of range.
 StatusOr<Image> RenderSurface(const Mesh& base, const PtexFile* map,
                               const SurfaceRenderOptions& options);
 

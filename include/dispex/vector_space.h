@@ -10,6 +10,8 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <string_view>
 
 #include "dispex/mesh.h"
@@ -20,6 +22,8 @@ namespace dispex {
 enum class VectorSpace : std::uint8_t { kTangent, kParametric, kObject };
 // "tangent", "parametric", "object".
 std::string_view VectorSpaceName(VectorSpace space);
+// The frame's definition in one line, as maps record it (dispex:frame).
+std::string_view VectorSpaceFrame(VectorSpace space);
 StatusOr<VectorSpace> ParseVectorSpace(std::string_view name);
 // The channel names in order, comma-separated: "T,B,N", "a,b,n", "x,y,z".
 std::string_view VectorSpaceChannels(VectorSpace space);
@@ -34,5 +38,25 @@ struct SurfaceFrame {
 // tangential part are 0 and a tangent frame falls back to any unit vector orthogonal to N).
 Float3 VectorFromChannels(VectorSpace space, const SurfaceFrame& frame, const float c[3]);
 void VectorToChannels(VectorSpace space, const SurfaceFrame& frame, const Float3& d, float c[3]);
+
+// ---- Scalar or vector: what a displacement map holds -----------------------------------------
+
+// The meta data (strings) that make a 3-channel map a vector map: the space's name
+// (VectorSpaceName) and the names of its channels (VectorSpaceChannels).
+inline constexpr std::string_view kVectorSpaceMetaKey = "dispex:vector_space";
+inline constexpr std::string_view kVectorChannelsMetaKey = "dispex:channels";
+
+// What a displacement map holds, from its channel count, alpha channel and the values of its
+// dispex:vector_space and dispex:channels meta data (nullptr when the map has no such item):
+//  - 1 channel, without dispex:vector_space: a scalar map, displaced by h N (nullopt);
+//  - 3 channels, no alpha, dispex:vector_space naming a space and dispex:channels, when present,
+//    equal to VectorSpaceChannels of it: a vector map in that space.
+// Anything else fails with one line that starts with `map` (the file's name): a 3-channel map
+// without dispex:vector_space, any other channel count, an unknown space, mismatched channel
+// names, an alpha channel, a 1-channel map that claims a vector space.
+StatusOr<std::optional<VectorSpace>> DisplacementMapSpace(std::string_view map, int channels,
+                                                          int alpha_channel,
+                                                          const std::string* vector_space,
+                                                          const std::string* channel_names);
 
 }  // namespace dispex

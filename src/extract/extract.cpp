@@ -26,6 +26,7 @@
 #include "extract/parallel_errors.h"
 #include "extract/previous_map.h"
 #include "extract/process_faces.h"
+#include "extract/vector_faces.h"
 
 namespace dispex::extract {
 
@@ -169,16 +170,27 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   const auto num_faces = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
   PreviousMap previous;
   if (options.incremental) {
-    previous = PreviousMap::Open(options.output_path, num_faces);
-    if (previous.usable() && previous.MetaString(kInputsKeyMetaKey) == report.inputs_key) {
+    // Vector maps are made whole; an up-to-date map of either kind is left as it is.
+    if (!options.vector) previous = PreviousMap::Open(options.output_path, num_faces);
+    const std::string stored = options.vector      ? StoredInputsKey(options.output_path)
+                               : previous.usable() ? previous.MetaString(kInputsKeyMetaKey)
+                                                   : "";
+    if (stored == report.inputs_key) {
       report.unchanged = true;
       report.t_total = total_clock.seconds();
       report.peak_rss_bytes = PeakResidentBytes();
       return report;
     }
+  }
+  if (options.incremental && options.vector) {
+    report.redo_reason = "a vector map is extracted whole when anything changed";
+  } else if (options.incremental) {
     previous.CheckFaceData();
     if (!previous.notice().empty()) report.warnings.push_back(previous.notice());
     report.redo_reason = RedoReason(previous, report);
+  }
+  if (options.vector) {
+    return ExtractVectorShape(options, std::move(inputs), std::move(report), total_clock);
   }
   // Through the subdivision correspondence no BVH is built up front (extract_mapping.h).
   DISPEX_RETURN_IF_ERROR(ChooseMethod(options, inputs, report));

@@ -45,6 +45,8 @@ nlohmann::json ExtractOptionsJson(const ExtractOptions& o) {
   j["max_miss_fraction"] = o.max_miss_fraction;
   j["bvh_quality"] = std::string(BuildQualityName(o.bvh_quality));
   j["watertight"] = std::string(WatertightEdgesName(o.watertight));
+  // Only on vector maps, so that scalar maps keep their keys (incremental re-use).
+  if (o.vector) j["vector"] = std::string(VectorSpaceName(*o.vector));
   // Only when given: maps made before the option existed keep their keys.
   if (o.method != ExtractMethod::kAuto) j["method"] = std::string(ExtractMethodName(o.method));
   return j;
@@ -52,7 +54,7 @@ nlohmann::json ExtractOptionsJson(const ExtractOptions& o) {
 
 nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
   nlohmann::json j;
-  j["method"] = std::string(ExtractMethodName(r.method));
+  if (r.vector_space.empty()) j["method"] = std::string(ExtractMethodName(r.method));
   j["tolerance"] = r.tolerance;
   j["tolerance_auto"] = r.tolerance_auto;
   j["sculpt_median_edge"] = r.sculpt_median_edge;
@@ -117,6 +119,14 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
                 {"step_across_faces", r.edge_step_across_faces},
                 {"max_edge_error", s.max_edge_error},
                 {"edge_limited_faces", s.edge_limited_faces}};
+  if (!r.vector_space.empty()) {
+    j["vector"] = {{"space", r.vector_space},
+                   {"mapping_levels", r.mapping_levels},
+                   {"mapping_max_offset", r.mapping_max_offset},
+                   {"mapping_rms_offset", r.mapping_rms_offset},
+                   {"length_max", r.vector_length_max},
+                   {"tangential_max", r.vector_tangential_max}};
+  }
   return j;
 }
 
@@ -155,6 +165,7 @@ Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractRep
         "dispex:discontinuous_faces", std::span<const std::int32_t>(report.discontinuous_faces)));
   }
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData(kInputsKeyMetaKey, report.inputs_key));
+  if (face_keys.empty()) return Status::Ok();  // a map whose faces are not re-used
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
       kFaceKeysMetaKey, std::span<const std::int8_t>(EncodeFaceKeys(face_keys))));
   return writer.AddMetaData(

@@ -39,13 +39,15 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
                             {"floored", e.floored},
                             {"capped", e.capped}};
   }
-  j["method"] = {{"used", std::string(ExtractMethodName(r.method))},
-                 {"levels", r.mapping_levels},
-                 {"max_offset", r.mapping_max_offset},
-                 {"rms_offset", r.mapping_rms_offset},
-                 {"reason", r.mapping_reason},
-                 {"fallback_samples", r.mapping_fallback_samples},
-                 {"fallback_faces", r.mapping_fallback_faces}};
+  if (r.vector_space.empty()) {
+    j["method"] = {{"used", std::string(ExtractMethodName(r.method))},
+                   {"levels", r.mapping_levels},
+                   {"max_offset", r.mapping_max_offset},
+                   {"rms_offset", r.mapping_rms_offset},
+                   {"reason", r.mapping_reason},
+                   {"fallback_samples", r.mapping_fallback_samples},
+                   {"fallback_faces", r.mapping_fallback_faces}};
+  }
   j["phases_seconds"] = {{"read_base", r.t_read_base},
                          {"read_sculpt", r.t_read_sculpt},
                          {"topology", r.t_topology},
@@ -138,20 +140,29 @@ std::string ExtractReportSummary(const ExtractReport& r) {
   }
   out += fmt::format("dispex: {} ({} Ptex faces) <- {} ({} faces)\n", r.output_path, r.ptex_faces,
                      r.sculpt_path, r.sculpt_faces);
-  if (r.method == ExtractMethod::kMapping) {
+  if (!r.vector_space.empty()) {
     out += fmt::format(
-        "  through the subdivision correspondence (level {}, {:.2f}s); {} samples of {} faces "
-        "left to a BVH\n",
-        r.mapping_levels, r.t_match, r.mapping_fallback_samples, r.mapping_fallback_faces);
+        "  vector ({}): the sculpt is the base refined {} times; its vertices lie up to {:.4g} "
+        "(rms {:.4g}) from their points on the limit surface\n",
+        r.vector_space, r.mapping_levels, r.mapping_max_offset, r.mapping_rms_offset);
+    out += fmt::format("  tolerance {:.4g}{}  samples {}  matched in {:.2f}s\n", r.tolerance,
+                       r.tolerance_auto ? " (auto)" : "", r.samples, r.t_match);
+  } else {
+    if (r.method == ExtractMethod::kMapping) {
+      out += fmt::format(
+          "  through the subdivision correspondence (level {}, {:.2f}s); {} samples of {} faces "
+          "left to a BVH\n",
+          r.mapping_levels, r.t_match, r.mapping_fallback_samples, r.mapping_fallback_faces);
+    }
+    out += fmt::format("  tolerance {:.4g}{}  search distance {:.4g}{}\n", r.tolerance,
+                       r.tolerance_auto ? " (auto)" : "", r.search_distance,
+                       r.search_distance_auto ? " (auto)" : "");
+    out += fmt::format(
+        "  samples {}  rays {}  misses {} ({} filled in-face, {} faces from "
+        "neighbours; {} more found by the {:.4g} search)\n",
+        r.samples, r.rays_cast, r.misses, r.holes_filled, r.faces_filled_from_neighbours,
+        r.misses_recovered, r.retry_search_distance);
   }
-  out += fmt::format("  tolerance {:.4g}{}  search distance {:.4g}{}\n", r.tolerance,
-                     r.tolerance_auto ? " (auto)" : "", r.search_distance,
-                     r.search_distance_auto ? " (auto)" : "");
-  out += fmt::format(
-      "  samples {}  rays {}  misses {} ({} filled in-face, {} faces from "
-      "neighbours; {} more found by the {:.4g} search)\n",
-      r.samples, r.rays_cast, r.misses, r.holes_filled, r.faces_filled_from_neighbours,
-      r.misses_recovered, r.retry_search_distance);
   if (r.hits_opposed > 0) {
     out += fmt::format(
         "  {} hits on sculpt faces facing against the normal (folds or other "
@@ -182,8 +193,16 @@ std::string ExtractReportSummary(const ExtractReport& r) {
     }
     out += "\n";
   }
-  out += fmt::format("  displacement [{:.4g}, {:.4g}] rms {:.4g}\n", r.displacement_min,
-                     r.displacement_max, r.displacement_rms);
+  if (r.vector_space.empty()) {
+    out += fmt::format("  displacement [{:.4g}, {:.4g}] rms {:.4g}\n", r.displacement_min,
+                       r.displacement_max, r.displacement_rms);
+  } else {
+    out += fmt::format(
+        "  displacement |D| up to {:.4g} (rms {:.4g}), along the normal [{:.4g}, {:.4g}], "
+        "across it up to {:.4g}\n",
+        r.vector_length_max, r.displacement_rms, r.displacement_min, r.displacement_max,
+        r.vector_tangential_max);
+  }
   out += fmt::format(
       "  time {:.2f}s (read {:.2f}+{:.2f}, bvh {:.2f}, sample+trace {:.2f}, "
       "write {:.2f})  {:.1f} MB  peak {:.0f} MB\n",

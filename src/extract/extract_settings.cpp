@@ -89,7 +89,10 @@ StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
   ExtractSettings settings;
   {
     DISPEX_ASSIGN_OR_RETURN(CoarseSampling coarse, SampleCoarsely(inputs.surface));
-    DISPEX_RETURN_IF_ERROR(ResolveSearchDistances(options, inputs, coarse, report));
+    // Vector maps read the sculpt through its correspondence: no rays, no search distance.
+    if (!options.vector) {
+      DISPEX_RETURN_IF_ERROR(ResolveSearchDistances(options, inputs, coarse, report));
+    }
     settings.plan =
         PlanOversampling(inputs.surface, inputs.sculpt, coarse.face_areas, options.oversample,
                          options.min_oversample, options.max_oversample);
@@ -110,7 +113,7 @@ StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
   settings.spectral.fixed_vlog2 = options.fixed_vlog2;
   settings.holes = options.holes;
   settings.data_type = options.data_type;
-  settings.watertight = options.resolution_rule == ResolutionRule::kErrorBound
+  settings.watertight = options.resolution_rule == ResolutionRule::kErrorBound && !options.vector
                             ? options.watertight
                             : WatertightEdges::kOff;
   settings.edge_step_budget = report.tolerance;

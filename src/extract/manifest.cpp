@@ -91,13 +91,21 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
     return SetNamed(o.bvh_quality, v, ParseBuildQuality);
   } else if (name == "method") {
     return SetNamed(o.method, v, ParseExtractMethod);
+  } else if (name == "vector") {
+    if (v == "off") {
+      o.vector.reset();
+      return Status::Ok();
+    }
+    VectorSpace space{};
+    DISPEX_RETURN_IF_ERROR(SetNamed(space, v, ParseVectorSpace));
+    o.vector = space;
   } else {
     return Status::Error(
         "unknown option (known: oversample, max_oversample, min_oversample, search_distance, "
         "ray_policy, tolerance, tolerance_fraction, resolution_rule, fixed_resolution, "
         "nonzero_threshold, "
         "data_type, compression_level, holes, watertight, max_miss_fraction, bvh_quality, "
-        "method)");
+        "method, vector)");
   }
   return Status::Ok();
 }

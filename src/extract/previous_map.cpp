@@ -44,6 +44,19 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces) {
   return out;
 }
 
+std::string StoredInputsKey(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return "";
+  StatusOr<PtexFile> file = PtexFile::Open(path);
+  if (!file.ok()) return "";
+  const PtexMetaItem* version = file->FindMetaData("dispex:version");
+  const PtexMetaItem* key = file->FindMetaData(kInputsKeyMetaKey);
+  if (version == nullptr || key == nullptr || version->AsString() != DISPEX_VERSION_STRING) {
+    return "";
+  }
+  return key->AsString();
+}
+
 void PreviousMap::CheckFaceData() {
   if (!file_) return;
   Status valid = file_->Validate();

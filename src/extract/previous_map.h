@@ -14,6 +14,11 @@
 
 namespace dispex::extract {
 
+// The dispex:inputs_key of the map at `path` when it is one this version of dispex wrote and
+// its structure is sound; "" otherwise (missing, unreadable, foreign). A map with the key of
+// the inputs and options at hand is up to date.
+std::string StoredInputsKey(const std::string& path);
+
 class PreviousMap {
  public:
   // Never fails: a missing file re-uses nothing and leaves notice() empty; a map that cannot be

@@ -13,6 +13,7 @@
 #include "dispex/render.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
+#include "dispex/vector_space.h"
 #include "render/bitmap_font.h"
 #include "render/image_ops.h"
 #include "render/ray_caster.h"
@@ -50,7 +51,10 @@ Status ValidateSurfaceRenderOptions(const SurfaceRenderOptions& o) {
   if (!(o.ao_distance > 0 && o.ao_distance <= 1)) {
     return Status::Error(fmt::format("ao_distance = {}: must be in (0, 1]", o.ao_distance));
   }
-  if (o.channel < 0) return Status::Error(fmt::format("channel = {}: must be >= 0", o.channel));
+  if (o.channel < -1) {
+    return Status::Error(
+        fmt::format("channel = {}: must be >= 0, or -1 (the map says what it holds)", o.channel));
+  }
   if (o.threads < 0) return Status::Error(fmt::format("threads = {}: must be >= 0", o.threads));
   // The view: framing a unit box checks the angles, field of view and margin.
   BoundingBox unit;
@@ -61,7 +65,15 @@ Status ValidateSurfaceRenderOptions(const SurfaceRenderOptions& o) {
 
 namespace {
 
-Status CheckMap(const Mesh& base, const LimitSurface& surface, const PtexFile& map, int channel) {
+// How the map displaces (SurfaceRenderOptions::channel): the channel of a scalar map, or a
+// vector map's space.
+struct MapUse {
+  int channel = 0;
+  std::optional<VectorSpace> space;
+};
+
+StatusOr<MapUse> CheckMap(const Mesh& base, const LimitSurface& surface, const PtexFile& map,
+                          int channel) {
   if (map.header().mesh_type != PtexMeshType::kQuad) {
     return Status::Error(map.name() +
                          ": triangle-mesh Ptex files cannot displace a "
@@ -76,7 +88,20 @@ Status CheckMap(const Mesh& base, const LimitSurface& surface, const PtexFile& m
         "{}: {} Ptex faces, but the base mesh {} has {}: the map was made for another mesh",
         map.name(), map.num_faces(), base.source, surface.num_ptex_faces()));
   }
-  return Status::Ok();
+  MapUse use;
+  if (channel >= 0) {
+    use.channel = channel;
+    return use;
+  }
+  const PtexMetaItem* space = map.FindMetaData(kVectorSpaceMetaKey);
+  const PtexMetaItem* names = map.FindMetaData(kVectorChannelsMetaKey);
+  const std::string space_value = space ? space->AsString() : "";
+  const std::string names_value = names ? names->AsString() : "";
+  DISPEX_ASSIGN_OR_RETURN(
+      use.space,
+      DisplacementMapSpace(map.name(), map.header().num_channels, map.header().alpha_channel,
+                           space ? &space_value : nullptr, names ? &names_value : nullptr));
+  return use;
 }
 
 std::vector<std::array<int, 2>> Densities(const LimitSurface& surface, const PtexFile* map,
@@ -118,16 +143,17 @@ StatusOr<Image> Cast(const render::ShadedMesh& mesh, std::span<const Float3> fra
   return render::CastPanel(mesh, *tracer, camera, Shading(o, frame));
 }
 
-// The limit surface of `base`, displaced by `map` or not, tessellated at the map's densities
-// when `density_map` is given, else at o.density.
+// The limit surface of `base`, displaced by `map` (as `use` says) or not, tessellated at the
+// map's densities when `density_map` is given, else at o.density.
 StatusOr<render::ShadedMesh> Surface(const Mesh& base, const LimitSurface& surface,
                                      const PtexFile* density_map, const PtexFile* map,
-                                     const SurfaceRenderOptions& o) {
+                                     const MapUse& use, const SurfaceRenderOptions& o) {
   const auto density = Densities(surface, density_map, o);
-  return render::TessellateLimitSurface(base, surface, density, map, o.channel,
+  return render::TessellateLimitSurface(base, surface, density, map, use.channel,
                                         o.per_face_displacement
                                             ? render::BoundaryDisplacement::kPerFace
-                                            : render::BoundaryDisplacement::kMean);
+                                            : render::BoundaryDisplacement::kMean,
+                                        use.space);
 }
 
 template <class F>
@@ -143,8 +169,12 @@ StatusOr<Image> RenderSurface(const Mesh& base, const PtexFile* map,
   DISPEX_RETURN_IF_ERROR(ValidateSurfaceRenderOptions(options));
   return InArena(options.threads, [&]() -> StatusOr<Image> {
     DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
-    if (map) DISPEX_RETURN_IF_ERROR(CheckMap(base, surface, *map, options.channel));
-    DISPEX_ASSIGN_OR_RETURN(render::ShadedMesh mesh, Surface(base, surface, map, map, options));
+    MapUse use;
+    if (map) {
+      DISPEX_ASSIGN_OR_RETURN(use, CheckMap(base, surface, *map, options.channel));
+    }
+    DISPEX_ASSIGN_OR_RETURN(render::ShadedMesh mesh,
+                            Surface(base, surface, map, map, use, options));
     return Cast(mesh, base.positions, options, options.width, options.height);
   });
 }
@@ -179,15 +209,16 @@ StatusOr<Image> RenderComparison(const Mesh& base, const PtexFile& map, const Me
   }
   return InArena(options.threads, [&]() -> StatusOr<Image> {
     DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
-    DISPEX_RETURN_IF_ERROR(CheckMap(base, surface, map, options.channel));
+    DISPEX_ASSIGN_OR_RETURN(const MapUse use, CheckMap(base, surface, map, options.channel));
     const std::span<const Float3> frame = base.positions;
     Image image(options.width, options.height, render::kPanelBackground);
     const char* labels[3] = {"base", "base + map", "sculpt"};
     for (int k = 0; k < panels; ++k) {
       std::optional<Image> panel;
       if (k < 2) {
-        DISPEX_ASSIGN_OR_RETURN(render::ShadedMesh mesh,
-                                Surface(base, surface, &map, k == 1 ? &map : nullptr, options));
+        DISPEX_ASSIGN_OR_RETURN(
+            render::ShadedMesh mesh,
+            Surface(base, surface, &map, k == 1 ? &map : nullptr, use, options));
         DISPEX_ASSIGN_OR_RETURN(panel, Cast(mesh, frame, options, panel_width, panel_height));
       } else {
         const render::ShadedMesh mesh = render::ShadePolygonMesh(*sculpt);

@@ -8,9 +8,11 @@
 // name and share one vertex: position and normal from the lowest-numbered face, displacement
 // averaged over all of them (or, with per-face displacement, one copy of the vertex per face,
 // each displaced by its own face's value, as a renderer that reads each face on its own
-// displaces it). Along a line the points of all its faces are merged, and a cell
-// whose side received points from a finer neighbour becomes a fan around the cell centre, as
-// in the usual crack-free stitching of adaptive tessellations (e.g. Moreton, "Watertight
+// displaces it). A vector map's displacement is a vector in object space, each face's from its
+// own frame and channels at its own (u, v), so the faces around a point average (or keep)
+// vectors as a scalar map's average heights. Along a line the points of all its faces are merged,
+// and a cell whose side received points from a finer neighbour becomes a fan around the cell
+// centre, as in the usual crack-free stitching of adaptive tessellations (e.g. Moreton, "Watertight
 // tessellation using forward differencing", 2001, and OpenSubdiv's Bfr::Tessellation with
 // per-edge rates). Every stage is a flat array filled in parallel in a fixed order, or a
 // sort under a total order, so the mesh does not depend on the thread count.
@@ -240,13 +242,14 @@ class Tessellation {
  public:
   Tessellation(const Mesh& cage, const LimitSurface& surface,
                std::span<const std::array<int, 2>> density, const PtexFile* map, int channel,
-               BoundaryDisplacement boundary)
+               BoundaryDisplacement boundary, std::optional<VectorSpace> space)
       : cage_(cage),
         surface_(surface),
         density_(density),
         map_(map),
         channel_(channel),
         per_face_(boundary == BoundaryDisplacement::kPerFace),
+        space_(map ? space : std::nullopt),
         n_(surface.num_ptex_faces()) {}
 
   StatusOr<ShadedMesh> Run() {
@@ -256,6 +259,7 @@ class Tessellation {
     NumberSharedVertices();
     CountFaceElements();
     DISPEX_RETURN_IF_ERROR(AllocateMesh());
+    if (space_) DISPEX_RETURN_IF_ERROR(RecordVectors());
     DISPEX_RETURN_IF_ERROR(PlaceSharedVertices());
     DISPEX_RETURN_IF_ERROR(FillFaces());
     SmoothNormals();
@@ -264,9 +268,35 @@ class Tessellation {
 
  private:
   struct Scratch {
-    std::vector<float> uv, p, nrm;
+    std::vector<float> uv, p, nrm, du, dv;  // du, dv: of a vector map only
     std::vector<std::int32_t> polygon;
   };
+
+  // Limit points at s.uv, with their frames for a vector map.
+  Status Evaluate(int f, Scratch& s) {
+    const std::size_t count = s.uv.size() / 2;
+    s.p.resize(3 * count);
+    s.nrm.resize(3 * count);
+    if (!space_) return EvaluatorForThread().EvaluatePoints(PtexFaceId(f), s.uv, s.p, s.nrm);
+    s.du.resize(3 * count);
+    s.dv.resize(3 * count);
+    return EvaluatorForThread().EvaluatePointFrames(PtexFaceId(f), s.uv, {s.p, s.nrm, s.du, s.dv});
+  }
+
+  // A vector map's D at point k of s (face f at s.uv[2k], s.uv[2k + 1]), in object space.
+  StatusOr<Float3> MapVector(int f, const Scratch& s, std::size_t k) const {
+    const float u = s.uv[2 * k], v = s.uv[2 * k + 1];
+    const float c[3] = {map_->Sample(PtexFaceId(f), u, v, 0), map_->Sample(PtexFaceId(f), u, v, 1),
+                        map_->Sample(PtexFaceId(f), u, v, 2)};
+    if (!std::isfinite(c[0]) || !std::isfinite(c[1]) || !std::isfinite(c[2])) {
+      return MapValueError(*map_, f);
+    }
+    const std::size_t i = 3 * k;
+    const SurfaceFrame frame{{s.du[i], s.du[i + 1], s.du[i + 2]},
+                             {s.dv[i], s.dv[i + 1], s.dv[i + 2]},
+                             {s.nrm[i], s.nrm[i + 1], s.nrm[i + 2]}};
+    return VectorFromChannels(*space_, frame, c);
+  }
 
   bool Active(int f) const {
     return density_[static_cast<std::size_t>(f)][0] > 0 && !surface_.is_hole(PtexFaceId(f));
@@ -525,6 +555,46 @@ class Tessellation {
     out_.mesh.positions[v] = {s.p[i] + h * s.nrm[i], s.p[i + 1] + h * s.nrm[i + 1],
                               s.p[i + 2] + h * s.nrm[i + 2]};
   }
+  // The same moved by the vector d.
+  void Place(std::size_t v, const Scratch& s, std::size_t k, const Float3& d) {
+    const std::size_t i = 3 * k;
+    limit_normals_[v] = {s.nrm[i], s.nrm[i + 1], s.nrm[i + 2]};
+    out_.mesh.positions[v] = {s.p[i] + d.x, s.p[i + 1] + d.y, s.p[i + 2] + d.z};
+  }
+
+  // 5a. A vector map: every record's D, from its own face's frame and channels at its own
+  // (u, v), the records of a face evaluated together.
+  Status RecordVectors() {
+    const std::size_t faces = static_cast<std::size_t>(n_);
+    std::vector<std::size_t> start(faces + 1, 0), order(records_.size());
+    for (const Record& r : records_) ++start[static_cast<std::size_t>(r.face) + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t r = 0; r < records_.size(); ++r) {
+      order[fill[static_cast<std::size_t>(records_[r].face)]++] = r;
+    }
+    record_vectors_.resize(records_.size());
+    tbb::parallel_for(std::size_t{0}, faces, [&](std::size_t face) {
+      const std::size_t begin = start[face], end = start[face + 1];
+      if (begin == end) return;
+      const int f = static_cast<int>(face);
+      Scratch& s = scratch_.local();
+      s.uv.resize(2 * (end - begin));
+      for (std::size_t k = begin; k < end; ++k) {
+        s.uv[2 * (k - begin)] = records_[order[k]].u;
+        s.uv[2 * (k - begin) + 1] = records_[order[k]].v;
+      }
+      Status st = Evaluate(f, s);
+      if (!st.ok()) return error_.Record(f, st);
+      for (std::size_t k = begin; k < end; ++k) {
+        StatusOr<Float3> d = MapVector(f, s, k - begin);
+        if (!d.ok()) return error_.Record(f, d.status());
+        record_vectors_[order[k]] = *d;
+      }
+    });
+    if (error_.failed()) return error_.status();
+    return Status::Ok();
+  }
 
   // 5. Shared vertices: each point evaluated on its first face, displaced by the mean of all
   // faces, or with per-face displacement each face's copy by that face's own value.
@@ -555,6 +625,24 @@ class Tessellation {
       if (!st.ok()) return error_.Record(f, st);
       for (std::size_t k = begin; k < end; ++k) {
         const auto v = static_cast<std::size_t>(owners[k].second);
+        if (space_) {
+          if (per_face_) {
+            for (std::size_t c = point_copies_[v]; c < point_copies_[v + 1]; ++c) {
+              Place(c, s, k - begin, record_vectors_[copy_records_[c]]);
+            }
+            continue;
+          }
+          double sum[3] = {0, 0, 0};
+          for (std::size_t r = point_records_[v]; r < point_records_[v + 1]; ++r) {
+            const Float3& d = record_vectors_[r];
+            sum[0] += d.x, sum[1] += d.y, sum[2] += d.z;
+          }
+          const double count = double(point_records_[v + 1] - point_records_[v]);
+          Place(v, s, k - begin,
+                Float3{static_cast<float>(sum[0] / count), static_cast<float>(sum[1] / count),
+                       static_cast<float>(sum[2] / count)});
+          continue;
+        }
         if (per_face_) {
           for (std::size_t c = point_copies_[v]; c < point_copies_[v + 1]; ++c) {
             const Record& own = records_[copy_records_[c]];
@@ -622,10 +710,13 @@ class Tessellation {
     DISPEX_CHECK_EQ(first + count,
                     static_cast<std::size_t>(vertex_start_[static_cast<std::size_t>(f) + 1]));
     if (count == 0) return Status::Ok();
-    s.p.resize(3 * count);
-    s.nrm.resize(3 * count);
-    DISPEX_RETURN_IF_ERROR(EvaluatorForThread().EvaluatePoints(PtexFaceId(f), s.uv, s.p, s.nrm));
+    DISPEX_RETURN_IF_ERROR(Evaluate(f, s));
     for (std::size_t k = 0; k < count; ++k) {
+      if (space_) {
+        DISPEX_ASSIGN_OR_RETURN(const Float3 d, MapVector(f, s, k));
+        Place(first + k, s, k, d);
+        continue;
+      }
       float h = 0;
       if (map_) {
         h = map_->Sample(PtexFaceId(f), s.uv[2 * k], s.uv[2 * k + 1], channel_);
@@ -752,8 +843,9 @@ class Tessellation {
   std::span<const std::array<int, 2>> density_;
   const PtexFile* map_;
   int channel_;
-  bool per_face_;  // BoundaryDisplacement::kPerFace
-  int n_;          // Ptex faces
+  bool per_face_;                     // BoundaryDisplacement::kPerFace
+  std::optional<VectorSpace> space_;  // a vector map's
+  int n_;                             // Ptex faces
 
   std::vector<SideEntry> entries_;         // face sides, by line
   std::vector<std::int64_t> entry_of_;     // 4 f + side -> its entry, or -1
@@ -772,6 +864,7 @@ class Tessellation {
   std::vector<std::int64_t> entry_point_offset_;
   std::vector<std::int32_t> entry_point_vertex_;
   std::size_t num_shared_ = 0;  // vertices 0 .. num_shared_ - 1 are the shared points' (copies)
+  std::vector<Float3> record_vectors_;  // a vector map's D per record (RecordVectors)
   std::vector<std::int64_t> vertex_start_, triangle_start_;  // per face, prefix sums
 
   ShadedMesh out_;
@@ -786,8 +879,9 @@ class Tessellation {
 StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface& surface,
                                             std::span<const std::array<int, 2>> density,
                                             const PtexFile* map, int channel,
-                                            BoundaryDisplacement boundary) {
-  return Tessellation(cage, surface, density, map, channel, boundary).Run();
+                                            BoundaryDisplacement boundary,
+                                            std::optional<VectorSpace> vector_space) {
+  return Tessellation(cage, surface, density, map, channel, boundary, vector_space).Run();
 }
 
 ShadedMesh ShadePolygonMesh(const Mesh& mesh) {

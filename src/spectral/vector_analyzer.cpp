@@ -136,8 +136,8 @@ SpectralVectorAnalyzer::SpectralVectorAnalyzer(SpectralVectorAnalyzer&&) noexcep
 SpectralVectorAnalyzer& SpectralVectorAnalyzer::operator=(SpectralVectorAnalyzer&&) noexcept =
     default;
 
-StatusOr<SpectralVectorFace> SpectralVectorAnalyzer::Analyze(std::span<const float> samples,
-                                                             int nx, int ny,
+StatusOr<SpectralVectorFace> SpectralVectorAnalyzer::Analyze(std::span<const float> samples, int nx,
+                                                             int ny,
                                                              const SpectralOptions& options) {
   DISPEX_RETURN_IF_ERROR(ValidateSpectralOptions(options));
   if (options.edge_tolerance > 0 || options.pin_edges) {
@@ -145,9 +145,10 @@ StatusOr<SpectralVectorFace> SpectralVectorAnalyzer::Analyze(std::span<const flo
   }
   DISPEX_ASSIGN_OR_RETURN(const BlockShape shape, spectral::MakeBlockShape(nx, ny));
   if (samples.size() != kChannels * shape.count()) {
-    return Status::Error(fmt::format("samples holds {} values, a {} x {} block of 3 channels "
-                                     "needs {}",
-                                     samples.size(), nx, ny, kChannels * shape.count()));
+    return Status::Error(
+        fmt::format("samples holds {} values, a {} x {} block of 3 channels "
+                    "needs {}",
+                    samples.size(), nx, ny, kChannels * shape.count()));
   }
   Impl& m = *impl_;
   DISPEX_RETURN_IF_ERROR(m.Load(samples, shape));
@@ -215,10 +216,10 @@ StatusOr<SpectralVectorFace> SpectralVectorAnalyzer::Analyze(std::span<const flo
     const int slot_u = (slot + 1) % 3;
     const int slot_v = (slot + 2) % 3;
     constexpr double kNone = std::numeric_limits<double>::infinity();
-    const double error_u = can_u ? m.ResampleAndMeasure(shape, ShapeOfLog2(kx + 1, ky), slot_u)
-                                 : kNone;
-    const double error_v = can_v ? m.ResampleAndMeasure(shape, ShapeOfLog2(kx, ky + 1), slot_v)
-                                 : kNone;
+    const double error_u =
+        can_u ? m.ResampleAndMeasure(shape, ShapeOfLog2(kx + 1, ky), slot_u) : kNone;
+    const double error_v =
+        can_v ? m.ResampleAndMeasure(shape, ShapeOfLog2(kx, ky + 1), slot_v) : kNone;
     if (can_u && error_u <= error_v) {
       ++kx;
       slot = slot_u;

@@ -57,8 +57,11 @@ using subdiv::RefinedCage;
 using Label = std::uint32_t;
 constexpr Label kNoLabel = kNoHalfEdge;
 constexpr int kMaxLevels = 7;
-// Sculpt vertices tried per component as the image of its seed vertex, nearest first.
+// Sculpt vertices tried per component as the image of its seed vertex, nearest first; when no
+// labelling from them holds (vertices moved far across the surface, as a vector sculpt's
+// overhangs do, push the true one down the list), the match is tried again with the wider list.
 constexpr int kCandidates = 8;
+constexpr int kWideCandidates = 128;
 // The position check reads every grid point of grids up to this size, and on larger ones the
 // points on every (n / kCheckedLines)-th row and column (the borders included): on level 6 of
 // a 941-quad cage (3.9M vertices, one core) 23% of the vertices in 0.06 s, where all of them
@@ -105,8 +108,10 @@ struct SeedAttempt {
 
 class Matcher {
  public:
-  Matcher(const LimitSurface& surface, const Mesh& sculpt, const MatchOptions& options)
-      : surface_(surface),
+  Matcher(const LimitSurface& surface, const Mesh& sculpt, const MatchOptions& options,
+          int candidates)
+      : candidates_(candidates),
+        surface_(surface),
         s_(SurfaceImpl(surface)),
         sculpt_(sculpt),
         options_(options),
@@ -414,6 +419,7 @@ class Matcher {
     SeedAttempt attempt;
     for (int p : component.faces) seeds_[p] = kNoLabel;
     for (int w : component.vertices) base_sculpt_[w] = -1;
+    centre_sculpt_.assign(static_cast<std::size_t>(s_.num_base_faces()), -1);
     const auto fail = [&](std::string message) {
       attempt.failure = Status::Error(std::move(message));
       return attempt;
@@ -486,6 +492,26 @@ class Matcher {
       }
     }
     DISPEX_CHECK_EQ(attempt.seeded, component.faces.size());
+    // The far corner (n, n) of every grid: base vertex 2 of a quad, or the centre of an n-gon,
+    // which its n sub-faces share. A labelling that only the (0,0) corners agree with -- a
+    // vector sculpt's overhangs can move vertices so far that one ranks first -- fails here.
+    for (int p : component.faces) {
+      const int n = cage_.grid_size(p);
+      const Label far = Walk(seeds_[p], {0, 0}, {n - 1, n - 1});
+      if (far == kNoLabel) return fail(NoNeighbourMessage(p));
+      const std::int32_t x = VertexAt(far, 2);
+      const int w = cage_.CornerVertex(p, 2);
+      const int base_face = s_.ptex_base[p];
+      const int valence = w >= 0 ? cage_.valence(w) : s_.face_size(base_face);
+      std::int32_t& known = w >= 0 ? base_sculpt_[w] : centre_sculpt_[base_face];
+      if (adjacency_.valence[x] != valence || (known >= 0 && known != x)) {
+        return fail(fmt::format(
+            "{}: face {} does not fit the grid of Ptex face {}: its far corner, vertex {}, is "
+            "not the {} of the refined base",
+            where_, far / 4, p, x, w >= 0 ? fmt::format("base vertex {}", w) : "face centre"));
+      }
+      known = x;
+    }
     attempt.complete = true;
     return attempt;
   }
@@ -532,16 +558,16 @@ class Matcher {
   };
 
   // The sculpt vertices of `vertex_class` in unmatched components of `cells` quads within
-  // the offset limit of base vertex w's limit point, at most kCandidates.
+  // the offset limit of base vertex w's limit point, at most candidates_.
   CandidateList Candidates(int vertex_class, int w, std::uint64_t cells) const {
     using Ranked = std::pair<double, std::uint32_t>;
     struct Found {
       std::vector<Ranked> best;
       Ranked nearest{HUGE_VAL, 0};
     };
-    const auto keep_best = [](std::vector<Ranked>& list) {
+    const auto keep_best = [this](std::vector<Ranked>& list) {
       std::sort(list.begin(), list.end());
-      if (list.size() > kCandidates) list.resize(kCandidates);
+      if (list.size() > static_cast<std::size_t>(candidates_)) list.resize(candidates_);
     };
     tbb::combinable<Found> found;
     const std::uint32_t* begin = class_vertices_.data() + class_offsets_[vertex_class];
@@ -561,7 +587,9 @@ class Matcher {
                           mine.nearest = std::min(mine.nearest, Ranked{d2, x});
                           if (d2 > offset_limit_ * offset_limit_) continue;
                           mine.best.emplace_back(SeedScore(vertex, w), x);
-                          if (mine.best.size() >= 4 * kCandidates) keep_best(mine.best);
+                          if (mine.best.size() >= 4 * static_cast<std::size_t>(candidates_)) {
+                            keep_best(mine.best);
+                          }
                         }
                       });
     std::vector<Ranked> all;
@@ -963,6 +991,7 @@ class Matcher {
   }
 
   bool labelling_ = false;
+  const int candidates_;  // seed candidates per component
   const LimitSurface& surface_;
   const LimitSurface::Impl& s_;
   const Mesh& sculpt_;
@@ -985,6 +1014,7 @@ class Matcher {
   // met there; the walk's queue.
   std::vector<Label> seeds_;
   std::vector<std::int32_t> base_sculpt_;
+  std::vector<std::int32_t> centre_sculpt_;  // per base face: the sculpt vertex at its centre
   std::vector<int> queue_;
   struct {
     Label label = kNoLabel;
@@ -1024,11 +1054,16 @@ StatusOr<SculptCorrespondence> MatchRefinedSculpt(const LimitSurface& surface, c
   arena.execute([&] {
     bool labelling = false;
     {
-      Matcher matcher(surface, sculpt, options);
+      Matcher matcher(surface, sculpt, options, kCandidates);
       result.emplace(matcher.Run());
       labelling = matcher.labelling();
     }
     if (result->ok() || !labelling) return;
+    auto wide = Matcher(surface, sculpt, options, kWideCandidates).Run();
+    if (wide.ok()) {
+      result.emplace(std::move(wide));
+      return;
+    }
     // Flipped normals: say so rather than which quad the labelling stumbled on.
     Mesh reversed;
     reversed.source = sculpt.source;
@@ -1038,7 +1073,7 @@ StatusOr<SculptCorrespondence> MatchRefinedSculpt(const LimitSurface& surface, c
     for (std::size_t f = 0; f < reversed.num_faces(); ++f) {
       std::swap(reversed.face_indices[4 * f + 1], reversed.face_indices[4 * f + 3]);
     }
-    auto mirrored = Matcher(surface, reversed, options).Run();
+    auto mirrored = Matcher(surface, reversed, options, kCandidates).Run();
     if (mirrored.ok()) {
       result.emplace(Status::Error(fmt::format(
           "{}: every face winds the other way from the cage's (flipped normals); reversed, it "

@@ -25,11 +25,11 @@ struct LimitEvaluator::Impl {
     const bool frames = !out.du.empty() || !out.dv.empty();
     if (out.positions.size() < needed || (!out.normals.empty() && out.normals.size() < needed) ||
         (frames && (out.normals.empty() || out.du.size() < needed || out.dv.size() < needed))) {
-      return Status::Error(fmt::format(
-          "{}: Ptex face {}: {} {} floats per output (got {} positions, {} normals, "
-          "{} and {} derivatives; derivatives need normals)",
-          surface.source, face.value, what, needed, out.positions.size(), out.normals.size(),
-          out.du.size(), out.dv.size()));
+      return Status::Error(
+          fmt::format("{}: Ptex face {}: {} {} floats per output (got {} positions, {} normals, "
+                      "{} and {} derivatives; derivatives need normals)",
+                      surface.source, face.value, what, needed, out.positions.size(),
+                      out.normals.size(), out.du.size(), out.dv.size()));
     }
     return Status::Ok();
   }
@@ -88,8 +88,7 @@ Status LimitEvaluator::EvaluateGridFrames(PtexFaceId face, int rx, int ry, Frame
   return Status::Ok();
 }
 
-Status LimitEvaluator::EvaluatePointFrames(PtexFaceId face, std::span<const float> uv,
-                                           Frames out) {
+Status LimitEvaluator::EvaluatePointFrames(PtexFaceId face, std::span<const float> uv, Frames out) {
   if (uv.size() % 2 != 0) {
     return Status::Error(fmt::format("{}: Ptex face {}: {} uv values is not a list of pairs",
                                      impl_->surface.source, face.value, uv.size()));

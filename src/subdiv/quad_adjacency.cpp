@@ -210,7 +210,8 @@ std::vector<std::uint32_t> QuadComponents(const QuadAdjacency& adjacency,
   });
   tbb::parallel_for(Range(0, num_faces, 1 << 14), [&](const Range& r) {
     for (std::size_t f = r.begin(); f < r.end(); ++f) {
-      parent[f] = find(static_cast<std::uint32_t>(f));
+      std::atomic_ref<std::uint32_t>(parent[f]).store(find(static_cast<std::uint32_t>(f)),
+                                                      std::memory_order_relaxed);
     }
   });
   // Roots precede their members, so one pass in order renumbers them.

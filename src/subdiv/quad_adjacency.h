@@ -1,8 +1,9 @@
 // Edge adjacency of an all-quad mesh (a sculpt that may be a refined cage), by half-edges.
 //
 // Half-edge 4 f + k runs from corner k of quad f to corner k + 1 (mod 4); it starts at vertex
-// mesh.face_indices[4 f + k]. Built in parallel from a vertex-bucketed list of half-edges (no
-// map per edge): about 36 bytes per quad at the peak, 16 per quad plus 7 per vertex after.
+// mesh.face_indices[4 f + k]. Built in parallel from the half-edges bucketed by start vertex
+// (no map per edge): about 48 bytes per quad and 4 per vertex at the peak, 16 per quad and 7
+// per vertex after.
 #pragma once
 
 #include <cstdint>

@@ -24,7 +24,7 @@ Vec3d TangentAxis(const Vec3d& du, const Vec3d& n) {
   const Vec3d t = du - n * Dot(du, n);
   const double len = std::sqrt(Dot(t, t));
   if (len > 1e-30 * (1 + std::sqrt(Dot(du, du))) && std::isfinite(len)) return t * (1 / len);
-  const Vec3d axis = std::fabs(n.x) < 0.6 ? Vec3d{1, 0, 0}
+  const Vec3d axis = std::fabs(n.x) < 0.6   ? Vec3d{1, 0, 0}
                      : std::fabs(n.y) < 0.6 ? Vec3d{0, 1, 0}
                                             : Vec3d{0, 0, 1};
   return Normalize(axis - n * Dot(axis, n));
@@ -45,6 +45,22 @@ StatusOr<VectorSpace> ParseVectorSpace(std::string_view name) {
   }
   return Status::Error(
       fmt::format("unknown vector space '{}' (valid: tangent, parametric, object)", name));
+}
+
+std::string_view VectorSpaceFrame(VectorSpace space) {
+  switch (space) {
+    case VectorSpace::kTangent:
+      return "D = c0 T + c1 B + c2 N; T = normalize(dP/du), N = the unit limit normal "
+             "normalize(dP/du x dP/dv), B = N x T; P the Catmull-Clark limit surface, (u, v) "
+             "the Ptex face's own coordinates in [0, 1]";
+    case VectorSpace::kParametric:
+      return "D = c0 dP/du + c1 dP/dv + c2 N; N = the unit limit normal normalize(dP/du x "
+             "dP/dv); P the Catmull-Clark limit surface, (u, v) the Ptex face's own "
+             "coordinates in [0, 1]";
+    case VectorSpace::kObject:
+      break;
+  }
+  return "D = (c0, c1, c2) in the base mesh's object space";
 }
 
 std::string_view VectorSpaceChannels(VectorSpace space) {
@@ -110,6 +126,42 @@ void VectorToChannels(VectorSpace space, const SurfaceFrame& frame, const Float3
       c[2] = d_in.z;
       return;
   }
+}
+
+StatusOr<std::optional<VectorSpace>> DisplacementMapSpace(std::string_view map, int channels,
+                                                          int alpha_channel,
+                                                          const std::string* vector_space,
+                                                          const std::string* channel_names) {
+  if (channels == 1) {
+    if (vector_space != nullptr) {
+      return Status::Error(fmt::format("{}: 1 channel, but {} '{}' (a vector map has 3 channels)",
+                                       map, kVectorSpaceMetaKey, *vector_space));
+    }
+    return std::optional<VectorSpace>();
+  }
+  if (channels != 3) {
+    return Status::Error(
+        fmt::format("{}: {} channels: a displacement map has 1 (scalar) or 3 (vector, with {})",
+                    map, channels, kVectorSpaceMetaKey));
+  }
+  if (vector_space == nullptr) {
+    return Status::Error(
+        fmt::format("{}: 3 channels but no {} meta data: not a vector displacement map", map,
+                    kVectorSpaceMetaKey));
+  }
+  StatusOr<VectorSpace> space = ParseVectorSpace(*vector_space);
+  if (!space.ok())
+    return space.status().WithPrefix(fmt::format("{}: {}", map, kVectorSpaceMetaKey));
+  if (channel_names != nullptr && *channel_names != VectorSpaceChannels(*space)) {
+    return Status::Error(fmt::format("{}: {} '{}' does not match {} '{}' (expected '{}')", map,
+                                     kVectorChannelsMetaKey, *channel_names, kVectorSpaceMetaKey,
+                                     *vector_space, VectorSpaceChannels(*space)));
+  }
+  if (alpha_channel != -1) {
+    return Status::Error(fmt::format("{}: alpha channel {}: a vector displacement map has none",
+                                     map, alpha_channel));
+  }
+  return std::optional<VectorSpace>(*space);
 }
 
 }  // namespace dispex

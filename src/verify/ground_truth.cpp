@@ -11,19 +11,31 @@ namespace dispex {
 
 namespace {
 constexpr char kMagic[8] = {'D', 'I', 'S', 'P', 'E', 'X', 'G', 'T'};
-constexpr std::size_t kHeader = 24, kRecordV1 = 16, kRecordV2 = 20;
+constexpr std::size_t kHeader = 24, kRecordV1 = 16, kRecordV2 = 20, kRecordV3 = 32;
+constexpr std::size_t kRecordSize[4] = {0, kRecordV1, kRecordV2, kRecordV3};
 }  // namespace
 
 Status WriteGroundTruth(const std::string& path, const GroundTruth& truth) {
-  DISPEX_ASSIGN_OR_RETURN(AtomicOutput out, AtomicOutput::Create(path));
   if (!truth.local_error.empty() && truth.local_error.size() != truth.size()) {
     return Status::Error(fmt::format("{}: {} local errors for {} records", path,
                                      truth.local_error.size(), truth.size()));
   }
-  const bool v2 = !truth.local_error.empty();
-  const std::size_t record_size = v2 ? kRecordV2 : kRecordV1;
-  std::uint32_t version = v2 ? 2 : 1, zero = 0;
+  if (!truth.d.empty() && truth.d.size() != 3 * truth.size()) {
+    return Status::Error(fmt::format("{}: {} displacement values for {} records (3 each)", path,
+                                     truth.d.size(), truth.size()));
+  }
+  if (!truth.d.empty() && truth.local_error.empty()) {
+    return Status::Error(path + ": a truth with displacements (version 3) needs local errors");
+  }
+  if (truth.faces.size() != truth.size() || truth.uvs.size() != 2 * truth.size()) {
+    return Status::Error(fmt::format("{}: {} faces and {} uv values for {} records", path,
+                                     truth.faces.size(), truth.uvs.size(), truth.size()));
+  }
+  const std::uint32_t version = static_cast<std::uint32_t>(truth.version()), zero = 0;
+  const bool v2 = version >= 2, v3 = version == 3;
+  const std::size_t record_size = kRecordSize[version];
   std::uint64_t count = truth.size();
+  DISPEX_ASSIGN_OR_RETURN(AtomicOutput out, AtomicOutput::Create(path));
   DISPEX_RETURN_IF_ERROR(out.Write(kMagic, 8));
   DISPEX_RETURN_IF_ERROR(out.Write(&version, 4));
   DISPEX_RETURN_IF_ERROR(out.Write(&zero, 4));
@@ -40,6 +52,7 @@ Status WriteGroundTruth(const std::string& path, const GroundTruth& truth) {
       std::memcpy(p + 4, &truth.uvs[2 * i], 8);
       std::memcpy(p + 12, &truth.h[i], 4);
       if (v2) std::memcpy(p + 16, &truth.local_error[i], 4);
+      if (v3) std::memcpy(p + 20, &truth.d[3 * i], 12);
     }
     DISPEX_RETURN_IF_ERROR(out.Write(buffer.data(), buffer.size()));
   }
@@ -55,10 +68,10 @@ StatusOr<GroundTruth> ReadGroundTruth(const std::string& path) {
   std::uint64_t count = 0;
   std::memcpy(&version, file.data() + 8, 4);
   std::memcpy(&count, file.data() + 16, 8);
-  if (version != 1 && version != 2) {
-    return Status::Error(fmt::format("{}: unsupported version {}", path, version));
+  if (version < 1 || version > 3) {
+    return Status::Error(fmt::format("{}: unsupported version {} (1..3)", path, version));
   }
-  const std::size_t record_size = version == 2 ? kRecordV2 : kRecordV1;
+  const std::size_t record_size = kRecordSize[version];
   if (count > (file.size() - kHeader) / record_size ||
       kHeader + count * record_size != file.size()) {
     return Status::Error(fmt::format("{}: {} records claimed but the file holds {} bytes", path,
@@ -68,7 +81,8 @@ StatusOr<GroundTruth> ReadGroundTruth(const std::string& path) {
   truth.faces.resize(count);
   truth.uvs.resize(2 * count);
   truth.h.resize(count);
-  if (version == 2) truth.local_error.resize(count);
+  if (version >= 2) truth.local_error.resize(count);
+  if (version == 3) truth.d.resize(3 * count);
   const char* p = file.data() + kHeader;
   for (std::size_t i = 0; i < count; ++i, p += record_size) {
     std::int32_t face;
@@ -76,7 +90,8 @@ StatusOr<GroundTruth> ReadGroundTruth(const std::string& path) {
     truth.faces[i] = PtexFaceId(face);
     std::memcpy(&truth.uvs[2 * i], p + 4, 8);
     std::memcpy(&truth.h[i], p + 12, 4);
-    if (version == 2) std::memcpy(&truth.local_error[i], p + 16, 4);
+    if (version >= 2) std::memcpy(&truth.local_error[i], p + 16, 4);
+    if (version == 3) std::memcpy(&truth.d[3 * i], p + 20, 12);
   }
   return truth;
 }

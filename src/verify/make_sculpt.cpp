@@ -1,7 +1,7 @@
 // Ground-truth sculpts: the cage refined uniformly with OpenSubdiv, or a jittered triangulated
-// grid on every Ptex face, every vertex on the limit surface and moved along the limit normal
-// by a known pattern h (pattern_field.h), which is evaluated at each vertex's (Ptex face, u, v)
-// and limit position.
+// grid on every Ptex face, every vertex on the limit surface and moved by a known displacement
+// D (pattern_field.h: h along the limit normal, or a vector pattern), which is evaluated at
+// each vertex's (Ptex face, u, v), limit position and normal.
 #include <fmt/format.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
@@ -329,9 +329,10 @@ StatusOr<SculptQuality> MeasureSculpt(const LimitSurface& surface, const SculptL
           }
           double worst = 0;
           for (int s = 0; s < points; ++s) {
-            double h = pattern(layout.face_ptex[f], uv[2 * s], uv[2 * s + 1], &p[3 * s]);
-            double truth[3] = {p[3 * s] + h * n[3 * s], p[3 * s + 1] + h * n[3 * s + 1],
-                               p[3 * s + 2] + h * n[3 * s + 2]};
+            double disp[3];
+            pattern.Displacement(layout.face_ptex[f], uv[2 * s], uv[2 * s + 1], &p[3 * s],
+                                 &n[3 * s], disp);
+            double truth[3] = {p[3 * s] + disp[0], p[3 * s + 1] + disp[1], p[3 * s + 2] + disp[2]};
             auto distance = [&](const double* q) {
               double dx = q[0] - truth[0], dy = q[1] - truth[1], dz = q[2] - truth[2];
               return std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -368,9 +369,14 @@ StatusOr<SculptQuality> MeasureSculpt(const LimitSurface& surface, const SculptL
         *std::max_element(quality.face_errors.begin(), quality.face_errors.end());
   }
   for (std::uint8_t f : folded) quality.folded_faces += f;
-  // No bound holds near a fold (rays can meet another sheet): infinite local error there.
-  for (std::size_t f = 0; f < faces; ++f) {
-    if (folded[f]) quality.face_errors[f] = std::numeric_limits<float>::infinity();
+  // No bound holds near a fold of a scalar pattern (rays along the normal can meet another
+  // sheet): infinite local error there. The vector patterns' truth is D itself, which a fold
+  // along the normal does not make ambiguous (kOverhang folds by design), so their faces keep
+  // their measured error.
+  if (!pattern.vector()) {
+    for (std::size_t f = 0; f < faces; ++f) {
+      if (folded[f]) quality.face_errors[f] = std::numeric_limits<float>::infinity();
+    }
   }
   return quality;
 }
@@ -471,17 +477,36 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   truth.faces = layout.ptex_faces;
   truth.uvs = layout.uvs;
   truth.h.resize(n);
+  truth.d.resize(3 * n);
+  std::vector<float> tangential(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t v = range.begin(); v < range.end(); ++v) {
                         Float3& p = sculpt.positions[v];
                         const float xyz[3] = {p.x, p.y, p.z};
-                        double h =
-                            pattern(truth.faces[v], truth.uvs[2 * v], truth.uvs[2 * v + 1], xyz);
+                        const float* normal = &layout.normals[3 * v];
+                        // D, and h = D.N (for the scalar patterns the pattern's h itself, D = h N).
+                        const PtexFaceId face = truth.faces[v];
+                        const float u = truth.uvs[2 * v], w = truth.uvs[2 * v + 1];
+                        double d[3], h;
+                        if (pattern.vector()) {
+                          pattern.Displacement(face, u, w, xyz, normal, d);
+                          h = d[0] * normal[0] + d[1] * normal[1] + d[2] * normal[2];
+                        } else {
+                          h = pattern(face, u, w, xyz);
+                          for (int i = 0; i < 3; ++i) d[i] = h * normal[i];
+                        }
+                        double t2 = 0;
+                        for (int i = 0; i < 3; ++i) {
+                          truth.d[3 * v + i] = static_cast<float>(d[i]);
+                          const double t = d[i] - h * normal[i];
+                          t2 += t * t;
+                        }
                         truth.h[v] = static_cast<float>(h);
-                        p.x = static_cast<float>(p.x + h * layout.normals[3 * v]);
-                        p.y = static_cast<float>(p.y + h * layout.normals[3 * v + 1]);
-                        p.z = static_cast<float>(p.z + h * layout.normals[3 * v + 2]);
+                        tangential[v] = static_cast<float>(std::sqrt(t2));
+                        p.x = static_cast<float>(p.x + d[0]);
+                        p.y = static_cast<float>(p.y + d[1]);
+                        p.z = static_cast<float>(p.z + d[2]);
                       }
                     });
   DISPEX_ASSIGN_OR_RETURN(SculptQuality quality, MeasureSculpt(surface, layout, pattern));
@@ -506,10 +531,18 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   report.amplitude = frame.amplitude;
   report.diagonal = frame.diagonal;
   report.edge = frame.edge;
+  report.frame = frame;
   if (n) {
     auto [lo, hi] = std::minmax_element(truth.h.begin(), truth.h.end());
     report.h_min = *lo;
     report.h_max = *hi;
+    report.max_tangential = *std::max_element(tangential.begin(), tangential.end());
+    for (std::size_t v = 0; v < n; ++v) {
+      const float* d = &truth.d[3 * v];
+      report.max_displacement =
+          std::max(report.max_displacement,
+                   std::sqrt(double(d[0]) * d[0] + double(d[1]) * d[1] + double(d[2]) * d[2]));
+    }
   }
   report.linear_error = quality.linear_error;
   report.folded_faces = quality.folded_faces;

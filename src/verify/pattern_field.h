@@ -1,6 +1,7 @@
-// h over the base's limit surface for one MakeSculpt run, in one place for every pattern: the
-// closed-form patterns of the position (EvaluatePattern) and the image pattern of the point's
-// place on the base (Ptex face, u, v) through the cage's UVs (uv_charts.h, height_image.h).
+// h and D over the base's limit surface for one MakeSculpt run, in one place for every pattern:
+// the closed-form patterns of the position (EvaluatePattern, EvaluatePatternVector) and the
+// image pattern of the point's place on the base (Ptex face, u, v) through the cage's UVs
+// (uv_charts.h, height_image.h).
 // make_sculpt.cpp evaluates it at the sculpt's vertices and at its faces' centres.
 #pragma once
 
@@ -22,14 +23,26 @@ class PatternField {
                                        const PatternFrame& frame, const Mesh& cage,
                                        const LimitSurface& surface);
 
-  // h at the limit point `position` of Ptex face `face` at (u, v). Safe from any number of
-  // threads; no allocation.
+  // h at the limit point `position` of Ptex face `face` at (u, v) (D.N for the vector
+  // patterns). Safe from any number of threads; no allocation.
   double operator()(PtexFaceId face, float u, float v, const float position[3]) const {
     if (pattern_ != Pattern::kImage) return EvaluatePattern(pattern_, frame_, position);
     double uv[2];
     charts_->Evaluate(face, u, v, uv);
     return frame_.amplitude * (2 * image_->Sample(uv[0], uv[1]) - 1);
   }
+
+  // D there, the limit normal there being `normal`: h N for the scalar patterns (h exactly as
+  // operator() gives it), the vector patterns' own D.
+  void Displacement(PtexFaceId face, float u, float v, const float position[3],
+                    const float normal[3], double d[3]) const {
+    if (IsVectorPattern(pattern_))
+      return EvaluatePatternVector(pattern_, frame_, position, normal, d);
+    const double h = (*this)(face, u, v, position);
+    for (int i = 0; i < 3; ++i) d[i] = h * normal[i];
+  }
+
+  bool vector() const { return IsVectorPattern(pattern_); }
 
  private:
   Pattern pattern_ = Pattern::kNone;

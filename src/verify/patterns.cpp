@@ -1,6 +1,7 @@
 // Displacement patterns with known values, for ground-truth sculpts. Each but the image is a
-// closed-form function of the position, so the exact displacement at any point is known; the
-// image pattern (pattern_field.cpp) is a closed-form function of the point's place on the base.
+// closed-form function of the position (the vector patterns also of the limit normal), so the
+// exact displacement at any point is known; the image pattern (pattern_field.cpp) is a
+// closed-form function of the point's place on the base.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -63,6 +64,27 @@ const std::array<Wave, 24>& NoiseWaves(std::uint32_t seed, double edge) {
   return waves;
 }
 
+// The vector patterns (include/dispex/verify.h).
+constexpr double kSidewaysAxis1[3] = {0.6, 0.64, 0.48};
+constexpr double kSidewaysAxis2[3] = {-0.48, 0.6, 0.64};
+constexpr double kSidewaysWave2[3] = {0.64, -0.48, 0.6};
+constexpr double kOverhangAxis[3] = {0.8, 0.48, 0.36};
+
+// t(a) = a - (a.n) n.
+void TangentialAxis(const double a[3], const double n[3], double t[3]) {
+  const double an = Dot(a, n);
+  for (int i = 0; i < 3; ++i) t[i] = a[i] - an * n[i];
+}
+
+struct OverhangWave {
+  double k, theta;
+};
+OverhangWave Overhang(const double p[3], const PatternFrame& f) {
+  const double wavelength = std::max(4 * f.amplitude, 16 * f.edge);
+  const double k = kTwoPi / wavelength;
+  return {k, k * Dot(kOverhangAxis, p) + 0.7};
+}
+
 }  // namespace
 
 std::string_view PatternName(Pattern pattern) {
@@ -77,6 +99,10 @@ std::string_view PatternName(Pattern pattern) {
       return "noise";
     case Pattern::kNone:
       return "none";
+    case Pattern::kSideways:
+      return "sideways";
+    case Pattern::kOverhang:
+      return "overhang";
     case Pattern::kImage:
       return "image";
   }
@@ -84,16 +110,21 @@ std::string_view PatternName(Pattern pattern) {
 }
 
 StatusOr<Pattern> ParsePattern(std::string_view name) {
-  for (Pattern p :
-       {Pattern::kSmooth, Pattern::kDetail, Pattern::kRidges, Pattern::kNoise, Pattern::kNone}) {
+  for (Pattern p : {Pattern::kSmooth, Pattern::kDetail, Pattern::kRidges, Pattern::kNoise,
+                    Pattern::kNone, Pattern::kSideways, Pattern::kOverhang}) {
     if (name == PatternName(p)) return p;
   }
   if (name == "image") {
     return Status::Error("pattern 'image' needs a height image: image:FILE.png");
   }
-  return Status::Error(fmt::format(
-      "unknown pattern '{}' (expected smooth, detail, ridges, noise, none or image:FILE.png)",
-      name));
+  return Status::Error(
+      fmt::format("unknown pattern '{}' (expected smooth, detail, ridges, noise, none, sideways, "
+                  "overhang or image:FILE.png)",
+                  name));
+}
+
+bool IsVectorPattern(Pattern pattern) {
+  return pattern == Pattern::kSideways || pattern == Pattern::kOverhang;
 }
 
 StatusOr<PatternArgument> ParsePatternArgument(std::string_view text) {
@@ -152,11 +183,41 @@ double EvaluatePattern(Pattern pattern, const PatternFrame& f, const float point
       return A * h;
     }
     case Pattern::kNone:
+    case Pattern::kSideways:
       return 0;
+    case Pattern::kOverhang:
+      return A * std::sin(Overhang(p, f).theta);
     case Pattern::kImage:
       return std::numeric_limits<double>::quiet_NaN();
   }
   return 0;
+}
+
+void EvaluatePatternVector(Pattern pattern, const PatternFrame& f, const float point[3],
+                           const float normal[3], double d[3]) {
+  const double n[3] = {normal[0], normal[1], normal[2]};
+  if (!IsVectorPattern(pattern)) {
+    const double h = EvaluatePattern(pattern, f, point);
+    for (int i = 0; i < 3; ++i) d[i] = h * n[i];
+    return;
+  }
+  const double p[3] = {double(point[0]) - f.center[0], double(point[1]) - f.center[1],
+                       double(point[2]) - f.center[2]};
+  const double D = f.diagonal, A = f.amplitude;
+  double t1[3], t2[3];
+  if (pattern == Pattern::kSideways) {
+    TangentialAxis(kSidewaysAxis1, n, t1);
+    TangentialAxis(kSidewaysAxis2, n, t2);
+    const double s1 = 0.6 * A * std::sin(kTwoPi * Dot(kSidewaysAxis1, p) / (0.3 * D) + 0.5);
+    const double s2 = 0.4 * A * std::sin(kTwoPi * Dot(kSidewaysWave2, p) / (0.15 * D) + 1.7);
+    for (int i = 0; i < 3; ++i) d[i] = s1 * t1[i] + s2 * t2[i];
+    return;
+  }
+  const OverhangWave w = Overhang(p, f);
+  TangentialAxis(kOverhangAxis, n, t1);
+  // D = A sin(theta) N + (2 / k) sin(theta) t(a): finite (0) at A = 0 too.
+  const double s = std::sin(w.theta);
+  for (int i = 0; i < 3; ++i) d[i] = A * s * n[i] + (2 / w.k) * s * t1[i];
 }
 
 }  // namespace dispex

@@ -1,8 +1,9 @@
 // dispex verify: how far a displacement map is from the sculpt it was made from.
 //
 // The base limit surface displaced by the map (read bilinearly per face, as a renderer reads
-// it) is sampled densely on every Ptex face. Map -> sculpt: each sample's distance to the
-// nearest point of the sculpt. Sculpt -> map: each sculpt vertex's distance to the nearest
+// it: P + h N for a scalar map, P + D for a vector map, D from its channels in the frame at
+// the point) is sampled densely on every Ptex face. Map -> sculpt: each sample's distance to
+// the nearest point of the sculpt. Sculpt -> map: each sculpt vertex's distance to the nearest
 // point of the displaced surface, tessellated on the same grid. Truth: the map against the
 // exact displacement of a generated sculpt at each of its vertices' (face, u, v).
 #include "dispex/verify.h"
@@ -19,14 +20,17 @@
 #include <numeric>
 #include <optional>
 
+#include "core/check.h"
 #include "core/first_error.h"
 #include "core/system.h"
+#include "core/vec3.h"
 #include "dispex/extract.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
 #include "dispex/ptex_sampler.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
+#include "dispex/vector_space.h"
 
 namespace dispex {
 
@@ -51,6 +55,39 @@ ErrorStats Summarise(std::vector<float>& values) {
   return s;
 }
 
+// What the map holds (DisplacementMapSpace): nullopt for a scalar map.
+StatusOr<std::optional<VectorSpace>> MapSpace(const PtexFile& map) {
+  const PtexMetaItem* space = map.FindMetaData(kVectorSpaceMetaKey);
+  const PtexMetaItem* names = map.FindMetaData(kVectorChannelsMetaKey);
+  const std::string space_value = space ? space->AsString() : "";
+  const std::string names_value = names ? names->AsString() : "";
+  return DisplacementMapSpace(map.name(), map.header().num_channels, map.header().alpha_channel,
+                              space ? &space_value : nullptr, names ? &names_value : nullptr);
+}
+
+// A vector map's displacement at (u, v) of a face, in object space, the frame there being
+// `frame` (the per-face bilinear reader, as for scalar maps).
+Float3 MapVector(const PtexFile& map, VectorSpace space, PtexFaceId face, float u, float v,
+                 const SurfaceFrame& frame) {
+  const float c[3] = {map.Sample(face, u, v, 0), map.Sample(face, u, v, 1),
+                      map.Sample(face, u, v, 2)};
+  return VectorFromChannels(space, frame, c);
+}
+
+// Limit points with their frames, 3 floats per point in each array.
+struct FrameScratch {
+  std::vector<float> uv, p, nrm, du, dv;
+  void Resize(std::size_t points) {
+    for (auto* v : {&p, &nrm, &du, &dv}) v->resize(3 * points);
+  }
+  LimitEvaluator::Frames Frames() { return {p, nrm, du, dv}; }
+  SurfaceFrame At(std::size_t j) const {
+    return {{du[3 * j], du[3 * j + 1], du[3 * j + 2]},
+            {dv[3 * j], dv[3 * j + 1], dv[3 * j + 2]},
+            {nrm[3 * j], nrm[3 * j + 1], nrm[3 * j + 2]}};
+  }
+};
+
 struct DisplacedSurface {
   Mesh mesh;                    // (k+1)^2 vertices and k^2 quads per face
   std::vector<Float3> samples;  // k^2 points per face at cell centres
@@ -58,7 +95,8 @@ struct DisplacedSurface {
   std::vector<int> k;  // per face, 0 for holes
 };
 
-StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const PtexFile& map, int fixed_k) {
+StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const PtexFile& map,
+                                    std::optional<VectorSpace> space, int fixed_k) {
   const int n = surface.num_ptex_faces();
   DisplacedSurface d;
   d.k.assign(static_cast<std::size_t>(n), 0);
@@ -84,11 +122,8 @@ StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const PtexFile&
   d.mesh.face_indices.resize(4 * sample_start[n]);
   for (std::size_t q = 0; q <= sample_start[n]; ++q) d.mesh.face_offsets[q] = std::uint32_t(4 * q);
 
-  struct Scratch {
-    std::vector<float> uv, p, nrm;
-  };
   tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
-  tbb::enumerable_thread_specific<Scratch> scratch;
+  tbb::enumerable_thread_specific<FrameScratch> scratch;
   std::mutex mutex;
   Status error;
   tbb::parallel_for(0, n, [&](int f) {
@@ -97,7 +132,7 @@ StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const PtexFile&
     PtexFaceId face(f);
     auto& evaluator = evaluators.local();
     if (!evaluator) evaluator.emplace(surface);
-    Scratch& s = scratch.local();
+    FrameScratch& s = scratch.local();
     // Corner grid (for the mesh) then cell centres (for the samples), in one evaluation.
     const std::size_t corners = std::size_t(k + 1) * (k + 1), centres = std::size_t(k) * k;
     s.uv.resize(2 * (corners + centres));
@@ -114,16 +149,21 @@ StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const PtexFile&
         s.uv[i++] = (float(y) + 0.5f) / float(k);
       }
     }
-    s.p.resize(3 * (corners + centres));
-    s.nrm.resize(s.p.size());
-    Status st = evaluator->EvaluatePoints(face, s.uv, s.p, s.nrm);
+    s.Resize(corners + centres);
+    Status st = space ? evaluator->EvaluatePointFrames(face, s.uv, s.Frames())
+                      : evaluator->EvaluatePoints(face, s.uv, s.p, s.nrm);
     if (!st.ok()) {
       std::lock_guard lock(mutex);
       if (error.ok()) error = st;
       return;
     }
     auto displaced = [&](std::size_t j) {
-      float h = map.Sample(face, s.uv[2 * j], s.uv[2 * j + 1]);
+      const float u = s.uv[2 * j], v = s.uv[2 * j + 1];
+      if (space) {
+        const Float3 m = MapVector(map, *space, face, u, v, s.At(j));
+        return Float3{s.p[3 * j] + m.x, s.p[3 * j + 1] + m.y, s.p[3 * j + 2] + m.z};
+      }
+      float h = map.Sample(face, u, v);
       return Float3{s.p[3 * j] + h * s.nrm[3 * j], s.p[3 * j + 1] + h * s.nrm[3 * j + 1],
                     s.p[3 * j + 2] + h * s.nrm[3 * j + 2]};
     };
@@ -170,6 +210,100 @@ std::vector<float> ClosestDistances(const Tracer& tracer, std::span<const Float3
   return distances;
 }
 
+const char* TruthQuantity(bool vector_map, bool vector_truth) {
+  if (vector_map) return vector_truth ? "|D_map - D|" : "|D_map.N - h|";
+  return vector_truth ? "|map N - D|" : "|map - h|";
+}
+
+// The map against the truth at every record (VerifyReport::truth_quantity).
+struct TruthComparison {
+  std::vector<float> errors;         // the error
+  std::vector<float> signed_errors;  // the signed error of the normal part
+  std::vector<float> map_normal;     // the map's value, or D_map.N
+  std::vector<Float3> map_d;         // with D in the truth: the map's D (map N for a scalar map)
+};
+
+StatusOr<TruthComparison> CompareTruth(const LimitSurface& surface, const PtexFile& map,
+                                       std::optional<VectorSpace> space, const GroundTruth& truth) {
+  const std::size_t n = truth.size();
+  TruthComparison out;
+  out.errors.resize(n);
+  out.signed_errors.resize(n);
+  out.map_normal.resize(n);
+  const bool vector_truth = !truth.d.empty();
+  if (!space && !vector_truth) {  // the map's value against h: no frames needed
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+      float value = map.Sample(truth.faces[i], truth.uvs[2 * i], truth.uvs[2 * i + 1]);
+      out.map_normal[i] = value;
+      out.signed_errors[i] = value - truth.h[i];
+      out.errors[i] = std::abs(out.signed_errors[i]);
+    });
+    return out;
+  }
+  if (vector_truth) out.map_d.resize(n);
+  // The records of each face, evaluated together.
+  const std::size_t faces = static_cast<std::size_t>(surface.num_ptex_faces());
+  std::vector<std::size_t> start(faces + 1, 0), order(n);
+  for (std::size_t i = 0; i < n; ++i) ++start[static_cast<std::size_t>(truth.faces[i].value) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  {
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) {
+      order[fill[static_cast<std::size_t>(truth.faces[i].value)]++] = i;
+    }
+  }
+  tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
+  tbb::enumerable_thread_specific<FrameScratch> scratch;
+  FirstError error;
+  tbb::parallel_for(std::size_t{0}, faces, [&](std::size_t f) {
+    const std::size_t begin = start[f], end = start[f + 1];
+    if (begin == end) return;
+    const PtexFaceId face(static_cast<std::int32_t>(f));
+    auto& evaluator = evaluators.local();
+    if (!evaluator) evaluator.emplace(surface);
+    FrameScratch& s = scratch.local();
+    s.uv.resize(2 * (end - begin));
+    for (std::size_t k = begin; k < end; ++k) {
+      s.uv[2 * (k - begin)] = truth.uvs[2 * order[k]];
+      s.uv[2 * (k - begin) + 1] = truth.uvs[2 * order[k] + 1];
+    }
+    s.Resize(end - begin);
+    Status st = evaluator->EvaluatePointFrames(face, s.uv, s.Frames());
+    if (!st.ok()) return error.Record(static_cast<int>(f), st);
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::size_t i = order[k], j = k - begin;
+      const float u = s.uv[2 * j], v = s.uv[2 * j + 1];
+      const SurfaceFrame frame = s.At(j);
+      const Vec3d normal = ToVec3d(frame.normal);
+      const double h = truth.h[i];
+      const Vec3d d =
+          vector_truth ? Vec3d{truth.d[3 * i], truth.d[3 * i + 1], truth.d[3 * i + 2]} : Vec3d{};
+      double error_value, signed_error, map_normal;
+      Vec3d map_d;
+      if (space) {
+        map_d = ToVec3d(MapVector(map, *space, face, u, v, frame));
+        map_normal = Dot(map_d, normal);
+        signed_error = vector_truth ? Dot(map_d - d, normal) : map_normal - h;
+        error_value = vector_truth ? Length(map_d - d) : std::abs(signed_error);
+      } else {
+        // The normal part from the record's own h, so that a map of a scalar pattern measures
+        // as against a scalar truth; the tangential part of D, which h N lacks, on top.
+        map_normal = map.Sample(face, u, v);
+        map_d = normal * map_normal;
+        signed_error = map_normal - h;
+        const double tangential = Length(d - normal * h);
+        error_value = std::sqrt(signed_error * signed_error + tangential * tangential);
+      }
+      out.errors[i] = static_cast<float>(error_value);
+      out.signed_errors[i] = static_cast<float>(signed_error);
+      out.map_normal[i] = static_cast<float>(map_normal);
+      if (vector_truth) out.map_d[i] = FromVec3d<Float3>(map_d);
+    }
+  });
+  if (error.failed()) return error.status();
+  return out;
+}
+
 void Threshold(VerifyReport& r, const char* what, const ErrorStats& s, double limit,
                const char* option) {
   if (!r.passed || limit <= 0 || s.max <= limit) return;
@@ -195,38 +329,113 @@ std::vector<PtexFaceInfo> MapFacesOnSurface(const LimitSurface& surface, const P
   return faces;
 }
 
-Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFile& map,
-                    const VerifyOptions& options, VerifyReport& r) {
-  const std::vector<PtexFaceInfo> faces = MapFacesOnSurface(surface, map);
-  std::vector<std::vector<float>> texels(faces.size());
-  std::vector<std::uint8_t> holes(faces.size());
+// Per field and face, the level-0 values whose steps at face edges are measured: the map's
+// one channel (one value for a constant face), or a vector map's D in object space as three
+// fields x, y, z. A tangent or parametric map's texels are converted with the frame at their
+// centres (constant faces expanded, as D turns over them); an object map's channels are D.
+Status EdgeFields(const LimitSurface& surface, const PtexFile& map,
+                  std::optional<VectorSpace> space, std::span<const PtexFaceInfo> faces,
+                  std::vector<std::vector<std::vector<float>>>& fields) {
+  const int channels = map.header().num_channels;
+  const bool convert = space && *space != VectorSpace::kObject;
+  fields.assign(space ? 3 : 1, std::vector<std::vector<float>>(faces.size()));
+  tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
+  tbb::enumerable_thread_specific<FrameScratch> scratch;
   FirstError error;
   tbb::parallel_for(std::size_t{0}, faces.size(), [&](std::size_t f) {
     const PtexFaceId face(static_cast<std::int32_t>(f));
-    holes[f] = surface.is_hole(face);
-    const int channels = map.header().num_channels;
-    if (map.BlockInfo(face, 0).encoding == PtexBlockInfo::Encoding::kConstant) {
-      std::vector<float> value(static_cast<std::size_t>(channels));
-      map.ConstantValue(face, value.data());
-      texels[f] = {value[0]};
+    const bool hole = surface.is_hole(face);
+    std::vector<float> all;
+    if ((hole || !convert) &&
+        map.BlockInfo(face, 0).encoding == PtexBlockInfo::Encoding::kConstant) {
+      all.resize(static_cast<std::size_t>(channels));
+      map.ConstantValue(face, all.data());
     } else {
-      std::vector<float> all;
       Status read = map.ReadFace(face, 0, all);
       if (!read.ok()) return error.Record(static_cast<int>(f), read);
-      texels[f].resize(all.size() / static_cast<std::size_t>(channels));
-      for (std::size_t i = 0; i < texels[f].size(); ++i) {
-        texels[f][i] = all[i * static_cast<std::size_t>(channels)];
-      }
     }
-    for (float x : texels[f]) {
+    for (float x : all) {
       if (!std::isfinite(x)) {
         return error.Record(static_cast<int>(f),
                             Status::Error(fmt::format(
                                 "{}: face {} holds a value that is not finite", map.name(), f)));
       }
     }
+    const std::size_t texels = all.size() / static_cast<std::size_t>(channels);
+    for (std::size_t c = 0; c < fields.size(); ++c) fields[c][f].resize(texels);
+    if (convert && !hole) {
+      auto& evaluator = evaluators.local();
+      if (!evaluator) evaluator.emplace(surface);
+      FrameScratch& s = scratch.local();
+      s.Resize(texels);
+      Status st = evaluator->EvaluateGridFrames(face, faces[f].ures(), faces[f].vres(), s.Frames());
+      if (!st.ok()) return error.Record(static_cast<int>(f), st);
+      for (std::size_t i = 0; i < texels; ++i) {
+        const Float3 d = VectorFromChannels(*space, s.At(i), &all[3 * i]);
+        fields[0][f][i] = d.x, fields[1][f][i] = d.y, fields[2][f][i] = d.z;
+      }
+      return;
+    }
+    for (std::size_t c = 0; c < fields.size(); ++c) {
+      for (std::size_t i = 0; i < texels; ++i) {
+        fields[c][f][i] = all[i * static_cast<std::size_t>(channels) + c];
+      }
+    }
   });
-  if (error.failed()) return error.status();
+  return error.failed() ? error.status() : Status::Ok();
+}
+
+// The steps of a vector field from the steps of its three components, which MeasurePtexEdgeSteps
+// measured at the same points (t = j / n on every edge, n = max(16, 2 x the finer side's
+// texels along it)): per point the length of the step vector, per edge its largest and where.
+PtexEdgeSteps CombineSteps(std::span<const PtexFaceInfo> faces, const PtexEdgeSteps (&c)[3]) {
+  PtexEdgeSteps out;
+  out.edges = c[0].edges;
+  out.skipped_edges = c[0].skipped_edges;
+  auto length = [](float x, float y, float z) {
+    return static_cast<float>(std::sqrt(double(x) * x + double(y) * y + double(z) * z));
+  };
+  for (std::size_t i = 0; i < c[0].per_face.size(); ++i) {
+    out.per_face.push_back(length(c[0].per_face[i], c[1].per_face[i], c[2].per_face[i]));
+    out.across_faces.push_back(
+        length(c[0].across_faces[i], c[1].across_faces[i], c[2].across_faces[i]));
+  }
+  auto along = [&](int f, int e) {
+    const PtexFaceInfo& info = faces[static_cast<std::size_t>(f)];
+    return e % 2 == 0 ? info.ures() : info.vres();
+  };
+  std::size_t point = 0;
+  for (const PtexEdgeStep& e : c[0].edge_max) {
+    PtexEdgeSide other;
+    PtexAcrossEdge(faces, PtexFaceId(e.face), e.edge, 0.0, other);
+    const int points =
+        std::max(16, 2 * std::max(along(e.face, e.edge), along(other.face.value, other.edge)));
+    PtexEdgeStep worst{e.face, e.edge, e.neighbour, 0, 0, 0, 0};
+    for (int j = 0; j <= points; ++j, ++point) {
+      DISPEX_CHECK(point < out.per_face.size());
+      const double t = double(j) / points;
+      if (out.per_face[point] > worst.per_face)
+        worst.per_face = out.per_face[point], worst.t_per_face = t;
+      if (out.across_faces[point] > worst.across_faces) {
+        worst.across_faces = out.across_faces[point], worst.t_across_faces = t;
+      }
+    }
+    out.edge_max.push_back(worst);
+  }
+  DISPEX_CHECK_EQ(point, out.per_face.size());
+  return out;
+}
+
+Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFile& map,
+                    std::optional<VectorSpace> space, const VerifyOptions& options,
+                    VerifyReport& r) {
+  const std::vector<PtexFaceInfo> faces = MapFacesOnSurface(surface, map);
+  std::vector<std::vector<std::vector<float>>> fields;
+  DISPEX_RETURN_IF_ERROR(EdgeFields(surface, map, space, faces, fields));
+  std::vector<std::uint8_t> holes(faces.size());
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    holes[f] = surface.is_hole(PtexFaceId(static_cast<std::int32_t>(f)));
+  }
   std::vector<std::uint8_t> skip = holes, discontinuous(faces.size(), 0);
   if (const PtexMetaItem* listed = map.FindMetaData("dispex:discontinuous_faces")) {
     for (std::int32_t f : listed->AsInt32()) {
@@ -240,7 +449,19 @@ Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFil
       skip[static_cast<std::size_t>(f)] = 1;
     }
   }
-  PtexEdgeSteps steps = MeasurePtexEdgeSteps(faces, texels, SharpCreaseEdges(base, surface), skip);
+  const std::vector<std::uint8_t> creases = SharpCreaseEdges(base, surface);
+  PtexEdgeSteps steps;
+  if (fields.size() == 1) {
+    steps = MeasurePtexEdgeSteps(faces, fields[0], creases, skip);
+  } else {
+    PtexEdgeSteps components[3];
+    for (int c = 0; c < 3; ++c) {
+      components[c] =
+          MeasurePtexEdgeSteps(faces, fields[static_cast<std::size_t>(c)], creases, skip);
+    }
+    steps = CombineSteps(faces, components);
+    r.edges_object_space = true;
+  }
   r.measured_edges = true;
   r.discontinuous_edges = CountEdgesTouching(faces, discontinuous, holes);
   r.edges = steps.edges + r.discontinuous_edges;
@@ -325,7 +546,21 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
         "base mesh",
         options.map_path, map.num_faces(), options.base_path, surface.num_ptex_faces()));
   }
-  if (map.header().num_channels < 1) return Status::Error(options.map_path + ": no channels");
+  DISPEX_ASSIGN_OR_RETURN(const std::optional<VectorSpace> space, MapSpace(map));
+  r.map_vector = space.has_value();
+  if (space) {
+    r.map_space = *space;
+    const PtexEdgeFilterMode expected = *space == VectorSpace::kObject
+                                            ? PtexEdgeFilterMode::kNone
+                                            : PtexEdgeFilterMode::kTangentVector;
+    if (map.header().edge_filter != expected) {
+      r.warnings.push_back(fmt::format(
+          "{}: a {} vector map with edge filter mode {} ({} expected): filters across faces "
+          "will not turn its vectors as they should",
+          options.map_path, VectorSpaceName(*space),
+          PtexEdgeFilterModeName(map.header().edge_filter), PtexEdgeFilterModeName(expected)));
+    }
+  }
   if (const PtexMetaItem* stats = map.FindMetaData("dispex:statistics")) {
     auto j = nlohmann::json::parse(stats->AsString(), nullptr, false);
     if (j.is_object()) {
@@ -337,7 +572,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     }
   }
 
-  DISPEX_RETURN_IF_ERROR(MeasureEdges(base, surface, map, options, r));
+  DISPEX_RETURN_IF_ERROR(MeasureEdges(base, surface, map, space, options, r));
 
   if (!options.truth_path.empty()) {
     DISPEX_ASSIGN_OR_RETURN(GroundTruth truth, ReadGroundTruth(options.truth_path));
@@ -349,12 +584,11 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
                                          options.truth_path, i, f, u, v, options.map_path));
       }
     }
-    std::vector<float> errors(truth.size()), signed_errors(truth.size());
-    tbb::parallel_for(std::size_t{0}, truth.size(), [&](std::size_t i) {
-      float value = map.Sample(truth.faces[i], truth.uvs[2 * i], truth.uvs[2 * i + 1]);
-      signed_errors[i] = value - truth.h[i];
-      errors[i] = std::abs(signed_errors[i]);
-    });
+    r.truth_version = truth.version();
+    r.truth_quantity = TruthQuantity(space.has_value(), !truth.d.empty());
+    DISPEX_ASSIGN_OR_RETURN(TruthComparison compared, CompareTruth(surface, map, space, truth));
+    std::vector<float>& errors = compared.errors;
+    const std::vector<float>& signed_errors = compared.signed_errors;
     double sum = 0;
     for (float e : signed_errors) sum += e;
     r.truth_signed_mean = truth.size() ? sum / double(truth.size()) : 0;
@@ -374,9 +608,15 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
         if (ratio > 1) ++r.truth_over_bound;
         if (ratio > r.truth_worst_ratio || !std::isfinite(ratio)) {
           r.truth_worst_ratio = ratio;
-          r.truth_worst = {
-              i,          truth.faces[i].value,          truth.uvs[2 * i],    truth.uvs[2 * i + 1],
-              truth.h[i], truth.h[i] + signed_errors[i], truth.local_error[i]};
+          VerifyReport::TruthRecord& w = r.truth_worst;
+          w = {i,          truth.faces[i].value,   truth.uvs[2 * i],    truth.uvs[2 * i + 1],
+               truth.h[i], compared.map_normal[i], truth.local_error[i]};
+          if (!truth.d.empty()) {
+            w.vector = true;
+            const Float3& m = compared.map_d[i];
+            for (int c = 0; c < 3; ++c) w.d[c] = truth.d[3 * i + static_cast<std::size_t>(c)];
+            w.map_d[0] = m.x, w.map_d[1] = m.y, w.map_d[2] = m.z;
+          }
         }
       }
     }
@@ -394,7 +634,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   if (!options.sculpt_path.empty()) {
     DISPEX_ASSIGN_OR_RETURN(Mesh sculpt, ReadMesh(options.sculpt_path));
     DISPEX_ASSIGN_OR_RETURN(DisplacedSurface displaced,
-                            Displace(surface, map, options.samples_per_face));
+                            Displace(surface, map, space, options.samples_per_face));
     r.samples_per_face_min = 1 << 30;
     for (int k : displaced.k) {
       if (k == 0) continue;
@@ -446,22 +686,28 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   if (r.measured_truth && r.truth_over_bound > 0) {
     const auto& w = r.truth_worst;
     r.passed = false;
+    const std::string values =
+        w.vector ? fmt::format("map D ({:.4g}, {:.4g}, {:.4g}), D ({:.4g}, {:.4g}, {:.4g})",
+                               w.map_d[0], w.map_d[1], w.map_d[2], w.d[0], w.d[1], w.d[2])
+                 : fmt::format("map {:.6g}, h {:.6g}", w.map, w.h);
     r.failure = fmt::format(
-        "truth: {} of {} records exceed {} x tolerance + 2 x local linear error (worst {:.3g} "
-        "x, record {}: face {} at ({:.4g}, {:.4g}), map {:.6g}, h {:.6g}, bound {:.4g})",
-        r.truth_over_bound, r.truth.count, r.truth_local_tolerance_factor, r.truth_worst_ratio,
-        w.index, w.face, w.u, w.v, w.map, w.h,
+        "truth: {} of {} records exceed {} x tolerance + 2 x local linear error in {} (worst "
+        "{:.3g} x, record {}: face {} at ({:.4g}, {:.4g}), {}, bound {:.4g})",
+        r.truth_over_bound, r.truth.count, r.truth_local_tolerance_factor, r.truth_quantity,
+        r.truth_worst_ratio, w.index, w.face, w.u, w.v, values,
         r.truth_local_tolerance_factor * r.truth_tolerance + 2.0 * w.local_error);
   }
   if (r.measured_truth && r.passed && r.truth_rms_limit > 0 && r.truth.rms > r.truth_rms_limit) {
     r.passed = false;
-    r.failure = fmt::format("truth RMS error {:.4g} exceeds truth_rms_factor {} x tolerance {:.4g}",
-                            r.truth.rms, options.truth_rms_factor, r.truth_tolerance);
+    r.failure =
+        fmt::format("truth RMS error {:.4g} ({}) exceeds truth_rms_factor {} x tolerance {:.4g}",
+                    r.truth.rms, r.truth_quantity, options.truth_rms_factor, r.truth_tolerance);
   }
   if (r.measured_truth && r.passed && r.truth_p99_limit > 0 && r.truth.p99 > r.truth_p99_limit) {
     r.passed = false;
-    r.failure = fmt::format("truth p99 error {:.4g} exceeds truth_p99_factor {} x tolerance {:.4g}",
-                            r.truth.p99, options.truth_p99_factor, r.truth_tolerance);
+    r.failure =
+        fmt::format("truth p99 error {:.4g} ({}) exceeds truth_p99_factor {} x tolerance {:.4g}",
+                    r.truth.p99, r.truth_quantity, options.truth_p99_factor, r.truth_tolerance);
   }
   if (r.measured_truth) Threshold(r, "truth", r.truth, limit_abs, option);
   if (r.measured_distances) {
@@ -501,6 +747,8 @@ std::string VerifyReportJson(const VerifyReport& r) {
   nlohmann::json j;
   j["diagonal"] = r.diagonal;
   j["ptex_faces"] = r.ptex_faces;
+  j["map_kind"] = r.map_vector ? "vector" : "scalar";
+  if (r.map_vector) j["vector_space"] = VectorSpaceName(r.map_space);
   if (r.measured_distances) {
     j["samples_per_face"] = {r.samples_per_face_min, r.samples_per_face_max};
     j["map_to_sculpt"] = StatsJson(r.map_to_sculpt, r.diagonal);
@@ -511,6 +759,8 @@ std::string VerifyReportJson(const VerifyReport& r) {
   }
   if (r.measured_truth) {
     j["truth"] = StatsJson(r.truth, r.diagonal);
+    j["truth"]["version"] = r.truth_version;
+    j["truth"]["quantity"] = r.truth_quantity;
     j["truth"]["signed_mean"] = r.truth_signed_mean;
     nlohmann::json bound = {{"tolerance", r.truth_tolerance},
                             {"rms_limit", r.truth_rms_limit},
@@ -529,6 +779,10 @@ std::string VerifyReportJson(const VerifyReport& r) {
                                {"h", w.h},
                                {"map", w.map},
                                {"local_error", w.local_error}};
+      if (w.vector) {
+        bound["worst_record"]["d"] = {w.d[0], w.d[1], w.d[2]};
+        bound["worst_record"]["map_d"] = {w.map_d[0], w.map_d[1], w.map_d[2]};
+      }
     }
     j["truth"]["bound"] = bound;
   }
@@ -550,7 +804,8 @@ std::string VerifyReportJson(const VerifyReport& r) {
                        {"step", w.step},
                        {"reader", w.reader}});
     }
-    j["edges"] = {{"shared", r.edges},
+    j["edges"] = {{"object_space", r.edges_object_space},
+                  {"shared", r.edges},
                   {"sharp_creases", r.crease_edges},
                   {"discontinuous", r.discontinuous_edges},
                   {"tolerance", r.edge_tolerance},
@@ -572,8 +827,10 @@ std::string VerifyReportJson(const VerifyReport& r) {
 }
 
 std::string VerifyReportSummary(const VerifyReport& r) {
-  std::string out = fmt::format("verify: {} Ptex faces, bounding-box diagonal {:.4g}\n",
-                                r.ptex_faces, r.diagonal);
+  std::string out = fmt::format(
+      "verify: {} Ptex faces, bounding-box diagonal {:.4g}, {}\n", r.ptex_faces, r.diagonal,
+      r.map_vector ? fmt::format("vector map ({} space: P + D)", VectorSpaceName(r.map_space))
+                   : std::string("scalar map (P + h N)"));
   if (r.measured_distances) {
     out += StatsLine("map->sculpt", r.map_to_sculpt, r.diagonal);
     out += StatsLine("sculpt->map", r.sculpt_to_map, r.diagonal);
@@ -585,6 +842,7 @@ std::string VerifyReportSummary(const VerifyReport& r) {
   }
   if (r.measured_truth) {
     out += StatsLine("truth", r.truth, r.diagonal);
+    out += fmt::format("  truth (version {}) measured as {}\n", r.truth_version, r.truth_quantity);
     if (r.truth_local_checked) {
       out += fmt::format(
           "  truth bound {} x tolerance {:.4g} + 2 x local linear error: {} of {} records "
@@ -607,8 +865,9 @@ std::string VerifyReportSummary(const VerifyReport& r) {
       return fmt::format("  {:<12} p99 {:.4g}  max {:.4g}{}\n", what, s.p99, s.max, tolerances);
     };
     out += fmt::format(
-        "  edge steps on {} shared edges ({} points; not measured: {} on sharp "
+        "  edge steps{} on {} shared edges ({} points; not measured: {} on sharp "
         "creases, {} beside faces the map lists as discontinuous):\n",
+        r.edges_object_space ? " of |D| in object space" : "",
         r.edges - r.crease_edges - r.discontinuous_edges, r.edge_per_face.count, r.crease_edges,
         r.discontinuous_edges);
     out += line("per-face", r.edge_per_face);

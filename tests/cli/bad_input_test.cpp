@@ -216,6 +216,35 @@ TEST_F(BadInput, MatchRefusesWithTheReasonAndAcceptsTheRefinedBase) {
   EXPECT_NE(text.find("\"levels\": 2"), std::string::npos) << text;
 }
 
+// Vector maps through the command line: a bad space, a sculpt that is not the base refined,
+// then a map from the command line and one from a manifest's per-shape options.
+TEST_F(BadInput, VectorMaps) {
+  const std::string spot = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
+  ExpectFailure(Extract(cage_, sculpt_, "--vector world"),
+                "--vector: unknown vector space 'world' (valid: tangent, parametric, object)", 2);
+  ExpectFailure(Extract(spot, sculpt_, "--vector object"),
+                "vector displacement reads the sculpt through its correspondence with the base, "
+                "and there is none");
+  auto r = RunDispex(Extract(cage_, sculpt_, "--vector tangent"), dir_);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("vector (tangent): the sculpt is the base refined 2 times"),
+            std::string::npos)
+      << r.err;
+  auto map = PtexFile::Open(dir_ / "out.ptx");
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  EXPECT_EQ(map->header().num_channels, 3);
+  Write("asset.json", "{\"shapes\": [{\"name\": \"cube\", \"base\": \"" + cage_ +
+                          "\", \"sculpt\": \"" + sculpt_ +
+                          "\", \"options\": {\"vector\": \"object\"}}]}");
+  r = RunDispex("extract --manifest " + (dir_ / "asset.json") + " --out-dir " + (dir_ / "maps"),
+                dir_);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  auto shape = PtexFile::Open(dir_ / "maps/cube.ptx");
+  ASSERT_TRUE(shape.ok()) << shape.status().message();
+  ASSERT_NE(shape->FindMetaData("dispex:vector_space"), nullptr);
+  EXPECT_EQ(shape->FindMetaData("dispex:vector_space")->AsString(), "object");
+}
+
 // Assets of several shapes through the command line: the errors, and a run that works.
 TEST_F(BadInput, ShapesOptionsAndNames) {
   // Two shapes of the same cage in one base; the sculpt names one of them in other letter case.

@@ -16,6 +16,7 @@
 #include "../extract/e2e_support.h"
 #include "dispex/ptex.h"
 #include "dispex/render.h"
+#include "dispex/vector_space.h"
 
 namespace dispex::render_test {
 
@@ -65,6 +66,37 @@ inline void WriteMap(const std::string& path, int faces, int log2,
     for (int j = 0; j < res; ++j) {
       for (int i = 0; i < res; ++i) {
         texels[static_cast<std::size_t>(j) * res + i] = value(f, (i + 0.5) / res, (j + 0.5) / res);
+      }
+    }
+    PtexFaceInfo info;
+    info.ulog2 = info.vlog2 = static_cast<std::int8_t>(log2);
+    Status st = writer->SetFace(PtexFaceId(f), info, texels);
+    ASSERT_TRUE(st.ok()) << st.message();
+  }
+  Status st = writer->Finish();
+  ASSERT_TRUE(st.ok()) << st.message();
+}
+
+// Writes a 3-channel float vector map in `space` (dispex:vector_space, dispex:channels, the
+// space's edge filter mode) with `faces` faces of 2^log2 x 2^log2 texels, texel (i, j) of face
+// f holding the channels value(f, u, v, c) at its centre, c = 0, 1, 2.
+inline void WriteVectorMap(const std::string& path, VectorSpace space, int faces, int log2,
+                           const std::function<void(int, double, double, float*)>& value) {
+  PtexWriterOptions options;
+  options.num_channels = 3;
+  if (space != VectorSpace::kObject) options.edge_filter = PtexEdgeFilterMode::kTangentVector;
+  auto writer = PtexWriter::Create(path, options, faces);
+  ASSERT_TRUE(writer.ok()) << writer.status().message();
+  ASSERT_TRUE(writer->AddMetaData(std::string(kVectorSpaceMetaKey), VectorSpaceName(space)).ok());
+  ASSERT_TRUE(
+      writer->AddMetaData(std::string(kVectorChannelsMetaKey), VectorSpaceChannels(space)).ok());
+  const int res = 1 << log2;
+  std::vector<float> texels(3 * static_cast<std::size_t>(res) * res);
+  for (int f = 0; f < faces; ++f) {
+    for (int j = 0; j < res; ++j) {
+      for (int i = 0; i < res; ++i) {
+        value(f, (i + 0.5) / res, (j + 0.5) / res,
+              &texels[3 * (static_cast<std::size_t>(j) * res + i)]);
       }
     }
     PtexFaceInfo info;

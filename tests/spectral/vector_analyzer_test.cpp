@@ -51,9 +51,9 @@ double VectorReadBackError(const SpectralVectorFace& face, const std::vector<flo
   std::vector<double> d2(static_cast<std::size_t>(nx) * ny, 0.0);
   for (int c = 0; c < 3; ++c) {
     std::vector<float> read(d2.size());
-    EXPECT_TRUE(spectral::BilinearReadBack(Channel(face.texels, c), face.ulog2, face.vlog2, nx,
-                                           ny, read)
-                    .ok());
+    EXPECT_TRUE(
+        spectral::BilinearReadBack(Channel(face.texels, c), face.ulog2, face.vlog2, nx, ny, read)
+            .ok());
     for (std::size_t k = 0; k < d2.size(); ++k) {
       const double d = static_cast<double>(read[k]) - samples[3 * k + static_cast<std::size_t>(c)];
       d2[k] += d * d;
@@ -72,8 +72,8 @@ TEST(VectorAnalyzerTest, OneLiveChannelIsThatChannelsAnalysis) {
   const SpectralFace expected = scalar.Analyze(live, 64, 32, Bound(1e-3)).value();
   const std::vector<float> want(expected.texels.begin(), expected.texels.end());
   for (int c = 0; c < 3; ++c) {
-    const std::vector<float> block = Interleave(c == 0 ? live : zero, c == 1 ? live : zero,
-                                                c == 2 ? live : zero);
+    const std::vector<float> block =
+        Interleave(c == 0 ? live : zero, c == 1 ? live : zero, c == 2 ? live : zero);
     SpectralVectorAnalyzer vector;
     const SpectralVectorFace face = vector.Analyze(block, 64, 32, Bound(1e-3)).value();
     EXPECT_EQ(face.ulog2, expected.ulog2) << c;

@@ -62,9 +62,10 @@ TEST_P(RealCageTest, MatchesPatchTable) {
 }
 
 // EvaluatePointFrames' derivatives are dP/du and dP/dv in the Ptex face's own (u,v): central
-// differences of the positions agree to 3% (float positions, step 1/512) on every path (regular fast path, Bfr, Far patch
-// table) and every kind of face -- the check that rejects OpenSubdiv's sub-face derivatives,
-// twice the Ptex sub-face's on n-gons. The grid path gives the same frames as the point path.
+// differences of the positions agree to 3% (float positions, step 1/512) on every path (regular
+// fast path, Bfr, Far patch table) and every kind of face -- the check that rejects OpenSubdiv's
+// sub-face derivatives, twice the Ptex sub-face's on n-gons. The grid path gives the same frames as
+// the point path.
 TEST_P(RealCageTest, DerivativesAreThePtexFacesOwn) {
   const Mesh mesh = ReadOrDie(GetParam().path);
   StatusOr<LimitSurface> s = LimitSurface::Build(mesh);

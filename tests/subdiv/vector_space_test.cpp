@@ -1,10 +1,10 @@
 // Vector displacement frames: the definitions of include/dispex/vector_space.h on a skewed
 // frame, the round trip channels -> D -> channels, and the names.
+#include "dispex/vector_space.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "dispex/vector_space.h"
 
 namespace dispex {
 namespace {
@@ -51,7 +51,8 @@ TEST(VectorSpaceTest, Definitions) {
 TEST(VectorSpaceTest, RoundTrip) {
   const SurfaceFrame f = Skewed();
   const Float3 d = {0.25f, -1.5f, 0.75f};
-  for (VectorSpace space : {VectorSpace::kTangent, VectorSpace::kParametric, VectorSpace::kObject}) {
+  for (VectorSpace space :
+       {VectorSpace::kTangent, VectorSpace::kParametric, VectorSpace::kObject}) {
     float c[3];
     VectorToChannels(space, f, d, c);
     const Float3 back = VectorFromChannels(space, f, c);
@@ -84,6 +85,43 @@ TEST(VectorSpaceTest, Names) {
   EXPECT_EQ(ParseVectorSpace("object").value(), VectorSpace::kObject);
   EXPECT_EQ(ParseVectorSpace("world").status().message(),
             "unknown vector space 'world' (valid: tangent, parametric, object)");
+}
+
+// What a map holds, from its channels and meta data: each rule of DisplacementMapSpace, with
+// the one-line message naming the map. Rejects a reader that takes a 3-channel map without
+// dispex:vector_space for a vector map (or its channel 0 for a scalar map), that ignores
+// dispex:channels or an alpha channel, or that accepts other channel counts.
+TEST(VectorSpaceTest, DisplacementMapSpace) {
+  const std::string tangent = "tangent", object = "object", names = "T,B,N", bad = "x,y,z";
+  auto scalar = DisplacementMapSpace("m.ptx", 1, -1, nullptr, nullptr);
+  ASSERT_TRUE(scalar.ok());
+  EXPECT_FALSE(scalar->has_value());
+  auto vector = DisplacementMapSpace("m.ptx", 3, -1, &tangent, &names);
+  ASSERT_TRUE(vector.ok());
+  EXPECT_EQ(**vector, VectorSpace::kTangent);
+  auto unnamed = DisplacementMapSpace("m.ptx", 3, -1, &object, nullptr);  // names optional
+  ASSERT_TRUE(unnamed.ok());
+  EXPECT_EQ(**unnamed, VectorSpace::kObject);
+  EXPECT_EQ(DisplacementMapSpace("m.ptx", 3, -1, nullptr, nullptr).status().message(),
+            "m.ptx: 3 channels but no dispex:vector_space meta data: not a vector displacement "
+            "map");
+  EXPECT_EQ(DisplacementMapSpace("m.ptx", 2, -1, nullptr, nullptr).status().message(),
+            "m.ptx: 2 channels: a displacement map has 1 (scalar) or 3 (vector, with "
+            "dispex:vector_space)");
+  EXPECT_EQ(DisplacementMapSpace("m.ptx", 4, -1, &tangent, nullptr).status().message(),
+            "m.ptx: 4 channels: a displacement map has 1 (scalar) or 3 (vector, with "
+            "dispex:vector_space)");
+  const std::string world = "world";
+  EXPECT_EQ(DisplacementMapSpace("m.ptx", 3, -1, &world, nullptr).status().message(),
+            "m.ptx: dispex:vector_space: unknown vector space 'world' (valid: tangent, "
+            "parametric, object)");
+  EXPECT_EQ(DisplacementMapSpace("m.ptx", 3, -1, &tangent, &bad).status().message(),
+            "m.ptx: dispex:channels 'x,y,z' does not match dispex:vector_space 'tangent' "
+            "(expected 'T,B,N')");
+  EXPECT_EQ(DisplacementMapSpace("m.ptx", 3, 2, &tangent, &names).status().message(),
+            "m.ptx: alpha channel 2: a vector displacement map has none");
+  EXPECT_EQ(DisplacementMapSpace("m.ptx", 1, -1, &tangent, nullptr).status().message(),
+            "m.ptx: 1 channel, but dispex:vector_space 'tangent' (a vector map has 3 channels)");
 }
 
 }  // namespace

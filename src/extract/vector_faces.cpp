@@ -1,0 +1,283 @@
+#include "extract/vector_faces.h"
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "core/progress.h"
+#include "core/vec3.h"
+#include "dispex/cancel.h"
+#include "dispex/correspondence.h"
+#include "dispex/spectral.h"
+#include "dispex/vector_space.h"
+#include "extract/extract_meta.h"
+#include "extract/extract_settings.h"
+#include "extract/parallel_errors.h"
+
+namespace dispex::extract {
+
+namespace {
+
+// What one face contributes to the report.
+struct VectorFaceStats {
+  std::int64_t samples = 0;
+  float normal_min = 0, normal_max = 0;  // D . N
+  double tangential_max = 0;             // |D - (D . N) N|
+  double length_max = 0;                 // |D|
+  double sum_squares = 0;                // of |D|
+  SpectralFaceStats spectral;
+  std::int8_t ulog2 = 0, vlog2 = 0;
+};
+
+struct VectorScratch {
+  explicit VectorScratch(const LimitSurface& surface) : evaluator(surface) {}
+  LimitEvaluator evaluator;
+  SpectralVectorAnalyzer analyzer;
+  std::vector<float> positions, normals, du, dv, channels, texels;
+  double cpu_limit = 0, cpu_spectral = 0, cpu_write = 0;
+};
+
+PtexFaceInfo FaceInfo(const ExtractInputs& inputs, PtexFaceId face, int ulog2, int vlog2) {
+  PtexFaceInfo info = inputs.faces[static_cast<std::size_t>(face.value)];
+  info.ulog2 = static_cast<std::int8_t>(ulog2);
+  info.vlog2 = static_cast<std::int8_t>(vlog2);
+  return info;
+}
+
+// D at the face's n x n texel centres, in the map's space, into w.channels.
+Status SampleFace(PtexFaceId face, int n, VectorSpace space, const ExtractInputs& inputs,
+                  const SculptCorrespondence& correspondence, VectorScratch& w,
+                  VectorFaceStats& stats) {
+  const std::size_t count = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+  for (auto* buffer : {&w.positions, &w.normals, &w.du, &w.dv, &w.channels}) {
+    buffer->resize(3 * count);
+  }
+  DISPEX_RETURN_IF_ERROR(
+      w.evaluator.EvaluateGridFrames(face, n, n, {w.positions, w.normals, w.du, w.dv}));
+  stats.samples = static_cast<std::int64_t>(count);
+  stats.normal_min = std::numeric_limits<float>::infinity();
+  stats.normal_max = -std::numeric_limits<float>::infinity();
+  for (int j = 0; j < n; ++j) {
+    const float v = (static_cast<float>(j) + 0.5f) / static_cast<float>(n);
+    for (int i = 0; i < n; ++i) {
+      const float u = (static_cast<float>(i) + 0.5f) / static_cast<float>(n);
+      const std::size_t k = 3 * (static_cast<std::size_t>(j) * n + i);
+      const Float3 sculpt = SculptPointAt(correspondence, inputs.sculpt, face, u, v);
+      const Float3 limit{w.positions[k], w.positions[k + 1], w.positions[k + 2]};
+      const SurfaceFrame frame{{w.du[k], w.du[k + 1], w.du[k + 2]},
+                               {w.dv[k], w.dv[k + 1], w.dv[k + 2]},
+                               {w.normals[k], w.normals[k + 1], w.normals[k + 2]}};
+      const Vec3d d = ToVec3d(sculpt) - ToVec3d(limit);
+      VectorToChannels(space, frame, FromVec3d<Float3>(d), &w.channels[k]);
+      const double along = Dot(d, ToVec3d(frame.normal));
+      const double length2 = Dot(d, d);
+      stats.normal_min = std::min(stats.normal_min, static_cast<float>(along));
+      stats.normal_max = std::max(stats.normal_max, static_cast<float>(along));
+      stats.tangential_max =
+          std::max(stats.tangential_max, std::sqrt(std::max(0.0, length2 - along * along)));
+      stats.length_max = std::max(stats.length_max, std::sqrt(length2));
+      stats.sum_squares += length2;
+    }
+  }
+  return Status::Ok();
+}
+
+// Parametric channels (a, b, n) are not lengths: D = a dP/du + b dP/dv + n N. With s the largest
+// |dP/du|, |dP/dv| over the face's samples and N orthogonal to both,
+// |dD|^2 <= 2 s^2 (da^2 + db^2) + dn^2, so the analyzer's vector norm over (k a, k b, n) with
+// k >= sqrt(2) s bounds the object-space error. k is a power of two, so scaling is exact.
+float ParametricScale(const VectorScratch& w) {
+  double s2 = 0;
+  for (std::size_t k = 0; k + 2 < w.du.size(); k += 3) {
+    s2 = std::max({s2, static_cast<double>(w.du[k]) * w.du[k] + w.du[k + 1] * w.du[k + 1] +
+                           w.du[k + 2] * w.du[k + 2],
+                   static_cast<double>(w.dv[k]) * w.dv[k] + w.dv[k + 1] * w.dv[k + 1] +
+                       w.dv[k + 2] * w.dv[k + 2]});
+  }
+  const double k = std::sqrt(2 * s2);
+  if (!(k > 0) || !std::isfinite(k)) return 1.0f;
+  return std::ldexp(1.0f, std::clamp(static_cast<int>(std::ceil(std::log2(k))), -60, 60));
+}
+
+// Multiplies the first two of every three channels by `scale`.
+void ScaleTangentChannels(std::span<float> channels, float scale) {
+  if (scale == 1.0f) return;
+  for (std::size_t k = 0; k + 2 < channels.size(); k += 3) {
+    channels[k] *= scale;
+    channels[k + 1] *= scale;
+  }
+}
+
+Status ProcessVectorFace(PtexFaceId face, VectorSpace space, const ExtractInputs& inputs,
+                         const ExtractSettings& settings,
+                         const SculptCorrespondence& correspondence, PtexWriter& writer,
+                         VectorScratch& w, VectorFaceStats& stats) {
+  if (inputs.surface.is_hole(face)) {
+    const float zero[3] = {0, 0, 0};
+    return writer.SetConstantFace(face, FaceInfo(inputs, face, 0, 0), zero);
+  }
+  const int n = 1 << settings.plan.log2[static_cast<std::size_t>(face.value)];
+  ThreadCpuStopwatch limit_clock;
+  DISPEX_RETURN_IF_ERROR(SampleFace(face, n, space, inputs, correspondence, w, stats));
+  w.cpu_limit += limit_clock.seconds();
+  ThreadCpuStopwatch spectral_clock;
+  const float scale = space == VectorSpace::kParametric ? ParametricScale(w) : 1.0f;
+  ScaleTangentChannels(w.channels, scale);
+  auto analysed = w.analyzer.Analyze(w.channels, n, n, settings.spectral);
+  if (!analysed.ok()) {
+    return Status::Error(fmt::format("{}: Ptex face {}: {}", inputs.sculpt.source, face.value,
+                                     analysed.status().message()));
+  }
+  w.cpu_spectral += spectral_clock.seconds();
+  std::span<const float> texels = analysed->texels;
+  if (scale != 1.0f) {
+    w.texels.assign(texels.begin(), texels.end());
+    ScaleTangentChannels(w.texels, 1.0f / scale);
+    ScaleTangentChannels(analysed->constant_value, 1.0f / scale);
+    texels = w.texels;
+  }
+  stats.spectral = analysed->stats;
+  stats.ulog2 = static_cast<std::int8_t>(analysed->ulog2);
+  stats.vlog2 = static_cast<std::int8_t>(analysed->vlog2);
+  ThreadCpuStopwatch write_clock;
+  const PtexFaceInfo info = FaceInfo(inputs, face, analysed->ulog2, analysed->vlog2);
+  Status written = analysed->constant
+                       ? writer.SetConstantFace(face, info, analysed->constant_value)
+                       : writer.SetFace(face, info, texels);
+  w.cpu_write += write_clock.seconds();
+  return written;
+}
+
+Status ProcessVectorFaces(const ExtractOptions& options, const ExtractInputs& inputs,
+                          const ExtractSettings& settings,
+                          const SculptCorrespondence& correspondence, PtexWriter& writer,
+                          std::vector<VectorFaceStats>& stats, ExtractReport& report) {
+  const VectorSpace space = *options.vector;
+  const int num_faces = inputs.surface.num_ptex_faces();
+  stats.assign(static_cast<std::size_t>(num_faces), {});
+  tbb::enumerable_thread_specific<VectorScratch> scratches(
+      [&] { return VectorScratch(inputs.surface); });
+  Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", options.progress);
+  FirstError error;
+  tbb::parallel_for(tbb::blocked_range<int>(0, num_faces, 1),
+                    [&](const tbb::blocked_range<int>& range) {
+                      VectorScratch& w = scratches.local();
+                      for (int f = range.begin(); f != range.end(); ++f) {
+                        if (error.failed()) return;
+                        if (CancelRequested()) return error.Record(-1, Cancelled());
+                        Status s = ProcessVectorFace(PtexFaceId(f), space, inputs, settings,
+                                                     correspondence, writer, w,
+                                                     stats[static_cast<std::size_t>(f)]);
+                        if (!s.ok()) return error.Record(f, s);
+                        bar.Advance();
+                      }
+                    });
+  bar.Finish();
+  if (error.failed()) return error.status();
+  for (const VectorScratch& w : scratches) {
+    report.cpu_limit += w.cpu_limit;
+    report.cpu_spectral += w.cpu_spectral;
+    report.cpu_compress += w.cpu_write;
+    report.fallback_normals += w.evaluator.stats().fallback_normals;
+  }
+  return Status::Ok();
+}
+
+// The report's totals: samples, resolutions, and the displacement's statistics (its normal
+// component as the scalar map's, and how far it leaves the normal).
+void SumVectorFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
+                    std::span<const VectorFaceStats> stats, ExtractReport& report) {
+  double sum_squares = 0;
+  bool first = true;
+  for (int f = 0; f < inputs.surface.num_ptex_faces(); ++f) {
+    if (inputs.surface.is_hole(PtexFaceId(f))) continue;
+    const VectorFaceStats& r = stats[static_cast<std::size_t>(f)];
+    report.oversample_faces[settings.plan.log2[static_cast<std::size_t>(f)]]++;
+    report.samples += r.samples;
+    report.spectral.Add(r.spectral, r.ulog2, r.vlog2);
+    sum_squares += r.sum_squares;
+    report.displacement_min = first ? r.normal_min : std::min<double>(report.displacement_min,
+                                                                      r.normal_min);
+    report.displacement_max = first ? r.normal_max : std::max<double>(report.displacement_max,
+                                                                      r.normal_max);
+    report.vector_length_max = std::max(report.vector_length_max, r.length_max);
+    report.vector_tangential_max = std::max(report.vector_tangential_max, r.tangential_max);
+    first = false;
+  }
+  report.displacement_rms =
+      report.samples ? std::sqrt(sum_squares / static_cast<double>(report.samples)) : 0;
+}
+
+StatusOr<PtexWriter> CreateVectorMap(const ExtractOptions& options, const ExtractInputs& inputs) {
+  PtexWriterOptions writer_options;
+  writer_options.data_type = options.data_type;
+  writer_options.compression_level = options.compression_level;
+  writer_options.num_channels = 3;
+  writer_options.edge_filter = *options.vector == VectorSpace::kObject
+                                   ? PtexEdgeFilterMode::kNone
+                                   : PtexEdgeFilterMode::kTangentVector;
+  return PtexWriter::Create(options.output_path, writer_options, inputs.surface.num_ptex_faces());
+}
+
+}  // namespace
+
+StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, ExtractInputs inputs,
+                                           ExtractReport report, const Stopwatch& total_clock) {
+  report.vector_space = std::string(VectorSpaceName(*options.vector));
+  report.watertight = WatertightEdges::kOff;
+  Stopwatch match_clock;
+  MatchOptions match;
+  match.threads = report.threads;
+  if (options.search_distance.kind != SearchDistanceSpec::Kind::kAuto) {
+    DISPEX_ASSIGN_OR_RETURN(match.max_offset, ResolveSearchDistance(options.search_distance,
+                                                                    report.base_diagonal));
+  }
+  auto correspondence = MatchRefinedSculpt(inputs.surface, inputs.sculpt, match);
+  if (!correspondence.ok()) {
+    return Status::Error(fmt::format(
+        "vector displacement reads the sculpt through its correspondence with the base, and "
+        "there is none: {}",
+        correspondence.status().message()));
+  }
+  report.t_match = match_clock.seconds();
+  report.mapping_levels = correspondence->levels;
+  report.mapping_max_offset = correspondence->max_offset;
+  report.mapping_rms_offset = correspondence->rms_offset;
+  report.search_distance = match.max_offset;
+  DISPEX_ASSIGN_OR_RETURN(ExtractSettings settings, ResolveSettings(options, inputs, report));
+  if (CancelRequested()) return Cancelled();
+  DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateVectorMap(options, inputs));
+
+  Stopwatch faces_clock;
+  std::vector<VectorFaceStats> stats;
+  DISPEX_RETURN_IF_ERROR(
+      ProcessVectorFaces(options, inputs, settings, *correspondence, writer, stats, report));
+  report.faces_extracted =
+      inputs.surface.num_ptex_faces() - inputs.surface.stats().hole_ptex_faces;
+  report.t_sample_trace = faces_clock.seconds();
+  SumVectorFaces(inputs, settings, stats, report);
+
+  Stopwatch write_clock;
+  DISPEX_RETURN_IF_ERROR(AddExtractMetaData(writer, inputs.base, report, {}, {}, {}));
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData(std::string(kVectorSpaceMetaKey), report.vector_space));
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
+      std::string(kVectorChannelsMetaKey), std::string(VectorSpaceChannels(*options.vector))));
+  DISPEX_RETURN_IF_ERROR(
+      writer.AddMetaData("dispex:frame", std::string(VectorSpaceFrame(*options.vector))));
+  if (CancelRequested()) return Cancelled();
+  DISPEX_RETURN_IF_ERROR(writer.Finish());
+  report.t_write = write_clock.seconds();
+  std::error_code ec;
+  report.bytes_written = std::filesystem::file_size(report.output_path, ec);
+  report.peak_rss_bytes = PeakResidentBytes();
+  report.t_total = total_clock.seconds();
+  return report;
+}
+
+}  // namespace dispex::extract

@@ -1,0 +1,19 @@
+// Vector displacement maps (docs/VECTOR.md): for a sculpt that is the base refined, every
+// Ptex face's samples read the sculpt exactly where they lie through the correspondence
+// (MatchRefinedSculpt) -- D = sculpt(u, v) - limit(u, v), no rays -- expressed in the map's
+// vector space, and stored at the fewest texels that keep the vector error within the
+// tolerance (SpectralVectorAnalyzer).
+#pragma once
+
+#include "core/system.h"
+#include "dispex/extract.h"
+#include "extract/extract_inputs.h"
+
+namespace dispex::extract {
+
+// Steps 2-9 of ExtractShape for ExtractOptions::vector: correspondence, settings (no search
+// distance), faces, totals, the map with its vector meta data.
+StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, ExtractInputs inputs,
+                                           ExtractReport report, const Stopwatch& total_clock);
+
+}  // namespace dispex::extract
