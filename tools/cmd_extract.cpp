@@ -33,6 +33,7 @@ constexpr FlagName kExtractFlags[] = {
     {"threads", "--threads"},
     {"max_memory", "--max-memory"},
     {"output_dir", "--out-dir"},
+    {"method", "--method"},
 };
 
 struct ExtractArgs {
@@ -47,6 +48,7 @@ struct ExtractArgs {
   std::string holes = "fill";
   std::string watertight = "filter";
   std::string bvh_quality = "low";
+  std::string method = "auto";
   std::string vector;
   std::string report_path;
   std::string preview_dir;
@@ -153,6 +155,9 @@ Status Resolve(ExtractArgs& a) {
   auto quality = ParseBuildQuality(a.bvh_quality);
   if (!quality.ok()) return quality.status().WithPrefix("--bvh-quality");
   o.bvh_quality = *quality;
+  auto method = ParseExtractMethod(a.method);
+  if (!method.ok()) return method.status().WithPrefix("--method");
+  o.method = *method;
   o.progress = !a.quiet && StderrIsInteractive();
   if (!a.max_memory.empty()) {
     auto bytes = ParseBytes(a.max_memory);
@@ -301,6 +306,11 @@ void SetupExtract(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-miss-fraction", o.max_miss_fraction,
                   "fail when more than this fraction of the samples miss the sculpt after the "
                   "second search (0..1; 1: never)")
+      ->capture_default_str();
+  cmd->add_option("--method", args->method,
+                  "how rays are answered: auto (through the subdivision correspondence when "
+                  "the sculpt is the base refined, else rays), rays (a BVH of the sculpt), "
+                  "mapping (the correspondence; an error when there is none)")
       ->capture_default_str();
   cmd->add_option("--bvh-quality", args->bvh_quality, "BVH build quality: low, medium, high")
       ->capture_default_str();

@@ -49,6 +49,20 @@ enum class WatertightEdges : std::uint8_t {
 std::string_view WatertightEdgesName(WatertightEdges mode);  // "all", "filter", "off"
 StatusOr<WatertightEdges> ParseWatertightEdges(std::string_view name);
 
+// How the samples' rays are answered.
+enum class ExtractMethod : std::uint8_t {
+  // Through the subdivision correspondence when the sculpt is the base refined
+  // (MatchRefinedSculpt), else rays.
+  kAuto,
+  kRays,  // a BVH of the whole sculpt
+  // Through the correspondence: each sample's rays against the sculpt quads in the rings of
+  // cells around it, the few it cannot decide by a BVH built afterwards (docs/ARCHITECTURE.md);
+  // an error when the sculpt is not the base refined.
+  kMapping,
+};
+std::string_view ExtractMethodName(ExtractMethod method);  // "auto", "rays", "mapping"
+StatusOr<ExtractMethod> ParseExtractMethod(std::string_view name);
+
 struct ExtractOptions {
   std::string base_path;
   std::string sculpt_path;
@@ -64,6 +78,7 @@ struct ExtractOptions {
 
   SearchDistanceSpec search_distance;  // auto, absolute, or a fraction of the base diagonal
   HitPolicy ray_policy = HitPolicy::kNearest;
+  ExtractMethod method = ExtractMethod::kAuto;
 
   // Largest allowed error of a stored face against its samples, in object units; 0: automatic,
   // tolerance_fraction times the sculpt's median edge length.
@@ -147,6 +162,15 @@ struct ExtractReport {
   // Phases, wall seconds.
   double t_read_base = 0, t_read_sculpt = 0, t_topology = 0, t_bvh = 0, t_search = 0,
          t_sample_trace = 0, t_write = 0, t_total = 0;
+
+  // Scalar maps (ExtractMethod): the method that ran (kRays or kMapping); when the
+  // correspondence was looked for, the match as below (mapping_levels, offsets, t_match), or
+  // why the sculpt is not the base refined.
+  ExtractMethod method = ExtractMethod::kRays;
+  std::string mapping_reason;
+  // Samples the mapping could not decide, answered by a BVH of the sculpt within their reach,
+  // and the Ptex faces they are in (of the faces extracted in this run).
+  std::int64_t mapping_fallback_samples = 0, mapping_fallback_faces = 0;
   // Within sample+trace, CPU time of the worker threads (each thread's own clock, summed):
   // limit evaluation, rays, spectral analysis, compression and writing.
   double cpu_limit = 0, cpu_trace = 0, cpu_spectral = 0, cpu_compress = 0;
@@ -211,9 +235,9 @@ struct ExtractReport {
   std::int64_t tracer_faces = 0;
 
   // Vector maps (ExtractOptions::vector): the space; the correspondence (the sculpt is the base
-  // refined mapping_levels times; how far its vertices lie from their points on the limit
-  // surface); the largest |D| and its largest part across the normal (displacement_min, _max
-  // hold D . N, displacement_rms |D|).
+  // refined mapping_levels times, -1 when not matched; how far its vertices lie from their
+  // points on the limit surface; scalar maps through the mapping too); the largest |D| and its
+  // largest part across the normal (displacement_min, _max hold D . N, displacement_rms |D|).
   std::string vector_space;  // empty for a scalar map
   int mapping_levels = -1;
   double mapping_max_offset = 0, mapping_rms_offset = 0;

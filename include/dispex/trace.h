@@ -304,6 +304,12 @@ StatusOr<SearchDistanceEstimate> EstimateSearchDistance(const Tracer& tracer,
                                                         double base_diagonal,
                                                         const SearchDistanceOptions& options = {});
 
+// EstimateSearchDistance's rule over hits found another way (the same long rays answered
+// without this tracer): `abs_t`, |t| of the hits among `samples` queries. Same errors.
+StatusOr<SearchDistanceEstimate> SearchDistanceFromHits(std::vector<double> abs_t,
+                                                        std::size_t samples, double base_diagonal,
+                                                        const SearchDistanceOptions& options = {});
+
 // The search distance for an absolute or relative spec: value, or value * base_diagonal.
 // Error for kAuto (use EstimateSearchDistance) or a base_diagonal that is not finite and > 0.
 StatusOr<double> ResolveSearchDistance(const SearchDistanceSpec& spec, double base_diagonal);

@@ -15,7 +15,7 @@ namespace dispex::extract {
 
 StatusOr<CoarseSampling> SampleCoarsely(const LimitSurface& surface) {
   const int n = surface.num_ptex_faces();
-  constexpr int kGrid = 4;
+  constexpr int kGrid = CoarseSampling::kGrid;
   CoarseSampling out;
   out.face_areas.assign(static_cast<std::size_t>(n), 0.0);
   std::vector<float> pos(static_cast<std::size_t>(n) * kGrid * kGrid * 3, 0.0f);
@@ -58,6 +58,7 @@ StatusOr<CoarseSampling> SampleCoarsely(const LimitSurface& surface) {
     if (!ok[i / (kGrid * kGrid)]) continue;
     out.points.push_back({pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]});
     out.normals.push_back({nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]});
+    out.ids.push_back(static_cast<std::int64_t>(i));
   }
   return out;
 }

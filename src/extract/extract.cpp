@@ -15,6 +15,7 @@
 #include "dispex/version.h"
 #include "extract/edge_matching.h"
 #include "extract/extract_inputs.h"
+#include "extract/extract_mapping.h"
 #include "extract/extract_meta.h"
 #include "extract/extract_settings.h"
 #include "extract/extract_shape.h"
@@ -191,15 +192,23 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   if (options.vector) {
     return ExtractVectorShape(options, std::move(inputs), std::move(report), total_clock);
   }
+  // Through the subdivision correspondence no BVH is built up front (extract_mapping.h).
+  DISPEX_RETURN_IF_ERROR(ChooseMethod(options, inputs, report));
+  const bool mapping = inputs.mapping != nullptr;
   // The automatic search distance is estimated with rays over the whole surface; a given one
   // lets a re-run trace only the sculpt within reach of the faces it extracts.
-  const bool local = options.incremental && previous.usable() &&
+  const bool local = !mapping && options.incremental && previous.usable() &&
                      options.search_distance.kind != SearchDistanceSpec::Kind::kAuto;
-  if (!local) DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
+  if (mapping) {
+    SetTracerOptions(options, inputs);
+  } else if (!local) {
+    DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
+  }
   DISPEX_ASSIGN_OR_RETURN(ExtractSettings settings, ResolveSettings(options, inputs, report));
   Stopwatch keys_clock;
   const FaceKeys face_keys = ComputeFaceKeys(inputs, settings);
   const std::vector<Hash128>& keys = face_keys.keys;
+  inputs.face_keys = &face_keys;
   report.t_keys = keys_clock.seconds();
   if (local) DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, face_keys, inputs, report));
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateMap(options, inputs));
@@ -219,6 +228,7 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   }
   ListDiscontinuousFaces(inputs, faces, report);
   report.t_sample_trace = faces_clock.seconds();
+  if (mapping) ReportMapping(inputs, faces, report);
 
   DISPEX_RETURN_IF_ERROR(AddFaceTotals(options, inputs, settings, faces, report));
   DISPEX_RETURN_IF_ERROR(CommitMap(writer, inputs, keys, faces, report));

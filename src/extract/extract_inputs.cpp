@@ -104,7 +104,10 @@ StatusOr<ExtractInputs> FinishInputs(const ExtractOptions& options, MeshesRead m
                        {},
                        {},
                        false,
-                       {}};
+                       {},
+                       nullptr,
+                       nullptr,
+                       0};
 }
 
 }  // namespace

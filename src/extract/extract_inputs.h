@@ -12,8 +12,11 @@
 #include "dispex/ptex.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
+#include "extract/mapping_trace.h"
 
 namespace dispex::extract {
+
+struct FaceKeys;
 
 struct ExtractInputs {
   Mesh base;
@@ -29,6 +32,12 @@ struct ExtractInputs {
   Mesh traced_part;      // the part of the sculpt that tracer reads, when it reads a part
   bool widened = false;  // EnsureTraced replaced a part's tracer by the whole sculpt's
   TracerOptions tracer_options;
+  // The sculpt as the base refined (ExtractMethod, extract_mapping.h): samples are traced
+  // through it, and `tracer` is built only for those it leaves undecided (TraceFallback), over
+  // the sculpt within reach of their faces (`face_keys`, the run's).
+  std::unique_ptr<SculptMapping> mapping;
+  const FaceKeys* face_keys = nullptr;
+  double fallback_bvh_seconds = 0;  // building those tracers
 };
 
 // Reads the sculpt while the base is read and its limit surface built, fingerprints both

@@ -47,11 +47,14 @@ nlohmann::json ExtractOptionsJson(const ExtractOptions& o) {
   j["watertight"] = std::string(WatertightEdgesName(o.watertight));
   // Only on vector maps, so that scalar maps keep their keys (incremental re-use).
   if (o.vector) j["vector"] = std::string(VectorSpaceName(*o.vector));
+  // Only when given: maps made before the option existed keep their keys.
+  if (o.method != ExtractMethod::kAuto) j["method"] = std::string(ExtractMethodName(o.method));
   return j;
 }
 
 nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
   nlohmann::json j;
+  if (r.vector_space.empty()) j["method"] = std::string(ExtractMethodName(r.method));
   j["tolerance"] = r.tolerance;
   j["tolerance_auto"] = r.tolerance_auto;
   j["sculpt_median_edge"] = r.sculpt_median_edge;

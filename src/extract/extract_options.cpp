@@ -47,6 +47,25 @@ StatusOr<WatertightEdges> ParseWatertightEdges(std::string_view name) {
       fmt::format("unknown watertight mode '{}' (expected all, filter or off)", name));
 }
 
+std::string_view ExtractMethodName(ExtractMethod method) {
+  switch (method) {
+    case ExtractMethod::kAuto:
+      return "auto";
+    case ExtractMethod::kRays:
+      return "rays";
+    case ExtractMethod::kMapping:
+      return "mapping";
+  }
+  return "auto";
+}
+
+StatusOr<ExtractMethod> ParseExtractMethod(std::string_view name) {
+  for (ExtractMethod m : {ExtractMethod::kAuto, ExtractMethod::kRays, ExtractMethod::kMapping}) {
+    if (name == ExtractMethodName(m)) return m;
+  }
+  return Status::Error(fmt::format("unknown method '{}' (expected auto, rays or mapping)", name));
+}
+
 namespace {
 bool IsPowerOfTwoIn(int v, int lo, int hi) {
   return v >= lo && v <= hi && std::has_single_bit(static_cast<unsigned>(v));

@@ -39,9 +39,19 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
                             {"floored", e.floored},
                             {"capped", e.capped}};
   }
+  if (r.vector_space.empty()) {
+    j["method"] = {{"used", std::string(ExtractMethodName(r.method))},
+                   {"levels", r.mapping_levels},
+                   {"max_offset", r.mapping_max_offset},
+                   {"rms_offset", r.mapping_rms_offset},
+                   {"reason", r.mapping_reason},
+                   {"fallback_samples", r.mapping_fallback_samples},
+                   {"fallback_faces", r.mapping_fallback_faces}};
+  }
   j["phases_seconds"] = {{"read_base", r.t_read_base},
                          {"read_sculpt", r.t_read_sculpt},
                          {"topology", r.t_topology},
+                         {"match", r.t_match},
                          {"bvh", r.t_bvh},
                          {"auto_settings", r.t_search},
                          {"face_keys", r.t_keys},
@@ -138,6 +148,12 @@ std::string ExtractReportSummary(const ExtractReport& r) {
     out += fmt::format("  tolerance {:.4g}{}  samples {}  matched in {:.2f}s\n", r.tolerance,
                        r.tolerance_auto ? " (auto)" : "", r.samples, r.t_match);
   } else {
+    if (r.method == ExtractMethod::kMapping) {
+      out += fmt::format(
+          "  through the subdivision correspondence (level {}, {:.2f}s); {} samples of {} faces "
+          "left to a BVH\n",
+          r.mapping_levels, r.t_match, r.mapping_fallback_samples, r.mapping_fallback_faces);
+    }
     out += fmt::format("  tolerance {:.4g}{}  search distance {:.4g}{}\n", r.tolerance,
                        r.tolerance_auto ? " (auto)" : "", r.search_distance,
                        r.search_distance_auto ? " (auto)" : "");

@@ -8,6 +8,7 @@
 
 #include "core/system.h"
 #include "extract/coarse_sampling.h"
+#include "extract/extract_mapping.h"
 
 namespace dispex::extract {
 
@@ -53,8 +54,10 @@ Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs
                               const CoarseSampling& coarse, ExtractReport& report) {
   report.search_distance_auto = options.search_distance.kind == SearchDistanceSpec::Kind::kAuto;
   if (report.search_distance_auto) {
-    auto estimate =
-        EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals, report.base_diagonal);
+    auto estimate = inputs.mapping
+                        ? EstimateSearchDistanceMapped(inputs, coarse, report.base_diagonal)
+                        : EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals,
+                                                 report.base_diagonal);
     if (!estimate.ok()) {
       return Status::Error(fmt::format("{} and {} do not overlap: {}", options.base_path,
                                        options.sculpt_path, estimate.status().message()));
@@ -102,6 +105,7 @@ StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
   settings.query.policy = options.ray_policy;
   settings.retry_query = settings.query;
   settings.retry_query.distance = static_cast<float>(report.retry_search_distance);
+  settings.mapping = inputs.mapping != nullptr;
   settings.spectral.rule = options.resolution_rule;
   settings.spectral.tolerance = report.tolerance;
   settings.spectral.nonzero_threshold = options.nonzero_threshold;

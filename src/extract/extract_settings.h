@@ -28,6 +28,7 @@ struct ExtractSettings {
   // The most samples per side a face may be re-extracted with when its edges need a finer
   // resolution than its planned samples hold (log2; max_oversample).
   int max_samples_log2 = 0;
+  bool mapping = false;  // samples traced through the subdivision correspondence
 };
 
 // Tolerance (from the sculpt's median edge length unless given), search distance (estimated

@@ -214,6 +214,8 @@ Hash128 SettingsKey(const ExtractSettings& s) {
   h.Add(s.spectral.pin_edges).Add(s.spectral.edge_tolerance);
   h.Add(static_cast<int>(s.holes)).Add(static_cast<int>(s.data_type));
   h.Add(static_cast<int>(s.watertight)).Add(s.edge_step_budget).Add(s.max_samples_log2);
+  // Rays' keys stay as they were; a map of either method re-uses only its own faces.
+  if (s.mapping) h.Add(std::string_view("mapping"));
   return h.Digest();
 }
 

@@ -15,21 +15,22 @@ std::span<const Float3> AsFloat3(const std::vector<float>& v, std::size_t n) {
   return {reinterpret_cast<const Float3*>(v.data()), n};
 }
 
-// Rays along +-n from every sample; with a retry distance, the samples that missed are
-// searched again that far. Returns how many the second search found.
-std::int32_t TraceSamples(const Tracer& tracer, const ExtractSettings& settings, std::size_t count,
-                          FaceScratch& w) {
-  tracer.TraceNormals(AsFloat3(w.positions, count), AsFloat3(w.normals, count), settings.query,
-                      NormalHits{w.t, {}, w.flags}, w.counters);
+// Rays along +-n from each origin; with a retry distance, the samples that missed are searched
+// again that far. Returns how many the second search found.
+std::int32_t TraceRays(const Tracer& tracer, const ExtractSettings& settings,
+                       std::span<const Float3> origins, std::span<const Float3> normals,
+                       std::span<float> t, std::span<std::uint8_t> flags, FaceScratch& w) {
+  const std::size_t count = origins.size();
+  tracer.TraceNormals(origins, normals, settings.query, NormalHits{t, {}, flags}, w.counters);
   if (!(settings.retry_query.distance > 0)) return 0;
   w.retry_origins.clear();
   w.retry_normals.clear();
   w.retry_index.clear();
   for (std::size_t i = 0; i < count; ++i) {
-    if (w.flags[i] & HitFlags::kHit) continue;
+    if (flags[i] & HitFlags::kHit) continue;
     w.retry_index.push_back(static_cast<std::int32_t>(i));
-    w.retry_origins.push_back(AsFloat3(w.positions, count)[i]);
-    w.retry_normals.push_back(AsFloat3(w.normals, count)[i]);
+    w.retry_origins.push_back(origins[i]);
+    w.retry_normals.push_back(normals[i]);
   }
   if (w.retry_index.empty()) return 0;
   const std::size_t m = w.retry_index.size();
@@ -41,9 +42,78 @@ std::int32_t TraceSamples(const Tracer& tracer, const ExtractSettings& settings,
   for (std::size_t k = 0; k < m; ++k) {
     if (!(w.retry_flags[k] & HitFlags::kHit)) continue;
     const auto i = static_cast<std::size_t>(w.retry_index[k]);
-    w.t[i] = w.retry_t[k];
-    w.flags[i] = w.retry_flags[k];
+    t[i] = w.retry_t[k];
+    flags[i] = w.retry_flags[k];
     ++recovered;
+  }
+  return recovered;
+}
+
+const Tracer* TracerFor(const ExtractInputs& inputs, PtexFaceId face) {
+  if (!inputs.tracer) return nullptr;
+  if (!inputs.traced.empty() && !inputs.traced[static_cast<std::size_t>(face.value)]) {
+    return nullptr;
+  }
+  return inputs.tracer.get();
+}
+
+// The same through the mapping; the samples it leaves undecided go to `tracer` as TraceRays
+// traces them, or, without one, the face is left for later (result.needs_tracer).
+std::int32_t TraceMappedSamples(PtexFaceId face, int n, const ExtractInputs& inputs,
+                                const ExtractSettings& settings, std::size_t count, FaceScratch& w,
+                                FaceResult& result) {
+  const auto origins = AsFloat3(w.positions, count), normals = AsFloat3(w.normals, count);
+  w.undecided.resize(count);
+  TraceMapped(*inputs.mapping, inputs.sculpt, face, n, {}, origins, normals, settings.query,
+              NormalHits{w.t, {}, w.flags}, w.undecided, w.mapping, w.mapping_counters);
+  std::int32_t recovered = 0;
+  if (settings.retry_query.distance > 0) {
+    w.mapped_index.clear();
+    for (std::size_t i = 0; i < count; ++i) {
+      if (!w.undecided[i] && !(w.flags[i] & HitFlags::kHit)) {
+        w.mapped_index.push_back(static_cast<std::int32_t>(i));
+      }
+    }
+    if (!w.mapped_index.empty()) {
+      w.mapped_t.resize(count);
+      w.mapped_flags.resize(count);
+      TraceMapped(*inputs.mapping, inputs.sculpt, face, n, w.mapped_index, origins, normals,
+                  settings.retry_query, NormalHits{w.mapped_t, {}, w.mapped_flags}, w.undecided,
+                  w.mapping, w.mapping_counters);
+      for (const std::int32_t i : w.mapped_index) {
+        const auto k = static_cast<std::size_t>(i);
+        if (w.undecided[k] || !(w.mapped_flags[k] & HitFlags::kHit)) continue;
+        w.t[k] = w.mapped_t[k];
+        w.flags[k] = w.mapped_flags[k];
+        ++recovered;
+      }
+    }
+  }
+  w.mapped_index.clear();
+  for (std::size_t i = 0; i < count; ++i) {
+    if (w.undecided[i]) w.mapped_index.push_back(static_cast<std::int32_t>(i));
+  }
+  result.fallback_samples = static_cast<std::int32_t>(w.mapped_index.size());
+  if (w.mapped_index.empty()) return recovered;
+  const Tracer* tracer = TracerFor(inputs, face);
+  if (tracer == nullptr) {
+    result.needs_tracer = true;
+    return 0;
+  }
+  w.fallback_origins.clear();
+  w.fallback_normals.clear();
+  for (const std::int32_t i : w.mapped_index) {
+    w.fallback_origins.push_back(origins[static_cast<std::size_t>(i)]);
+    w.fallback_normals.push_back(normals[static_cast<std::size_t>(i)]);
+  }
+  w.fallback_t.resize(w.mapped_index.size());
+  w.fallback_flags.resize(w.mapped_index.size());
+  recovered += TraceRays(*tracer, settings, w.fallback_origins, w.fallback_normals, w.fallback_t,
+                         w.fallback_flags, w);
+  for (std::size_t k = 0; k < w.mapped_index.size(); ++k) {
+    const auto i = static_cast<std::size_t>(w.mapped_index[k]);
+    w.t[i] = w.fallback_t[k];
+    w.flags[i] = w.fallback_flags[k];
   }
   return recovered;
 }
@@ -90,8 +160,14 @@ StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
   DISPEX_RETURN_IF_ERROR(w.evaluator.EvaluateGrid(face, n, n, w.positions, w.normals));
   w.cpu_limit += step.seconds();
   step.Reset();
-  r.recovered = TraceSamples(*inputs.tracer, settings, count, w);
+  if (inputs.mapping) {
+    r.recovered = TraceMappedSamples(face, n, inputs, settings, count, w, result);
+  } else {
+    r.recovered = TraceRays(*inputs.tracer, settings, AsFloat3(w.positions, count),
+                            AsFloat3(w.normals, count), w.t, w.flags, w);
+  }
   w.cpu_trace += step.seconds();
+  if (result.needs_tracer) return result;
   r.rays = static_cast<std::int64_t>(w.counters.rays_cast - rays_before);
   r.fallback_normals =
       static_cast<std::int32_t>(w.evaluator.stats().fallback_normals - fallbacks_before);

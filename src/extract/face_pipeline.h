@@ -14,6 +14,7 @@
 #include "extract/extract_inputs.h"
 #include "extract/extract_settings.h"
 #include "extract/hole_fill.h"
+#include "extract/mapping_trace.h"
 
 namespace dispex::extract {
 
@@ -41,6 +42,11 @@ struct FaceResult {
     kAnalysed,   // `analysed` holds the face to write
   };
   Kind kind = Kind::kHole;
+  // Through the mapping (ExtractInputs::mapping): samples it left undecided were traced by the
+  // BVH; with no tracer holding this face, nothing else is set and the face must be processed
+  // again once one does (TraceFallback).
+  std::int32_t fallback_samples = 0;
+  bool needs_tracer = false;
   FaceStats stats;
   EdgeMeans edge_means;   // what a neighbour that missed entirely is filled from
   SpectralFace analysed;  // its texels live in the scratch until its next ProcessFace
@@ -57,6 +63,13 @@ struct FaceScratch {
   std::vector<float> retry_t;
   std::vector<std::uint8_t> retry_flags;
   std::vector<std::int32_t> retry_index;
+  // Through the mapping: its neighbourhoods, its second search, the undecided samples.
+  MappingScratch mapping;
+  MappingCounters mapping_counters;
+  std::vector<std::uint8_t> undecided, mapped_flags, fallback_flags;
+  std::vector<std::int32_t> mapped_index;
+  std::vector<float> mapped_t, fallback_t;
+  std::vector<Float3> fallback_origins, fallback_normals;
   PullPushScratch pull_push;
   TraceCounters counters;
   double cpu_limit = 0, cpu_trace = 0, cpu_spectral = 0, cpu_write = 0;  // this thread's seconds

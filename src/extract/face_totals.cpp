@@ -72,7 +72,7 @@ Status AddFaceTotals(const ExtractOptions& options, const ExtractInputs& inputs,
   report.cpu_spectral += w.cpu_spectral;
   report.cpu_compress += w.cpu_write;
   report.fallback_normals += w.fallback_normals;
-  return inputs.tracer->status();
+  return inputs.tracer ? inputs.tracer->status() : Status::Ok();
 }
 
 }  // namespace dispex::extract

@@ -89,6 +89,8 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
     DISPEX_ASSIGN_OR_RETURN(o.max_miss_fraction, NumberValue(v));
   } else if (name == "bvh_quality") {
     return SetNamed(o.bvh_quality, v, ParseBuildQuality);
+  } else if (name == "method") {
+    return SetNamed(o.method, v, ParseExtractMethod);
   } else if (name == "vector") {
     if (v == "off") {
       o.vector.reset();
@@ -103,7 +105,7 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
         "ray_policy, tolerance, tolerance_fraction, resolution_rule, fixed_resolution, "
         "nonzero_threshold, "
         "data_type, compression_level, holes, watertight, max_miss_fraction, bvh_quality, "
-        "vector)");
+        "method, vector)");
   }
   return Status::Ok();
 }

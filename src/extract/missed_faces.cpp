@@ -22,8 +22,11 @@ Status FillMissedFaces(const ExtractOptions& options, const ExtractInputs& input
         options.base_path, options.sculpt_path, report.search_distance));
   }
   CrossFaceFill cross = FillEmptyFaces(has_values, faces.edge_means, inputs.faces);
+  std::int64_t filled = 0;
   for (std::size_t k = 0; k < cross.faces.size(); ++k) {
     const int f = cross.faces[k];
+    if (inputs.surface.is_hole(PtexFaceId(f))) continue;  // written as 0 with the first pass
+    ++filled;
     DISPEX_RETURN_IF_ERROR(WriteConstantFace(writer, inputs, PtexFaceId(f), cross.values[k]));
     FaceStats& r = faces.stats[static_cast<std::size_t>(f)];
     r.min = r.max = cross.values[k];
@@ -33,7 +36,7 @@ Status FillMissedFaces(const ExtractOptions& options, const ExtractInputs& input
     if (has_values[f] || inputs.surface.is_hole(PtexFaceId(f))) continue;
     DISPEX_RETURN_IF_ERROR(WriteConstantFace(writer, inputs, PtexFaceId(f), 0.0f));
   }
-  report.faces_filled_from_neighbours = static_cast<std::int64_t>(cross.faces.size());
+  report.faces_filled_from_neighbours = filled;
   report.faces_unreachable = static_cast<std::int64_t>(cross.unreachable);
   if (cross.unreachable > 0) {
     report.warnings.push_back(fmt::format(

@@ -4,8 +4,11 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+
 #include "core/progress.h"
 #include "core/system.h"
+#include "extract/extract_mapping.h"
 #include "extract/parallel_errors.h"
 #include "extract/previous_map.h"
 
@@ -101,7 +104,7 @@ Status WriteConstantFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFa
   return writer.SetConstantFace(face, FaceInfo(inputs, face, 0, 0), {&value, 1});
 }
 
-StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
+StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
                                       const PreviousMap* previous, std::span<const Hash128> keys,
                                       bool progress, PtexWriter& writer) {
   const int num_faces = inputs.surface.num_ptex_faces();
@@ -111,6 +114,8 @@ StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const Extract
   out.edge_means.resize(static_cast<std::size_t>(num_faces));
   if (keep) out.kept.resize(static_cast<std::size_t>(num_faces));
   std::vector<std::uint8_t> copied(static_cast<std::size_t>(num_faces), 0);
+  std::vector<std::uint8_t> deferred(static_cast<std::size_t>(num_faces), 0);
+  std::vector<std::int32_t> fallback(static_cast<std::size_t>(num_faces), 0);
   tbb::enumerable_thread_specific<FaceScratch> scratches(
       [&] { return FaceScratch(inputs.surface); });
   Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", progress);
@@ -139,6 +144,11 @@ StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const Extract
       return copy(face);
     }
     DISPEX_ASSIGN_OR_RETURN(FaceResult result, ProcessFace(face, inputs, settings, w));
+    if (result.needs_tracer) {
+      deferred[f] = 1;
+      return Status::Ok();
+    }
+    fallback[f] = result.fallback_samples;
     out.stats[f] = result.stats;
     out.edge_means[f] = result.edge_means;
     if (keep) {
@@ -152,6 +162,22 @@ StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const Extract
   };
   Status status = ForEachFace(
       num_faces, [](int k) { return k; }, scratches, &bar, process);
+  std::vector<int> waiting;
+  for (int f = 0; f < num_faces; ++f) {
+    if (deferred[static_cast<std::size_t>(f)]) waiting.push_back(f);
+  }
+  if (status.ok() && !waiting.empty()) {
+    status = TraceFallback(inputs, waiting);
+    std::fill(deferred.begin(), deferred.end(), 0);
+    if (status.ok()) {
+      status = ForEachFace(
+          static_cast<int>(waiting.size()),
+          [&](int k) { return waiting[static_cast<std::size_t>(k)]; }, scratches, nullptr, process);
+    }
+    if (status.ok() && std::count(deferred.begin(), deferred.end(), 1) > 0) {
+      status = Status::Error("internal: a face the fallback tracer holds asked for a tracer");
+    }
+  }
   bar.Finish();
   DISPEX_RETURN_IF_ERROR(status);
   AddCpuTimes(scratches, out.workers);
@@ -159,6 +185,8 @@ StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const Extract
     out.workers.rays_cast += static_cast<std::uint64_t>(out.stats[f].rays);
     out.workers.fallback_normals += out.stats[f].fallback_normals;
     out.faces_copied += copied[f];
+    out.fallback_samples += fallback[f];
+    out.fallback_faces += fallback[f] > 0;
   }
   out.first_pass = out.stats;
   return out;
@@ -167,13 +195,21 @@ StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const Extract
 Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
                       std::span<const int> faces, std::span<const std::array<int, 2>> least_log2,
                       ProcessedFaces& processed) {
-  DISPEX_RETURN_IF_ERROR(EnsureTraced(inputs, faces));
+  if (!inputs.mapping) DISPEX_RETURN_IF_ERROR(EnsureTraced(inputs, faces));
   tbb::enumerable_thread_specific<FaceScratch> scratches(
       [&] { return FaceScratch(inputs.surface); });
+  const auto num_faces = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
+  std::vector<std::uint8_t> deferred(num_faces, 0);
+  std::vector<std::int32_t> fallback(num_faces, 0);
   auto process = [&](PtexFaceId face, FaceScratch& w) -> Status {
     const auto f = static_cast<std::size_t>(face.value);
     DISPEX_ASSIGN_OR_RETURN(FaceResult result,
                             ProcessFace(face, inputs, settings, w, least_log2[f]));
+    if (result.needs_tracer) {
+      deferred[f] = 1;
+      return Status::Ok();
+    }
+    fallback[f] = result.fallback_samples;
     processed.stats[f] = result.stats;
     processed.kept[f] = Keep(result, settings.data_type);
     return Status::Ok();
@@ -181,11 +217,23 @@ Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
   DISPEX_RETURN_IF_ERROR(ForEachFace(
       static_cast<int>(faces.size()), [&](int k) { return faces[static_cast<std::size_t>(k)]; },
       scratches, nullptr, process));
+  std::vector<int> waiting;
+  for (int f : faces) {
+    if (deferred[static_cast<std::size_t>(f)]) waiting.push_back(f);
+  }
+  if (!waiting.empty()) {
+    DISPEX_RETURN_IF_ERROR(TraceFallback(inputs, waiting));
+    DISPEX_RETURN_IF_ERROR(ForEachFace(
+        static_cast<int>(waiting.size()),
+        [&](int k) { return waiting[static_cast<std::size_t>(k)]; }, scratches, nullptr, process));
+  }
   WorkerTotals extra;
   AddCpuTimes(scratches, extra);
   for (int f : faces) {
-    processed.workers.rays_cast +=
-        static_cast<std::uint64_t>(processed.stats[static_cast<std::size_t>(f)].rays);
+    const auto i = static_cast<std::size_t>(f);
+    processed.workers.rays_cast += static_cast<std::uint64_t>(processed.stats[i].rays);
+    processed.fallback_samples += fallback[i];
+    processed.fallback_faces += fallback[i] > 0;
   }
   processed.workers.cpu_limit += extra.cpu_limit;
   processed.workers.cpu_trace += extra.cpu_trace;

@@ -36,6 +36,9 @@ struct ProcessedFaces {
   std::vector<KeptFace> kept;         // per Ptex face, when settings.watertight is on
   WorkerTotals workers;
   std::int64_t faces_copied = 0;  // taken from the previous map
+  // Through the mapping: samples it left undecided and the faces they were in, over every face
+  // extracted (the edge pass's too).
+  std::int64_t fallback_samples = 0, fallback_faces = 0;
 };
 
 class PreviousMap;
@@ -43,16 +46,19 @@ class PreviousMap;
 // Every face through ProcessFace, in parallel, except those `previous` (may be null) holds
 // with the same key (`keys`, per Ptex face), whose first pass is copied from it. Each face is
 // written to the map as soon as it is done, or, with watertight edges, kept for MatchEdges and
-// WriteKeptFaces. On an error, the error of the lowest face id (whatever the scheduling), or
+// WriteKeptFaces. Through the mapping, faces with samples it leaves undecided wait until every
+// face has been through it; then one tracer is built for them (TraceFallback) and they are
+// processed again. On an error, the error of the lowest face id (whatever the scheduling), or
 // the cancellation.
-StatusOr<ProcessedFaces> ProcessFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
+StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
                                       const PreviousMap* previous, std::span<const Hash128> keys,
                                       bool progress, PtexWriter& writer);
 
 // Runs ProcessFace again for `faces` with their least resolutions (`least_log2`, per Ptex
 // face), replacing their kept texels and statistics; the rays cast count in the totals. Swaps
 // in the whole sculpt's tracer first when the current one does not hold their reach
-// (EnsureTraced).
+// (EnsureTraced); through the mapping, a tracer only for the faces that need one, afterwards
+// (TraceFallback).
 Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
                       std::span<const int> faces, std::span<const std::array<int, 2>> least_log2,
                       ProcessedFaces& processed);

@@ -69,16 +69,9 @@ StatusOr<double> ResolveSearchDistance(const SearchDistanceSpec& spec, double ba
   return spec.value * base_diagonal;
 }
 
-StatusOr<SearchDistanceEstimate> EstimateSearchDistance(const Tracer& tracer,
-                                                        std::span<const Float3> origins,
-                                                        std::span<const Float3> normals,
-                                                        double base_diagonal,
-                                                        const SearchDistanceOptions& options) {
-  if (origins.size() != normals.size()) {
-    return Status::Error(fmt::format("search distance estimate: {} sample points but {} normals",
-                                     origins.size(), normals.size()));
-  }
-  if (origins.empty()) return Status::Error("search distance estimate: no sample points");
+namespace {
+
+Status CheckEstimateOptions(double base_diagonal, const SearchDistanceOptions& options) {
   if (!PositiveFinite(base_diagonal)) {
     return Status::Error(fmt::format(
         "search distance estimate: the base mesh has no extent (diagonal {})", base_diagonal));
@@ -91,32 +84,20 @@ StatusOr<SearchDistanceEstimate> EstimateSearchDistance(const Tracer& tracer,
         "factor {}, min fraction {})",
         options.ray_fraction, options.percentile, options.safety_factor, options.min_fraction));
   }
+  return Status::Ok();
+}
 
+}  // namespace
+
+StatusOr<SearchDistanceEstimate> SearchDistanceFromHits(std::vector<double> abs_t,
+                                                        std::size_t samples, double base_diagonal,
+                                                        const SearchDistanceOptions& options) {
+  DISPEX_RETURN_IF_ERROR(CheckEstimateOptions(base_diagonal, options));
   SearchDistanceEstimate estimate;
   estimate.base_diagonal = base_diagonal;
   estimate.ray_length = options.ray_fraction * base_diagonal;
-  estimate.samples = origins.size();
+  estimate.samples = samples;
   estimate.percentile = options.percentile;
-
-  const NormalQuery query{static_cast<float>(estimate.ray_length), HitPolicy::kNearest};
-  std::vector<float> t(origins.size());
-  std::vector<std::uint8_t> flags(origins.size());
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, origins.size(), 4096),
-      [&](const tbb::blocked_range<std::size_t>& r) {
-        TraceCounters counters;
-        const std::size_t b = r.begin(), n = r.size();
-        tracer.TraceNormals(
-            origins.subspan(b, n), normals.subspan(b, n), query,
-            NormalHits{std::span(t).subspan(b, n), {}, std::span(flags).subspan(b, n)}, counters);
-      });
-  DISPEX_RETURN_IF_ERROR(tracer.status());
-
-  std::vector<double> abs_t;
-  abs_t.reserve(origins.size());
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    if (flags[i] & HitFlags::kHit) abs_t.push_back(std::fabs(static_cast<double>(t[i])));
-  }
   estimate.hits = abs_t.size();
   if (abs_t.empty()) {
     return Status::Error(fmt::format(
@@ -141,6 +122,41 @@ StatusOr<SearchDistanceEstimate> EstimateSearchDistance(const Tracer& tracer,
   }
   estimate.distance = distance;
   return estimate;
+}
+
+StatusOr<SearchDistanceEstimate> EstimateSearchDistance(const Tracer& tracer,
+                                                        std::span<const Float3> origins,
+                                                        std::span<const Float3> normals,
+                                                        double base_diagonal,
+                                                        const SearchDistanceOptions& options) {
+  if (origins.size() != normals.size()) {
+    return Status::Error(fmt::format("search distance estimate: {} sample points but {} normals",
+                                     origins.size(), normals.size()));
+  }
+  if (origins.empty()) return Status::Error("search distance estimate: no sample points");
+  DISPEX_RETURN_IF_ERROR(CheckEstimateOptions(base_diagonal, options));
+
+  const NormalQuery query{static_cast<float>(options.ray_fraction * base_diagonal),
+                          HitPolicy::kNearest};
+  std::vector<float> t(origins.size());
+  std::vector<std::uint8_t> flags(origins.size());
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, origins.size(), 4096),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        TraceCounters counters;
+        const std::size_t b = r.begin(), n = r.size();
+        tracer.TraceNormals(
+            origins.subspan(b, n), normals.subspan(b, n), query,
+            NormalHits{std::span(t).subspan(b, n), {}, std::span(flags).subspan(b, n)}, counters);
+      });
+  DISPEX_RETURN_IF_ERROR(tracer.status());
+
+  std::vector<double> abs_t;
+  abs_t.reserve(origins.size());
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (flags[i] & HitFlags::kHit) abs_t.push_back(std::fabs(static_cast<double>(t[i])));
+  }
+  return SearchDistanceFromHits(std::move(abs_t), origins.size(), base_diagonal, options);
 }
 
 }  // namespace dispex

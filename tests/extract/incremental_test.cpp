@@ -37,7 +37,7 @@ struct Variant {
   // always stay local.
   bool auto_search_distance;
   // A local edit extracts few enough faces for the re-run to trace only the sculpt within
-  // their reach (a BVH of part of it).
+  // their reach (a BVH of part of it): method rays.
   bool local_tracer = false;
   double edit_radius = 0.04;  // of the base's diagonal
 };
@@ -74,6 +74,9 @@ class Incremental : public ::testing::TestWithParam<Variant> {
     if (!GetParam().auto_search_distance) {
       o.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.01};
     }
+    // The BVH of part of the sculpt is the ray path's (the others go through the subdivision
+    // correspondence while the sculpt is the base refined).
+    if (GetParam().local_tracer) o.method = ExtractMethod::kRays;
     return o;
   }
 

@@ -1,0 +1,152 @@
+#include "extract/extract_mapping.h"
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <vector>
+
+#include "core/system.h"
+#include "dispex/cancel.h"
+#include "dispex/correspondence.h"
+#include "extract/face_keys.h"
+#include "extract/parallel_errors.h"
+
+namespace dispex::extract {
+
+Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report) {
+  report.method = ExtractMethod::kRays;
+  if (options.method == ExtractMethod::kRays) return Status::Ok();
+  Stopwatch clock;
+  MatchOptions match;
+  match.threads = report.threads;
+  StatusOr<SculptCorrespondence> correspondence =
+      MatchRefinedSculpt(inputs.surface, inputs.sculpt, match);
+  if (!correspondence.ok()) {
+    report.t_match = clock.seconds();
+    report.mapping_reason = correspondence.status().message();
+    if (options.method == ExtractMethod::kMapping) {
+      return Status::Error(fmt::format("method mapping: {}", report.mapping_reason));
+    }
+    return CancelRequested() ? Cancelled() : Status::Ok();
+  }
+  report.mapping_levels = correspondence->levels;
+  report.mapping_max_offset = correspondence->max_offset;
+  report.mapping_rms_offset = correspondence->rms_offset;
+  DISPEX_ASSIGN_OR_RETURN(SculptMapping mapping,
+                          SculptMapping::Build(*correspondence, inputs.sculpt, inputs.faces));
+  DISPEX_RETURN_IF_ERROR(mapping.MarkFolds(inputs.surface, inputs.sculpt, inputs.faces));
+  inputs.mapping = std::make_unique<SculptMapping>(std::move(mapping));
+  report.t_match = clock.seconds();
+  report.method = ExtractMethod::kMapping;
+  return CancelRequested() ? Cancelled() : Status::Ok();
+}
+
+StatusOr<SearchDistanceEstimate> EstimateSearchDistanceMapped(const ExtractInputs& inputs,
+                                                              const CoarseSampling& coarse,
+                                                              double base_diagonal) {
+  constexpr int g = CoarseSampling::kGrid;
+  constexpr std::int64_t per_face = g * g;
+  const SearchDistanceOptions options;
+  const NormalQuery query{static_cast<float>(options.ray_fraction * base_diagonal),
+                          HitPolicy::kNearest};
+  // The points of each face, which follow one another.
+  std::vector<std::size_t> starts;
+  for (std::size_t k = 0; k < coarse.ids.size(); ++k) {
+    if (k == 0 || coarse.ids[k] / per_face != coarse.ids[k - 1] / per_face) starts.push_back(k);
+  }
+  starts.push_back(coarse.ids.size());
+  std::vector<double> abs_t(coarse.ids.size(), -1.0);  // -1: a miss or not decided
+  std::vector<std::uint8_t> decided(coarse.ids.size(), 0);
+  struct Scratch {
+    std::optional<LimitEvaluator> evaluator;
+    MappingScratch mapping;
+    MappingCounters counters;
+  };
+  tbb::enumerable_thread_specific<Scratch> scratches;
+  FirstError error;
+  tbb::parallel_for(std::size_t{0}, starts.size() - 1, [&](std::size_t group) {
+    if (error.failed()) return;
+    Scratch& w = scratches.local();
+    if (!w.evaluator) w.evaluator.emplace(inputs.surface);
+    const std::size_t begin = starts[group], end = starts[group + 1];
+    const auto face = static_cast<int>(coarse.ids[begin] / per_face);
+    float positions[3 * per_face], normals[3 * per_face], t[per_face];
+    std::uint8_t flags[per_face], undecided[per_face];
+    std::int32_t samples[per_face];
+    const Status s = w.evaluator->EvaluateGrid(PtexFaceId(face), g, g, positions, normals);
+    if (!s.ok()) return error.Record(face, s);
+    for (std::size_t k = begin; k < end; ++k) {
+      samples[k - begin] = static_cast<std::int32_t>(coarse.ids[k] % per_face);
+    }
+    TraceMapped(*inputs.mapping, inputs.sculpt, PtexFaceId(face), g,
+                std::span(samples, end - begin),
+                std::span(reinterpret_cast<const Float3*>(positions), per_face),
+                std::span(reinterpret_cast<const Float3*>(normals), per_face), query,
+                NormalHits{t, {}, flags}, undecided, w.mapping, w.counters);
+    for (std::size_t k = begin; k < end; ++k) {
+      const auto i = static_cast<std::size_t>(samples[k - begin]);
+      decided[k] = !undecided[i];
+      if (decided[k] && (flags[i] & HitFlags::kHit)) abs_t[k] = std::fabs(double(t[i]));
+    }
+  });
+  if (error.failed()) return error.status();
+  std::vector<double> hits;
+  for (double a : abs_t) {
+    if (a >= 0) hits.push_back(a);
+  }
+  const auto count = static_cast<std::size_t>(std::count(decided.begin(), decided.end(), 1));
+  return SearchDistanceFromHits(std::move(hits), count, base_diagonal, options);
+}
+
+Status TraceFallback(ExtractInputs& inputs, std::span<const int> faces) {
+  if (inputs.tracer) {
+    if (inputs.traced.empty()) return Status::Ok();
+    if (std::all_of(faces.begin(), faces.end(),
+                    [&](int f) { return inputs.traced[static_cast<std::size_t>(f)] != 0; })) {
+      return Status::Ok();
+    }
+  }
+  Stopwatch clock;
+  const auto n = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
+  std::vector<std::uint8_t> traced = inputs.tracer ? inputs.traced : std::vector<std::uint8_t>(n);
+  for (int f : faces) traced[static_cast<std::size_t>(f)] = 1;
+  const auto count = static_cast<std::size_t>(std::count(traced.begin(), traced.end(), 1));
+  inputs.tracer.reset();
+  inputs.traced_part = Mesh{};
+  if (inputs.face_keys != nullptr && 2 * count <= n) {
+    inputs.traced_part = SculptWithinReach(inputs, *inputs.face_keys, traced);
+  }
+  if (inputs.traced_part.num_faces() == 0) {
+    inputs.traced.clear();
+    DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, inputs.tracer_options));
+  } else {
+    inputs.traced = std::move(traced);
+    DISPEX_ASSIGN_OR_RETURN(inputs.tracer,
+                            MakeEmbreeTracer(inputs.traced_part, inputs.tracer_options));
+  }
+  inputs.fallback_bvh_seconds += clock.seconds();
+  return CancelRequested() ? Cancelled() : Status::Ok();
+}
+
+void ReportMapping(const ExtractInputs& inputs, const ProcessedFaces& faces,
+                   ExtractReport& report) {
+  report.mapping_fallback_samples = faces.fallback_samples;
+  report.mapping_fallback_faces = faces.fallback_faces;
+  report.t_bvh += inputs.fallback_bvh_seconds;
+  report.tracer = fmt::format("subdivision correspondence (level {})", report.mapping_levels);
+  if (!inputs.tracer) return;
+  report.tracer +=
+      fmt::format("; {} for {} samples of {} faces it left undecided",
+                  inputs.tracer->stats().backend, faces.fallback_samples, faces.fallback_faces);
+  if (!inputs.traced.empty()) {
+    report.tracer += fmt::format(", {} of {} sculpt faces", inputs.traced_part.num_faces(),
+                                 inputs.sculpt.num_faces());
+  }
+}
+
+}  // namespace dispex::extract

@@ -1,0 +1,41 @@
+// The subdivision correspondence in an extraction (ExtractOptions::method): whether the sculpt
+// is the base refined, the automatic search distance without a BVH, and the BVH built
+// afterwards for the samples the mapping leaves undecided.
+#pragma once
+
+#include <span>
+
+#include "dispex/extract.h"
+#include "dispex/status.h"
+#include "dispex/trace.h"
+#include "extract/coarse_sampling.h"
+#include "extract/extract_inputs.h"
+#include "extract/process_faces.h"
+
+namespace dispex::extract {
+
+// Under kAuto and kMapping, matches the sculpt to the base (MatchRefinedSculpt) and on a match
+// sets inputs.mapping (no BVH is built up front then). Records the method that will run and
+// the match (time, level, offsets, or why there is none) in the report. kMapping fails with
+// the match's reason; kAuto then runs rays.
+Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report);
+
+// The automatic search distance through the mapping: EstimateSearchDistance's rule (1.5 x the
+// 99.9th percentile of |t| of rays 0.15 x the base diagonal long, nearest policy) over the
+// same coarse samples, each answered through the mapping. Samples it cannot decide are left
+// out (not traced by a BVH); `samples` of the estimate counts the decided ones. Errors as
+// EstimateSearchDistance's.
+StatusOr<SearchDistanceEstimate> EstimateSearchDistanceMapped(const ExtractInputs& inputs,
+                                                              const CoarseSampling& coarse,
+                                                              double base_diagonal);
+
+// Before Ptex faces `faces` are traced by a BVH (their samples the mapping left undecided): a
+// tracer holding the sculpt within reach of them and of the faces the current tracer holds
+// (SculptWithinReach with inputs.face_keys), or of the whole sculpt when those are more than
+// half the faces or there are no keys. Their hits are those of the whole sculpt's BVH.
+Status TraceFallback(ExtractInputs& inputs, std::span<const int> faces);
+
+// The report's tracer, BVH time and fallback counts of an extraction through the mapping.
+void ReportMapping(const ExtractInputs& inputs, const ProcessedFaces& faces, ExtractReport& report);
+
+}  // namespace dispex::extract

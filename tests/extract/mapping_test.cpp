@@ -1,0 +1,527 @@
+// Scalar extraction through the subdivision correspondence (--method mapping) against the ray
+// path: the kernel sample by sample, then whole maps, the method's choice, the samples it
+// leaves to a BVH, and threads.
+//
+// The bound on t: where both methods keep the same triangle t is the same expression of the
+// same floats, bit for bit; where the line passes within rounding of an edge or of a quad's
+// diagonal, Embree and the mapping may keep the two triangles on either side of it, whose
+// planes both hold the edge, so t differs by the rounding of where the line meets it times
+// the planes' difference in slope: well under one ulp of the tracer's scale (the power of two
+// at or above the base's largest |coordinate|) on these sculpts. kUlps = 4 leaves room and
+// still rejects any other triangle (a cell apart is thousands of ulps).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "dispex/correspondence.h"
+#include "dispex/extract.h"
+#include "dispex/mesh.h"
+#include "dispex/ptex.h"
+#include "dispex/subdiv.h"
+#include "dispex/trace.h"
+#include "dispex/verify.h"
+#include "e2e_support.h"
+#include "extract/extract_inputs.h"
+#include "extract/mapping_trace.h"
+
+namespace dispex::extract {
+namespace {
+
+using dispex::testing::DataPath;
+using dispex::testing::TempDir;
+
+constexpr double kUlps = 4;
+
+double UlpOfScale(const Mesh& base) {
+  return std::ldexp(double(TracerScale(base)), -23);
+}
+
+std::string Cage(const char* name) {
+  return DataPath(std::string("meshes/opensubdiv/") + name);
+}
+
+// A refined sculpt of `cage` in `dir`.
+std::string MakeRefined(const TempDir& dir, const std::string& cage, int levels, Pattern pattern,
+                        const std::string& name = "sculpt.obj") {
+  const std::string path = dir / name;
+  auto made = MakeSculpt(dispex::testing::SculptOptions(cage, path, levels, pattern, 0));
+  EXPECT_TRUE(made.ok()) << made.status().message();
+  return path;
+}
+
+// ---- The kernel, sample by sample ------------------------------------------------------------
+
+struct KernelResult {
+  std::size_t samples = 0, decided = 0, hits = 0, same_t = 0, flags_differ = 0, hit_differs = 0;
+  double max_ulps = 0;
+};
+
+// Every face's samples at `n` per side (2^L per sub-face side when n = 0: extract's own plan is
+// 2^(L+1) on quads, 2^L on sub-faces) through TraceMapped and through the Embree tracer.
+KernelResult CompareKernel(const std::string& cage, const std::string& sculpt_path,
+                           HitPolicy policy, double distance_fraction) {
+  auto base = ReadMesh(cage);
+  auto sculpt = ReadMesh(sculpt_path);
+  EXPECT_TRUE(base.ok() && sculpt.ok());
+  auto surface = LimitSurface::Build(*base);
+  EXPECT_TRUE(surface.ok());
+  const std::vector<PtexFaceInfo> faces = PtexFaceTable(*surface);
+  auto correspondence = MatchRefinedSculpt(*surface, *sculpt);
+  EXPECT_TRUE(correspondence.ok()) << correspondence.status().message();
+  auto mapping = SculptMapping::Build(*correspondence, *sculpt, faces);
+  EXPECT_TRUE(mapping.ok()) << mapping.status().message();
+  EXPECT_TRUE(mapping->MarkFolds(*surface, *sculpt, faces).ok());
+  EXPECT_EQ(mapping->fold_risk_faces(), 0u) << "these sculpts do not fold";
+  TracerOptions options;
+  options.scale = TracerScale(*base);
+  auto tracer = MakeEmbreeTracer(*sculpt, options);
+  EXPECT_TRUE(tracer.ok());
+  const double ulp = UlpOfScale(*base);
+  const NormalQuery query{static_cast<float>(distance_fraction * ComputeBounds(*base).diagonal()),
+                          policy};
+  LimitEvaluator evaluator(*surface);
+  MappingScratch scratch;
+  MappingCounters counters;
+  TraceCounters trace_counters;
+  KernelResult r;
+  for (int f = 0; f < surface->num_ptex_faces(); ++f) {
+    if (surface->is_hole(PtexFaceId(f))) continue;
+    const int n = 2 * mapping->grid_size(f);
+    const std::size_t count = static_cast<std::size_t>(n) * n;
+    std::vector<float> pos(3 * count), nrm(3 * count), t1(count), t2(count);
+    std::vector<std::uint8_t> f1(count), f2(count), undecided(count);
+    EXPECT_TRUE(evaluator.EvaluateGrid(PtexFaceId(f), n, n, pos, nrm).ok());
+    const std::span<const Float3> o(reinterpret_cast<const Float3*>(pos.data()), count);
+    const std::span<const Float3> d(reinterpret_cast<const Float3*>(nrm.data()), count);
+    TraceMapped(*mapping, *sculpt, PtexFaceId(f), n, {}, o, d, query, NormalHits{t1, {}, f1},
+                undecided, scratch, counters);
+    (*tracer)->TraceNormals(o, d, query, NormalHits{t2, {}, f2}, trace_counters);
+    for (std::size_t k = 0; k < count; ++k) {
+      ++r.samples;
+      if (undecided[k]) continue;
+      ++r.decided;
+      const bool h1 = f1[k] & HitFlags::kHit, h2 = f2[k] & HitFlags::kHit;
+      r.hit_differs += h1 != h2;
+      if (!h1 || !h2) continue;
+      ++r.hits;
+      r.same_t += std::memcmp(&t1[k], &t2[k], sizeof(float)) == 0;
+      r.flags_differ += f1[k] != f2[k];
+      r.max_ulps = std::max(r.max_ulps, std::fabs(double(t1[k]) - double(t2[k])) / ulp);
+    }
+  }
+  return r;
+}
+
+struct KernelCase {
+  const char* name;
+  const char* cage;
+  int levels;
+  Pattern pattern;
+};
+
+void PrintTo(const KernelCase& c, std::ostream* os) {
+  *os << c.name;
+}
+
+class MappingKernel : public ::testing::TestWithParam<KernelCase> {};
+
+// Rejects: a kernel that misses a triangle the ray path hits (or the reverse), keeps another
+// triangle than the nearest, computes t with less precision than the Tracer's plane formula in
+// double (t then differs in its last bits on many samples, where here all but the ties are bit
+// for bit equal), or sets other flags; and one that leaves more than a few samples undecided
+// on sculpts with no fold (each costs a BVH).
+TEST_P(MappingKernel, AgreesWithTheRayPathSampleBySample) {
+  TempDir dir;
+  const KernelCase& c = GetParam();
+  const std::string sculpt = MakeRefined(dir, Cage(c.cage), c.levels, c.pattern);
+  for (HitPolicy policy :
+       {HitPolicy::kNearest, HitPolicy::kOutsideFirst, HitPolicy::kInsideFirst}) {
+    SCOPED_TRACE(std::string(HitPolicyName(policy)));
+    const KernelResult r = CompareKernel(Cage(c.cage), sculpt, policy, 0.05);
+    EXPECT_GE(double(r.decided), 0.97 * double(r.samples));
+    EXPECT_EQ(r.hits, r.decided) << "every decided sample hits these sculpts";
+    EXPECT_EQ(r.hit_differs, 0u);
+    EXPECT_EQ(r.flags_differ, 0u);
+    EXPECT_LE(r.max_ulps, kUlps);
+    EXPECT_GE(double(r.same_t), 0.99 * double(r.hits));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cages, MappingKernel,
+    ::testing::Values(
+        KernelCase{"quads_detail_l3", "catmark_cube.obj", 3, Pattern::kDetail},
+        KernelCase{"ngons_detail_l3", "catmark_nonquads.obj", 3, Pattern::kDetail},
+        KernelCase{"ngons_ridges_l2", "catmark_nonquads.obj", 2, Pattern::kRidges},
+        KernelCase{"boundary_ridges_l3", "catmark_edgecorner.obj", 3, Pattern::kRidges},
+        KernelCase{"holes_detail_l2", "catmark_hole_test1.obj", 2, Pattern::kDetail},
+        KernelCase{"creases_detail_l4", "catmark_cube_creases0.obj", 4, Pattern::kDetail},
+        KernelCase{"valence8_ridges_l4", "catmark_pole8.obj", 4, Pattern::kRidges}),
+    [](const auto& param_info) { return std::string(param_info.param.name); });
+
+// ---- Whole maps ------------------------------------------------------------------------------
+
+ExtractOptions Options(const std::string& base, const std::string& sculpt,
+                       const std::string& output, ExtractMethod method) {
+  ExtractOptions o;
+  o.base_path = base;
+  o.sculpt_path = sculpt;
+  o.output_path = output;
+  o.method = method;
+  o.threads = 2;
+  return o;
+}
+
+// Every face's texels of both maps: resolutions equal, and the largest |difference| (in ulps
+// of `ulp`) and how many texels differ at all.
+struct TexelComparison {
+  bool same_resolutions = true;
+  std::size_t texels = 0, differ = 0;
+  double max_ulps = 0;
+};
+
+TexelComparison CompareTexels(const std::string& a_path, const std::string& b_path, double ulp) {
+  TexelComparison c;
+  auto a = PtexFile::Open(a_path);
+  auto b = PtexFile::Open(b_path);
+  EXPECT_TRUE(a.ok() && b.ok());
+  if (!a.ok() || !b.ok() || a->num_faces() != b->num_faces()) {
+    c.same_resolutions = false;
+    return c;
+  }
+  std::vector<float> ta, tb;
+  for (int f = 0; f < a->num_faces(); ++f) {
+    EXPECT_TRUE(a->ReadFace(PtexFaceId(f), 0, ta).ok() && b->ReadFace(PtexFaceId(f), 0, tb).ok());
+    if (ta.size() != tb.size()) {
+      c.same_resolutions = false;
+      continue;
+    }
+    for (std::size_t k = 0; k < ta.size(); ++k) {
+      ++c.texels;
+      c.differ += std::memcmp(&ta[k], &tb[k], sizeof(float)) != 0;
+      c.max_ulps = std::max(c.max_ulps, std::fabs(double(ta[k]) - double(tb[k])) / ulp);
+    }
+  }
+  return c;
+}
+
+struct MapCase {
+  const char* name;
+  const char* cage;
+  int levels;
+  Pattern pattern;
+  HitPolicy policy = HitPolicy::kNearest;
+};
+
+void PrintTo(const MapCase& c, std::ostream* os) {
+  *os << c.name;
+}
+
+class MappingMaps : public ::testing::TestWithParam<MapCase> {};
+
+// Every texel a sample (a fixed 2^(L+1) samples per side and the same fixed resolution, holes
+// zero): the maps of both methods agree texel by texel within kUlps. Rejects a mapping path
+// that answers any sample differently from the ray path (another triangle, a miss, a hole
+// filled differently), in the first pass or the second search.
+TEST_P(MappingMaps, EveryTexelAgreesWithTheRayMap) {
+  TempDir dir;
+  const MapCase& c = GetParam();
+  const std::string cage = Cage(c.cage);
+  const std::string sculpt = MakeRefined(dir, cage, c.levels, c.pattern);
+  auto base = ReadMesh(cage);
+  ASSERT_TRUE(base.ok());
+  std::string paths[2];
+  ExtractReport reports[2];
+  for (int m = 0; m < 2; ++m) {
+    const ExtractMethod method = m == 0 ? ExtractMethod::kMapping : ExtractMethod::kRays;
+    paths[m] = dir / (m == 0 ? "mapping.ptx" : "rays.ptx");
+    ExtractOptions o = Options(cage, sculpt, paths[m], method);
+    o.ray_policy = c.policy;
+    o.oversample = 1 << (c.levels + 1);
+    o.resolution_rule = ResolutionRule::kFixed;
+    o.fixed_ulog2 = o.fixed_vlog2 = c.levels + 1;
+    o.holes = HolePolicy::kZero;
+    auto report = Extract(o);
+    ASSERT_TRUE(report.ok()) << report.status().message();
+    reports[m] = *report;
+  }
+  EXPECT_EQ(reports[0].method, ExtractMethod::kMapping);
+  EXPECT_EQ(reports[0].mapping_levels, c.levels);
+  EXPECT_EQ(reports[1].method, ExtractMethod::kRays);
+  // The same automatic search distance: the same long rays, answered both ways.
+  EXPECT_EQ(reports[0].search_distance, reports[1].search_distance);
+  EXPECT_EQ(reports[0].misses, reports[1].misses);
+  EXPECT_EQ(reports[0].hits_negative, reports[1].hits_negative);
+  EXPECT_EQ(reports[0].hits_opposed, reports[1].hits_opposed);
+  EXPECT_LE(reports[0].rays_cast, reports[1].rays_cast / 10) << "the mapping cast many rays";
+  const TexelComparison t = CompareTexels(paths[0], paths[1], UlpOfScale(*base));
+  EXPECT_TRUE(t.same_resolutions);
+  EXPECT_GT(t.texels, 0u);
+  EXPECT_LE(t.max_ulps, kUlps) << t.differ << " of " << t.texels << " texels differ";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cages, MappingMaps,
+    ::testing::Values(MapCase{"quads_detail_l2", "catmark_cube.obj", 2, Pattern::kDetail},
+                      MapCase{"ngons_detail_l3", "catmark_nonquads.obj", 3, Pattern::kDetail},
+                      MapCase{"boundary_ridges_l3", "catmark_edgecorner.obj", 3, Pattern::kRidges},
+                      MapCase{"holes_detail_l3", "catmark_hole_test1.obj", 3, Pattern::kDetail},
+                      MapCase{"creases_ridges_l4", "catmark_cube_creases0.obj", 4,
+                              Pattern::kRidges},
+                      MapCase{"ngons_outside_first", "catmark_nonquads.obj", 2, Pattern::kRidges,
+                              HitPolicy::kOutsideFirst},
+                      MapCase{"boundary_inside_first", "catmark_edgecorner.obj", 2,
+                              Pattern::kDetail, HitPolicy::kInsideFirst}),
+    [](const auto& param_info) { return std::string(param_info.param.name); });
+
+// The default options (error bound, watertight edges, automatic search distance and
+// oversampling): every face at the resolution the ray map gives it, every texel within kUlps
+// of the ray map's. Not byte for byte: a sample whose line passes within rounding of a quad's
+// diagonal or a shared edge (on these symmetric cages, samples a quarter cell from a cell's
+// corner on flat parts: exactly on its diagonal in (u, v)) takes its t from the other triangle
+// than Embree's, the same plane through the edge to rounding; faces stored at their full sample
+// resolution hold those samples as they are, others a linear resampling of them. Rejects any
+// other difference: a resolution chosen differently, a texel beyond rounding, a search distance
+// or a second search that differs.
+TEST(MappingMaps, DefaultMapsAgreeWithTheRayMaps) {
+  for (const MapCase& c : {MapCase{"ngons", "catmark_nonquads.obj", 3, Pattern::kDetail},
+                           MapCase{"creases", "catmark_cube_creases0.obj", 3, Pattern::kRidges},
+                           MapCase{"holes", "catmark_hole_test1.obj", 3, Pattern::kDetail}}) {
+    SCOPED_TRACE(c.name);
+    TempDir dir;
+    const std::string cage = Cage(c.cage);
+    const std::string sculpt = MakeRefined(dir, cage, c.levels, c.pattern);
+    auto base = ReadMesh(cage);
+    ASSERT_TRUE(base.ok());
+    auto mapping = Extract(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kAuto));
+    auto rays = Extract(Options(cage, sculpt, dir / "rays.ptx", ExtractMethod::kRays));
+    ASSERT_TRUE(mapping.ok() && rays.ok())
+        << (mapping.ok() ? rays.status().message() : mapping.status().message());
+    EXPECT_EQ(mapping->method, ExtractMethod::kMapping);
+    EXPECT_EQ(mapping->search_distance, rays->search_distance);
+    EXPECT_EQ(mapping->spectral.texels_after, rays->spectral.texels_after);
+    EXPECT_EQ(mapping->edge_raised_faces, rays->edge_raised_faces);
+    const TexelComparison t =
+        CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
+    EXPECT_TRUE(t.same_resolutions);
+    EXPECT_LE(t.max_ulps, kUlps) << t.differ << " of " << t.texels << " texels differ";
+  }
+}
+
+// ---- Choosing the method -----------------------------------------------------------------------
+
+// Rejects: auto using the mapping on a sculpt that is not the base refined (or failing on
+// it), mapping not failing there, or failing without the match's reason.
+TEST(MappingMethod, AutoFallsBackToRaysAndMappingFailsWithTheReason) {
+  TempDir dir;
+  const std::string cage = Cage("catmark_nonquads.obj");
+  const std::string sculpt = dir / "jittered.obj";
+  ASSERT_TRUE(
+      MakeSculpt(dispex::testing::JitteredSculptOptions(cage, sculpt, 8, Pattern::kDetail, 0))
+          .ok());
+  auto automatic = Extract(Options(cage, sculpt, dir / "auto.ptx", ExtractMethod::kAuto));
+  ASSERT_TRUE(automatic.ok()) << automatic.status().message();
+  EXPECT_EQ(automatic->method, ExtractMethod::kRays);
+  EXPECT_EQ(automatic->mapping_levels, -1);
+  EXPECT_NE(automatic->mapping_reason.find("only quads"), std::string::npos)
+      << automatic->mapping_reason;
+  const nlohmann::json json = nlohmann::json::parse(ExtractReportJson(*automatic));
+  EXPECT_EQ(json["method"]["used"], "rays");
+
+  auto forced = Extract(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kMapping));
+  ASSERT_FALSE(forced.ok());
+  EXPECT_EQ(forced.status().message(), "method mapping: " + automatic->mapping_reason);
+  EXPECT_EQ(forced.status().message().find('\n'), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir / "mapping.ptx"));
+
+  // Rays on a refined sculpt when asked, and the option recorded only when given.
+  const std::string refined = MakeRefined(dir, cage, 2, Pattern::kSmooth, "refined.obj");
+  auto rays = Extract(Options(cage, refined, dir / "rays.ptx", ExtractMethod::kRays));
+  ASSERT_TRUE(rays.ok());
+  EXPECT_EQ(rays->method, ExtractMethod::kRays);
+  EXPECT_EQ(rays->t_match, 0.0);
+  auto chosen = Extract(Options(cage, refined, dir / "chosen.ptx", ExtractMethod::kAuto));
+  ASSERT_TRUE(chosen.ok());
+  EXPECT_EQ(chosen->method, ExtractMethod::kMapping);
+  auto options_of = [](const std::string& path) {
+    auto map = PtexFile::Open(path);
+    EXPECT_TRUE(map.ok());
+    return nlohmann::json::parse(map->FindMetaData("dispex:options")->AsString());
+  };
+  EXPECT_FALSE(options_of(dir / "chosen.ptx").contains("method"));
+  EXPECT_EQ(options_of(dir / "rays.ptx")["method"], "rays");
+  auto statistics = PtexFile::Open(dir / "chosen.ptx");
+  ASSERT_TRUE(statistics.ok());
+  EXPECT_EQ(
+      nlohmann::json::parse(statistics->FindMetaData("dispex:statistics")->AsString())["method"],
+      "mapping");
+}
+
+// Rejects a name table that loses a method, and a parser that takes what it should not.
+TEST(MappingMethod, NamesRoundTrip) {
+  for (ExtractMethod m : {ExtractMethod::kAuto, ExtractMethod::kRays, ExtractMethod::kMapping}) {
+    auto parsed = ParseExtractMethod(ExtractMethodName(m));
+    ASSERT_TRUE(parsed.ok());
+    EXPECT_EQ(*parsed, m);
+  }
+  auto bad = ParseExtractMethod("bvh");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("auto, rays or mapping"), std::string::npos);
+}
+
+// Rejects a manifest that ignores "method" or accepts an unknown one.
+TEST(MappingMethod, ManifestOption) {
+  TempDir dir;
+  const std::string cage = Cage("catmark_cube.obj");
+  std::ofstream(dir / "manifest.json")
+      << R"({"output_dir": "maps", "options": {"method": "rays"}, "shapes": [)"
+      << R"({"name": "a", "base": ")" << cage << R"(", "sculpt": ")" << cage
+      << R"(", "options": {"method": "mapping"}}, {"name": "b", "base": ")" << cage
+      << R"(", "sculpt": ")" << cage << R"("}]})";
+  auto manifest = ReadExtractManifest(dir / "manifest.json", ExtractAssetOptions{});
+  ASSERT_TRUE(manifest.ok()) << manifest.status().message();
+  ASSERT_EQ(manifest->manifest.size(), 2u);
+  EXPECT_EQ(manifest->manifest[0].options.method, ExtractMethod::kMapping);
+  EXPECT_EQ(manifest->manifest[1].options.method, ExtractMethod::kRays);
+  std::ofstream(dir / "bad.json") << R"({"output_dir": "maps", "options": {"method": "bvh"},)"
+                                  << R"( "shapes": [{"name": "a", "base": ")" << cage
+                                  << R"(", "sculpt": ")" << cage << R"("}]})";
+  auto bad = ReadExtractManifest(dir / "bad.json", ExtractAssetOptions{});
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("method"), std::string::npos) << bad.status().message();
+}
+
+// ---- Samples the rings do not decide ------------------------------------------------------------
+
+// The sculpt turned about the z axis by `degrees`: its vertices move along the (nearly
+// spherical) surface, several cells near the equator, so the hits of those samples lie outside
+// the rings around their cells; the topology and the match stay.
+std::string Turned(const TempDir& dir, const std::string& sculpt_path, double degrees) {
+  auto sculpt = ReadMesh(sculpt_path);
+  EXPECT_TRUE(sculpt.ok());
+  const double a = degrees * M_PI / 180, c = std::cos(a), s = std::sin(a);
+  for (Float3& p : sculpt->positions) {
+    const double x = p.x, y = p.y;
+    p.x = static_cast<float>(c * x - s * y);
+    p.y = static_cast<float>(s * x + c * y);
+  }
+  const std::string path = dir / "turned.obj";
+  EXPECT_TRUE(WriteObj(path, *sculpt).ok());
+  return path;
+}
+
+// Rejects: a mapping that decides samples whose hits lie beyond its rings (the maps differ),
+// one that does not count the samples it leaves to the BVH, and a fallback that depends on the
+// thread count (the maps of 1 and 2 threads differ).
+TEST(MappingFallback, HitsBeyondTheRingsGoToABvhAndTheMapEqualsTheRayMap) {
+  TempDir dir;
+  const std::string cage = Cage("catmark_cube.obj");
+  const std::string sculpt = Turned(dir, MakeRefined(dir, cage, 4, Pattern::kSmooth), 25);
+  auto base = ReadMesh(cage);
+  ASSERT_TRUE(base.ok());
+  auto fixed = [&](ExtractOptions o) {
+    o.oversample = 32;
+    o.resolution_rule = ResolutionRule::kFixed;
+    o.fixed_ulog2 = o.fixed_vlog2 = 5;
+    o.holes = HolePolicy::kZero;
+    o.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.3};
+    return o;
+  };
+  auto mapping =
+      Extract(fixed(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kMapping)));
+  ASSERT_TRUE(mapping.ok()) << mapping.status().message();
+  auto rays = Extract(fixed(Options(cage, sculpt, dir / "rays.ptx", ExtractMethod::kRays)));
+  ASSERT_TRUE(rays.ok()) << rays.status().message();
+  EXPECT_EQ(mapping->method, ExtractMethod::kMapping);
+  EXPECT_GT(mapping->mapping_fallback_samples, 0);
+  EXPECT_GT(mapping->mapping_fallback_faces, 0);
+  EXPECT_LT(mapping->mapping_fallback_samples, mapping->samples);
+  EXPECT_GE(mapping->rays_cast, static_cast<std::uint64_t>(mapping->mapping_fallback_samples));
+  EXPECT_NE(mapping->tracer.find("left undecided"), std::string::npos) << mapping->tracer;
+  EXPECT_EQ(mapping->misses, rays->misses);
+  const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
+  EXPECT_TRUE(t.same_resolutions);
+  EXPECT_LE(t.max_ulps, kUlps) << t.differ << " of " << t.texels << " texels differ";
+
+  ExtractOptions one = fixed(Options(cage, sculpt, dir / "one.ptx", ExtractMethod::kMapping));
+  one.threads = 1;
+  auto single = Extract(one);
+  ASSERT_TRUE(single.ok());
+  EXPECT_EQ(single->mapping_fallback_samples, mapping->mapping_fallback_samples);
+  EXPECT_EQ(single->mapping_fallback_faces, mapping->mapping_fallback_faces);
+  EXPECT_EQ(dispex::testing::Slurp(dir / "one.ptx"), dispex::testing::Slurp(dir / "mapping.ptx"));
+}
+
+// The default pipeline (edge pass, automatic distances) on the same sculpt at 1 and 2 threads:
+// byte-identical files. Rejects any dependence on scheduling in the mapping, its fallback or
+// the re-extraction of raised faces through it.
+TEST(MappingFallback, DefaultPipelineIsTheSameAtAnyThreadCount) {
+  TempDir dir;
+  const std::string cage = Cage("catmark_cube.obj");
+  const std::string sculpt = Turned(dir, MakeRefined(dir, cage, 3, Pattern::kDetail), 10);
+  ExtractOptions two = Options(cage, sculpt, dir / "two.ptx", ExtractMethod::kMapping);
+  ExtractOptions one = Options(cage, sculpt, dir / "one.ptx", ExtractMethod::kMapping);
+  one.threads = 1;
+  auto a = Extract(two);
+  auto b = Extract(one);
+  ASSERT_TRUE(a.ok() && b.ok()) << (a.ok() ? b.status().message() : a.status().message());
+  EXPECT_EQ(a->method, ExtractMethod::kMapping);
+  EXPECT_EQ(a->mapping_fallback_samples, b->mapping_fallback_samples);
+  EXPECT_EQ(dispex::testing::Slurp(dir / "one.ptx"), dispex::testing::Slurp(dir / "two.ptx"));
+}
+
+// Spot at level 3 with the detail pattern folds (MakeSculpt counts quads turned over): the faces
+// around the folds go to the BVH whole. Rejects a fold check that never fires, and a map that
+// then differs from the ray map in any face's resolution or beyond a few texels (the samples a
+// sheet from farther away reaches over, outside the faces marked, keep the mapping's own hit).
+TEST(MappingFallback, FoldsGoToTheBvh) {
+  TempDir dir;
+  const std::string cage = DataPath("meshes/keenan_spot/spot_quadrangulated.obj");
+  const std::string sculpt = dir / "sculpt.obj";
+  auto made = MakeSculpt(dispex::testing::SculptOptions(cage, sculpt, 3, Pattern::kDetail, 0));
+  ASSERT_TRUE(made.ok());
+  ASSERT_GT(made->folded_faces, 0u);
+  auto mapping = Extract(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kMapping));
+  auto rays = Extract(Options(cage, sculpt, dir / "rays.ptx", ExtractMethod::kRays));
+  ASSERT_TRUE(mapping.ok() && rays.ok());
+  EXPECT_GT(mapping->mapping_fallback_faces, 0);
+  const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", 1.0);
+  EXPECT_TRUE(t.same_resolutions);
+  EXPECT_LE(t.differ, t.texels / 1000) << t.differ << " of " << t.texels << " texels differ";
+}
+
+// ---- The command line -----------------------------------------------------------------------
+
+// Rejects a --method the command line does not take, or one whose failure is not one line.
+TEST(MappingCli, MethodFlag) {
+  TempDir dir;
+  const std::string cage = Cage("catmark_cube.obj");
+  const std::string sculpt = MakeRefined(dir, cage, 2, Pattern::kSmooth);
+  auto ok = dispex::testing::RunDispex("extract " + cage + " " + sculpt + " -o " + (dir / "m.ptx") +
+                                           " --method mapping -q " + "--report " + (dir / "r.json"),
+                                       dir);
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+  const nlohmann::json report = nlohmann::json::parse(dispex::testing::Slurp(dir / "r.json"));
+  EXPECT_EQ(report["method"]["used"], "mapping");
+  EXPECT_EQ(report["method"]["levels"], 2);
+  auto bad = dispex::testing::RunDispex(
+      "extract " + cage + " " + sculpt + " -o " + (dir / "b.ptx") + " --method bvh", dir);
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.err.find("auto, rays or mapping"), std::string::npos) << bad.err;
+  auto unmatched =
+      dispex::testing::RunDispex("extract " + cage + " " + Cage("catmark_nonquads.obj") + " -o " +
+                                     (dir / "u.ptx") + " --method mapping",
+                                 dir);
+  EXPECT_EQ(unmatched.exit_code, 1) << unmatched.err;
+  EXPECT_EQ(std::count(unmatched.err.begin(), unmatched.err.end(), '\n'), 1) << unmatched.err;
+  EXPECT_NE(unmatched.err.find("method mapping: "), std::string::npos) << unmatched.err;
+}
+
+}  // namespace
+}  // namespace dispex::extract
