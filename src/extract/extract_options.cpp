@@ -112,6 +112,10 @@ Status ValidateExtractOptions(const ExtractOptions& o) {
         fmt::format("max_miss_fraction = {}: must be in [0, 1]", o.max_miss_fraction));
   }
   if (o.threads < 0) return Status::Error(fmt::format("threads = {}: must be >= 0", o.threads));
+  if (o.vector && o.method == ExtractMethod::kRays) {
+    return Status::Error(
+        "method = rays: a vector map reads the sculpt through its correspondence, not rays");
+  }
   SpectralOptions spectral;
   spectral.rule = o.resolution_rule;
   spectral.tolerance = o.tolerance > 0 ? o.tolerance : 1.0;

@@ -95,8 +95,9 @@ Status SampleFace(PtexFaceId face, int n, VectorSpace space, const ExtractInputs
 float ParametricScale(const VectorScratch& w) {
   double s2 = 0;
   for (std::size_t k = 0; k + 2 < w.du.size(); k += 3) {
-    s2 = std::max({s2, static_cast<double>(w.du[k]) * w.du[k] + w.du[k + 1] * w.du[k + 1] +
-                           w.du[k + 2] * w.du[k + 2],
+    s2 = std::max({s2,
+                   static_cast<double>(w.du[k]) * w.du[k] + w.du[k + 1] * w.du[k + 1] +
+                       w.du[k + 2] * w.du[k + 2],
                    static_cast<double>(w.dv[k]) * w.dv[k] + w.dv[k + 1] * w.dv[k + 1] +
                        w.dv[k + 2] * w.dv[k + 2]});
   }
@@ -147,9 +148,8 @@ Status ProcessVectorFace(PtexFaceId face, VectorSpace space, const ExtractInputs
   stats.vlog2 = static_cast<std::int8_t>(analysed->vlog2);
   ThreadCpuStopwatch write_clock;
   const PtexFaceInfo info = FaceInfo(inputs, face, analysed->ulog2, analysed->vlog2);
-  Status written = analysed->constant
-                       ? writer.SetConstantFace(face, info, analysed->constant_value)
-                       : writer.SetFace(face, info, texels);
+  Status written = analysed->constant ? writer.SetConstantFace(face, info, analysed->constant_value)
+                                      : writer.SetFace(face, info, texels);
   w.cpu_write += write_clock.seconds();
   return written;
 }
@@ -165,19 +165,18 @@ Status ProcessVectorFaces(const ExtractOptions& options, const ExtractInputs& in
       [&] { return VectorScratch(inputs.surface); });
   Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", options.progress);
   FirstError error;
-  tbb::parallel_for(tbb::blocked_range<int>(0, num_faces, 1),
-                    [&](const tbb::blocked_range<int>& range) {
-                      VectorScratch& w = scratches.local();
-                      for (int f = range.begin(); f != range.end(); ++f) {
-                        if (error.failed()) return;
-                        if (CancelRequested()) return error.Record(-1, Cancelled());
-                        Status s = ProcessVectorFace(PtexFaceId(f), space, inputs, settings,
-                                                     correspondence, writer, w,
-                                                     stats[static_cast<std::size_t>(f)]);
-                        if (!s.ok()) return error.Record(f, s);
-                        bar.Advance();
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, num_faces, 1), [&](const tbb::blocked_range<int>& range) {
+        VectorScratch& w = scratches.local();
+        for (int f = range.begin(); f != range.end(); ++f) {
+          if (error.failed()) return;
+          if (CancelRequested()) return error.Record(-1, Cancelled());
+          Status s = ProcessVectorFace(PtexFaceId(f), space, inputs, settings, correspondence,
+                                       writer, w, stats[static_cast<std::size_t>(f)]);
+          if (!s.ok()) return error.Record(f, s);
+          bar.Advance();
+        }
+      });
   bar.Finish();
   if (error.failed()) return error.status();
   for (const VectorScratch& w : scratches) {
@@ -202,10 +201,10 @@ void SumVectorFaces(const ExtractInputs& inputs, const ExtractSettings& settings
     report.samples += r.samples;
     report.spectral.Add(r.spectral, r.ulog2, r.vlog2);
     sum_squares += r.sum_squares;
-    report.displacement_min = first ? r.normal_min : std::min<double>(report.displacement_min,
-                                                                      r.normal_min);
-    report.displacement_max = first ? r.normal_max : std::max<double>(report.displacement_max,
-                                                                      r.normal_max);
+    report.displacement_min =
+        first ? r.normal_min : std::min<double>(report.displacement_min, r.normal_min);
+    report.displacement_max =
+        first ? r.normal_max : std::max<double>(report.displacement_max, r.normal_max);
     report.vector_length_max = std::max(report.vector_length_max, r.length_max);
     report.vector_tangential_max = std::max(report.vector_tangential_max, r.tangential_max);
     first = false;
@@ -235,8 +234,8 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
   MatchOptions match;
   match.threads = report.threads;
   if (options.search_distance.kind != SearchDistanceSpec::Kind::kAuto) {
-    DISPEX_ASSIGN_OR_RETURN(match.max_offset, ResolveSearchDistance(options.search_distance,
-                                                                    report.base_diagonal));
+    DISPEX_ASSIGN_OR_RETURN(match.max_offset,
+                            ResolveSearchDistance(options.search_distance, report.base_diagonal));
   }
   auto correspondence = MatchRefinedSculpt(inputs.surface, inputs.sculpt, match);
   if (!correspondence.ok()) {
@@ -258,16 +257,15 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
   std::vector<VectorFaceStats> stats;
   DISPEX_RETURN_IF_ERROR(
       ProcessVectorFaces(options, inputs, settings, *correspondence, writer, stats, report));
-  report.faces_extracted =
-      inputs.surface.num_ptex_faces() - inputs.surface.stats().hole_ptex_faces;
+  report.faces_extracted = inputs.surface.num_ptex_faces() - inputs.surface.stats().hole_ptex_faces;
   report.t_sample_trace = faces_clock.seconds();
   SumVectorFaces(inputs, settings, stats, report);
 
   Stopwatch write_clock;
   DISPEX_RETURN_IF_ERROR(AddExtractMetaData(writer, inputs.base, report, {}, {}, {}));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData(std::string(kVectorSpaceMetaKey), report.vector_space));
-  DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
-      std::string(kVectorChannelsMetaKey), std::string(VectorSpaceChannels(*options.vector))));
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData(std::string(kVectorChannelsMetaKey),
+                                            std::string(VectorSpaceChannels(*options.vector))));
   DISPEX_RETURN_IF_ERROR(
       writer.AddMetaData("dispex:frame", std::string(VectorSpaceFrame(*options.vector))));
   if (CancelRequested()) return Cancelled();

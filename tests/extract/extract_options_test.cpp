@@ -40,6 +40,11 @@ TEST(ExtractOptions, MessagesNameTheFieldNotAFlag) {
       {"data_type", [](ExtractOptions& o) { o.data_type = PtexDataType::kUint8; }},
       {"max_miss_fraction = 2", [](ExtractOptions& o) { o.max_miss_fraction = 2; }},
       {"threads = -1", [](ExtractOptions& o) { o.threads = -1; }},
+      {"method = rays",
+       [](ExtractOptions& o) {
+         o.vector = VectorSpace::kTangent;
+         o.method = ExtractMethod::kRays;
+       }},
   };
   for (const auto& c : cases) {
     ExtractOptions o = Valid();

@@ -47,7 +47,7 @@ ReferenceGrid BuildReference(const LimitSurface& surface, int levels, const Mesh
   for (int f = 0; f < surface.num_ptex_faces(); ++f) {
     ref.cells[static_cast<std::size_t>(f)] =
         surface.num_ptex_faces(surface.base_face(PtexFaceId(f))) == 1 ? 1 << levels
-                                                                     : 1 << (levels - 1);
+                                                                      : 1 << (levels - 1);
   }
   for (std::size_t q = 0; q < refined->mesh.num_faces(); ++q) {
     const int f = refined->face_ptex[q].value;
@@ -65,7 +65,8 @@ ReferenceGrid BuildReference(const LimitSurface& surface, int levels, const Mesh
 Float3 ExpectedD(const ReferenceGrid& ref, const Mesh& sculpt, LimitEvaluator& eval, int face,
                  float u, float v) {
   const int n = ref.cells[static_cast<std::size_t>(face)];
-  const int i = std::min(static_cast<int>(u * n), n - 1), j = std::min(static_cast<int>(v * n), n - 1);
+  const int i = std::min(static_cast<int>(u * n), n - 1),
+            j = std::min(static_cast<int>(v * n), n - 1);
   const double s = u * n - i, t = v * n - j;
   auto at = [&](int di, int dj) { return sculpt.positions[ref.vertex.at({face, i + di, j + dj})]; };
   const Float3 a = at(0, 0), b = at(1, 0), c = at(1, 1), d = at(0, 1);
@@ -89,8 +90,8 @@ Float3 MapD(const PtexFile& map, VectorSpace space, LimitEvaluator& eval, int fa
   EXPECT_TRUE(eval.EvaluatePointFrames(PtexFaceId(face), uv, {p, n, du, dv}).ok());
   const float c[3] = {map.Sample(PtexFaceId(face), u, v, 0), map.Sample(PtexFaceId(face), u, v, 1),
                       map.Sample(PtexFaceId(face), u, v, 2)};
-  return VectorFromChannels(space, {{du[0], du[1], du[2]}, {dv[0], dv[1], dv[2]}, {n[0], n[1], n[2]}},
-                            c);
+  return VectorFromChannels(space,
+                            {{du[0], du[1], du[2]}, {dv[0], dv[1], dv[2]}, {n[0], n[1], n[2]}}, c);
 }
 
 double Distance(const Float3& a, const Float3& b) {
@@ -154,7 +155,8 @@ class VectorMapTest : public ::testing::TestWithParam<Case> {
 
 TEST_P(VectorMapTest, FullResolutionHoldsTheSculptAtEverySample) {
   const int samples = 2 << GetParam().levels;
-  for (VectorSpace space : {VectorSpace::kTangent, VectorSpace::kParametric, VectorSpace::kObject}) {
+  for (VectorSpace space :
+       {VectorSpace::kTangent, VectorSpace::kParametric, VectorSpace::kObject}) {
     ExtractOptions o = Options(space);
     o.oversample = samples;
     o.resolution_rule = ResolutionRule::kFixed;
@@ -257,8 +259,7 @@ TEST(VectorMapErrors, SculptThatIsNotARefinementFailsAndWritesNothing) {
 TEST(VectorMapDeterminism, SameBytesAtAnyThreadCount) {
   TempDir dir;
   const std::string cage = DataPath("meshes/opensubdiv/catmark_nonquads.obj");
-  ASSERT_TRUE(
-      MakeSculpt(SculptOptions(cage, dir / "sculpt.obj", 3, Pattern::kDetail, 0.02)).ok());
+  ASSERT_TRUE(MakeSculpt(SculptOptions(cage, dir / "sculpt.obj", 3, Pattern::kDetail, 0.02)).ok());
   std::string bytes[2];
   for (int k = 0; k < 2; ++k) {
     ExtractOptions o;
