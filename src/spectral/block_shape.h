@@ -19,6 +19,16 @@ struct BlockShape {
 // 1..kMaxSpectralSize.
 StatusOr<BlockShape> MakeBlockShape(int nx, int ny);
 
+// The shape of 2^lx x 2^ly, unchecked (lx, ly in 0..9).
+inline BlockShape ShapeOfLog2(int lx, int ly) {
+  BlockShape shape;
+  shape.lx = lx;
+  shape.ly = ly;
+  shape.nx = 1 << lx;
+  shape.ny = 1 << ly;
+  return shape;
+}
+
 // The shape of a 2^ulog2 x 2^vlog2 texel grid, or an error naming the log2 outside 0..9.
 StatusOr<BlockShape> MakeTexelShape(int ulog2, int vlog2);
 

@@ -21,19 +21,11 @@
 namespace dispex {
 
 using spectral::BlockShape;
+using spectral::ShapeOfLog2;
 
 namespace {
 
 constexpr int kChannels = 3;
-
-BlockShape ShapeOfLog2(int lx, int ly) {
-  BlockShape shape;
-  shape.lx = lx;
-  shape.ly = ly;
-  shape.nx = 1 << lx;
-  shape.ny = 1 << ly;
-  return shape;
-}
 
 }  // namespace
 
