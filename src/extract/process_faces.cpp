@@ -16,13 +16,6 @@ namespace dispex::extract {
 
 namespace {
 
-PtexFaceInfo FaceInfo(const ExtractInputs& inputs, PtexFaceId face, int ulog2, int vlog2) {
-  PtexFaceInfo info = inputs.faces[static_cast<std::size_t>(face.value)];
-  info.ulog2 = static_cast<std::int8_t>(ulog2);
-  info.vlog2 = static_cast<std::int8_t>(vlog2);
-  return info;
-}
-
 // A face that missed entirely is written later, once its neighbours are known.
 Status WriteFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFaceId face,
                  const FaceResult& result) {
@@ -76,28 +69,14 @@ KeptFace Keep(const FaceResult& result, PtexDataType type) {
   return kept;
 }
 
-// In parallel over `count` items, item k being face face_of(k); the error of the lowest face.
-template <class FaceOf, class Work>
-Status ForEachFace(int count, FaceOf face_of,
-                   tbb::enumerable_thread_specific<FaceScratch>& scratches, Progress* bar,
-                   Work work) {
-  FirstError error;
-  tbb::parallel_for(tbb::blocked_range<int>(0, count, 1),
-                    [&](const tbb::blocked_range<int>& range) {
-                      FaceScratch& w = scratches.local();
-                      for (int k = range.begin(); k != range.end(); ++k) {
-                        const int f = face_of(k);
-                        if (error.failed()) return;
-                        if (CancelRequested()) return error.Record(-1, Cancelled());
-                        Status s = work(PtexFaceId(f), w);
-                        if (!s.ok()) return error.Record(f, s);
-                        if (bar) bar->Advance();
-                      }
-                    });
-  return error.failed() ? error.status() : Status::Ok();
-}
-
 }  // namespace
+
+PtexFaceInfo FaceInfo(const ExtractInputs& inputs, PtexFaceId face, int ulog2, int vlog2) {
+  PtexFaceInfo info = inputs.faces[static_cast<std::size_t>(face.value)];
+  info.ulog2 = static_cast<std::int8_t>(ulog2);
+  info.vlog2 = static_cast<std::int8_t>(vlog2);
+  return info;
+}
 
 Status WriteConstantFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFaceId face,
                          float value) {

@@ -67,6 +67,9 @@ Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
 Status WriteKeptFaces(PtexWriter& writer, const ExtractInputs& inputs,
                       const ProcessedFaces& processed);
 
+// The map's record of `face` (numbering, adjacency) at 2^ulog2 x 2^vlog2 texels.
+PtexFaceInfo FaceInfo(const ExtractInputs& inputs, PtexFaceId face, int ulog2, int vlog2);
+
 // Writes a constant face with the face table's adjacency.
 Status WriteConstantFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFaceId face,
                          float value);

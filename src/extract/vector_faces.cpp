@@ -19,6 +19,7 @@
 #include "extract/extract_meta.h"
 #include "extract/extract_settings.h"
 #include "extract/parallel_errors.h"
+#include "extract/process_faces.h"
 
 namespace dispex::extract {
 
@@ -42,13 +43,6 @@ struct VectorScratch {
   std::vector<float> positions, normals, du, dv, channels, texels;
   double cpu_limit = 0, cpu_spectral = 0, cpu_write = 0;
 };
-
-PtexFaceInfo FaceInfo(const ExtractInputs& inputs, PtexFaceId face, int ulog2, int vlog2) {
-  PtexFaceInfo info = inputs.faces[static_cast<std::size_t>(face.value)];
-  info.ulog2 = static_cast<std::int8_t>(ulog2);
-  info.vlog2 = static_cast<std::int8_t>(vlog2);
-  return info;
-}
 
 // D at the face's n x n texel centres, in the map's space, into w.channels.
 Status SampleFace(PtexFaceId face, int n, VectorSpace space, const ExtractInputs& inputs,
@@ -164,21 +158,14 @@ Status ProcessVectorFaces(const ExtractOptions& options, const ExtractInputs& in
   tbb::enumerable_thread_specific<VectorScratch> scratches(
       [&] { return VectorScratch(inputs.surface); });
   Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", options.progress);
-  FirstError error;
-  tbb::parallel_for(
-      tbb::blocked_range<int>(0, num_faces, 1), [&](const tbb::blocked_range<int>& range) {
-        VectorScratch& w = scratches.local();
-        for (int f = range.begin(); f != range.end(); ++f) {
-          if (error.failed()) return;
-          if (CancelRequested()) return error.Record(-1, Cancelled());
-          Status s = ProcessVectorFace(PtexFaceId(f), space, inputs, settings, correspondence,
-                                       writer, w, stats[static_cast<std::size_t>(f)]);
-          if (!s.ok()) return error.Record(f, s);
-          bar.Advance();
-        }
+  Status status = ForEachFace(
+      num_faces, [](int k) { return k; }, scratches, &bar,
+      [&](PtexFaceId face, VectorScratch& w) {
+        return ProcessVectorFace(face, space, inputs, settings, correspondence, writer, w,
+                                 stats[static_cast<std::size_t>(face.value)]);
       });
   bar.Finish();
-  if (error.failed()) return error.status();
+  DISPEX_RETURN_IF_ERROR(status);
   for (const VectorScratch& w : scratches) {
     report.cpu_limit += w.cpu_limit;
     report.cpu_spectral += w.cpu_spectral;

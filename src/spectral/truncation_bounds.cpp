@@ -76,19 +76,7 @@ double TruncationBounds::Bound(int kx, int ky) const {
 }
 
 std::pair<int, int> TruncationBounds::Smallest(double tolerance) const {
-  for (int texels_log2 = 0; texels_log2 <= lx_ + ly_; ++texels_log2) {
-    int best_kx = -1;
-    double best_bound = 0;
-    for (int kx = std::max(0, texels_log2 - ly_); kx <= std::min(lx_, texels_log2); ++kx) {
-      const double bound = Bound(kx, texels_log2 - kx);
-      if (bound <= tolerance && (best_kx < 0 || bound < best_bound)) {
-        best_kx = kx;
-        best_bound = bound;
-      }
-    }
-    if (best_kx >= 0) return {best_kx, texels_log2 - best_kx};
-  }
-  return {lx_, ly_};
+  return SmallestWithin(lx_, ly_, tolerance, [this](int kx, int ky) { return Bound(kx, ky); });
 }
 
 }  // namespace dispex::spectral

@@ -12,6 +12,7 @@
 // table give every E(2^kx, 2^ky) as a sum of non-negative terms (no cancellation).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <utility>
 
@@ -19,6 +20,25 @@
 #include "spectral/block_shape.h"
 
 namespace dispex::spectral {
+
+// The (kx, ky), kx <= lx, ky <= ly, of fewest texels 2^(kx+ky) with bound(kx, ky) <= tolerance;
+// among equals the smaller bound, then the smaller kx; (lx, ly) when none is.
+template <class Bound>
+std::pair<int, int> SmallestWithin(int lx, int ly, double tolerance, Bound bound) {
+  for (int texels_log2 = 0; texels_log2 <= lx + ly; ++texels_log2) {
+    int best_kx = -1;
+    double best_bound = 0;
+    for (int kx = std::max(0, texels_log2 - ly); kx <= std::min(lx, texels_log2); ++kx) {
+      const double b = bound(kx, texels_log2 - kx);
+      if (b <= tolerance && (best_kx < 0 || b < best_bound)) {
+        best_kx = kx;
+        best_bound = b;
+      }
+    }
+    if (best_kx >= 0) return {best_kx, texels_log2 - best_kx};
+  }
+  return {lx, ly};
+}
 
 class TruncationBounds {
  public:

@@ -82,20 +82,8 @@ struct SpectralVectorAnalyzer::Impl {
 
   // TruncationBounds::Smallest on the vector bound.
   std::pair<int, int> Smallest(const BlockShape& shape, double tolerance) const {
-    for (int texels_log2 = 0; texels_log2 <= shape.lx + shape.ly; ++texels_log2) {
-      int best_kx = -1;
-      double best_bound = 0;
-      for (int kx = std::max(0, texels_log2 - shape.ly); kx <= std::min(shape.lx, texels_log2);
-           ++kx) {
-        const double bound = Bound(kx, texels_log2 - kx);
-        if (bound <= tolerance && (best_kx < 0 || bound < best_bound)) {
-          best_kx = kx;
-          best_bound = bound;
-        }
-      }
-      if (best_kx >= 0) return {best_kx, texels_log2 - best_kx};
-    }
-    return {shape.lx, shape.ly};
+    return spectral::SmallestWithin(shape.lx, shape.ly, tolerance,
+                                    [this](int kx, int ky) { return Bound(kx, ky); });
   }
 
   // The channels resampled to `res`, interleaved into interleaved[slot]; returns the largest

@@ -57,11 +57,8 @@ using subdiv::RefinedCage;
 using Label = std::uint32_t;
 constexpr Label kNoLabel = kNoHalfEdge;
 constexpr int kMaxLevels = 7;
-// Sculpt vertices tried per component as the image of its seed vertex, nearest first; when no
-// labelling from them holds (vertices moved far across the surface, as a vector sculpt's
-// overhangs do, push the true one down the list), the match is tried again with the wider list.
+// Sculpt vertices tried per component as the image of its seed vertex, nearest first.
 constexpr int kCandidates = 8;
-constexpr int kWideCandidates = 128;
 // The position check reads every grid point of grids up to this size, and on larger ones the
 // points on every (n / kCheckedLines)-th row and column (the borders included): on level 6 of
 // a 941-quad cage (3.9M vertices, one core) 23% of the vertices in 0.06 s, where all of them
@@ -108,10 +105,8 @@ struct SeedAttempt {
 
 class Matcher {
  public:
-  Matcher(const LimitSurface& surface, const Mesh& sculpt, const MatchOptions& options,
-          int candidates)
-      : candidates_(candidates),
-        surface_(surface),
+  Matcher(const LimitSurface& surface, const Mesh& sculpt, const MatchOptions& options)
+      : surface_(surface),
         s_(SurfaceImpl(surface)),
         sculpt_(sculpt),
         options_(options),
@@ -558,16 +553,16 @@ class Matcher {
   };
 
   // The sculpt vertices of `vertex_class` in unmatched components of `cells` quads within
-  // the offset limit of base vertex w's limit point, at most candidates_.
+  // the offset limit of base vertex w's limit point, at most kCandidates.
   CandidateList Candidates(int vertex_class, int w, std::uint64_t cells) const {
     using Ranked = std::pair<double, std::uint32_t>;
     struct Found {
       std::vector<Ranked> best;
       Ranked nearest{HUGE_VAL, 0};
     };
-    const auto keep_best = [this](std::vector<Ranked>& list) {
+    const auto keep_best = [](std::vector<Ranked>& list) {
       std::sort(list.begin(), list.end());
-      if (list.size() > static_cast<std::size_t>(candidates_)) list.resize(candidates_);
+      if (list.size() > kCandidates) list.resize(kCandidates);
     };
     tbb::combinable<Found> found;
     const std::uint32_t* begin = class_vertices_.data() + class_offsets_[vertex_class];
@@ -587,9 +582,7 @@ class Matcher {
                           mine.nearest = std::min(mine.nearest, Ranked{d2, x});
                           if (d2 > offset_limit_ * offset_limit_) continue;
                           mine.best.emplace_back(SeedScore(vertex, w), x);
-                          if (mine.best.size() >= 4 * static_cast<std::size_t>(candidates_)) {
-                            keep_best(mine.best);
-                          }
+                          if (mine.best.size() >= 4 * kCandidates) keep_best(mine.best);
                         }
                       });
     std::vector<Ranked> all;
@@ -991,7 +984,6 @@ class Matcher {
   }
 
   bool labelling_ = false;
-  const int candidates_;  // seed candidates per component
   const LimitSurface& surface_;
   const LimitSurface::Impl& s_;
   const Mesh& sculpt_;
@@ -1054,16 +1046,11 @@ StatusOr<SculptCorrespondence> MatchRefinedSculpt(const LimitSurface& surface, c
   arena.execute([&] {
     bool labelling = false;
     {
-      Matcher matcher(surface, sculpt, options, kCandidates);
+      Matcher matcher(surface, sculpt, options);
       result.emplace(matcher.Run());
       labelling = matcher.labelling();
     }
     if (result->ok() || !labelling) return;
-    auto wide = Matcher(surface, sculpt, options, kWideCandidates).Run();
-    if (wide.ok()) {
-      result.emplace(std::move(wide));
-      return;
-    }
     // Flipped normals: say so rather than which quad the labelling stumbled on.
     Mesh reversed;
     reversed.source = sculpt.source;
@@ -1073,7 +1060,7 @@ StatusOr<SculptCorrespondence> MatchRefinedSculpt(const LimitSurface& surface, c
     for (std::size_t f = 0; f < reversed.num_faces(); ++f) {
       std::swap(reversed.face_indices[4 * f + 1], reversed.face_indices[4 * f + 3]);
     }
-    auto mirrored = Matcher(surface, reversed, options, kCandidates).Run();
+    auto mirrored = Matcher(surface, reversed, options).Run();
     if (mirrored.ok()) {
       result.emplace(Status::Error(fmt::format(
           "{}: every face winds the other way from the cage's (flipped normals); reversed, it "
