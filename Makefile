@@ -5,7 +5,7 @@ JOBS        ?= $(shell nproc)
 WERROR      ?= OFF
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build demo test test-sanitize test-tsan bench fuzz format format-check clean
+.PHONY: all deps configure build demo test test-sanitize test-tsan bench bench-peers fuzz format format-check clean
 
 all: build
 
@@ -31,6 +31,11 @@ test: build
 # $$DISPEX_BENCH_CACHE (default ~/.cache/dispex/bench), table on stdout, JSON in out/bench/.
 bench: build
 	@DISPEX_BUILD=$(BUILD) bench/run $(BENCH_ARGS)
+
+# Blender's Cycles bake beside dispex on the cape asset (bench/peers/run; installs Debian's
+# blender when it is missing). Table on stdout, JSON in out/bench/peers/.
+bench-peers: build
+	@DISPEX_BUILD=$(BUILD) bench/peers/run $(BENCH_ARGS)
 
 # The whole test suite (unit, end-to-end, accuracy) built with AddressSanitizer and
 # UndefinedBehaviorSanitizer.
