@@ -71,7 +71,9 @@ void SetupMakeSculpt(CLI::App& app, int& exit_code) {
       "grid), displaced along the limit normal by a pattern (or by a vector pattern's D); "
       "writes SCULPT.obj and SCULPT.obj.truth");
   cmd->add_option("cage", o.cage_path, "base cage (.obj, .ply)")->required();
-  cmd->add_option("-o,--output", o.output_path, "sculpt to write (.obj)")->required();
+  cmd->add_option("-o,--output", o.output_path,
+                  "sculpt to write (.obj, or .ply: binary, faster to read)")
+      ->required();
   cmd->add_option("--levels", o.levels, "Catmull-Clark refinement levels (1..8; layout refined)")
       ->check(CLI::Range(1, 8))
       ->capture_default_str();

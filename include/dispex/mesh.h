@@ -113,6 +113,9 @@ enum class MeshFormat : std::uint8_t { kUnknown, kObj, kPly };
 // The reader ReadMesh picks for `path`: PLY when the file starts with the "ply" magic line or
 // is named *.ply, OBJ when named *.obj (any letter case), else kUnknown. Reads 5 bytes at most.
 MeshFormat DetectMeshFormat(const std::string& path);
+// The format a file's name asks for (*.obj, *.ply, any letter case), else kUnknown; reads
+// nothing. WriteMesh writes it.
+MeshFormat MeshFormatOfName(const std::string& path);
 
 // Reads an OBJ or PLY file, chosen by DetectMeshFormat (an unknown format is an error).
 //
@@ -171,6 +174,17 @@ StatusOr<Mesh> ParsePly(std::string_view bytes, const std::string& name,
 // shortest round-trip form, so ReadObj gives back the same positions bit for bit. Faces only:
 // no UVs, no subdivision tags.
 Status WriteObj(const std::string& path, const Mesh& mesh, const std::string& header = {});
+
+// Writes `mesh` as a binary little-endian PLY (float x, y, z per vertex; a face's
+// vertex_indices as an int list with a uchar count, uint where a face has more than 255
+// corners), atomically, with `comment` (line ends become blanks) as a comment line. ReadPly
+// gives back the same positions and faces bit for bit. PLY holds neither UVs, nor
+// subdivision tags, nor groups: they are not written.
+Status WritePly(const std::string& path, const Mesh& mesh, std::string_view comment = {});
+
+// WritePly or WriteObj by MeshFormatOfName(path) (an unknown name is an error), with
+// `comment` as one comment line.
+Status WriteMesh(const std::string& path, const Mesh& mesh, std::string_view comment = {});
 
 // ---- Validation and summary ----------------------------------------------------------------
 

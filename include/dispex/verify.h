@@ -116,7 +116,7 @@ StatusOr<SculptLayout> ParseSculptLayout(std::string_view name);
 
 struct MakeSculptOptions {
   std::string cage_path;
-  std::string output_path;  // the sculpt, OBJ
+  std::string output_path;  // the sculpt, OBJ or PLY by its name (WriteMesh)
   std::string truth_path;   // empty: output_path + ".truth"
   int levels = 4;           // uniform Catmull-Clark refinements, 1..8 (kRefined only)
   SculptLayout layout = SculptLayout::kRefined;

@@ -1,4 +1,5 @@
 // ReadMesh: picks the reader from the file's first bytes and its extension.
+// MeshFormatOfName: the format a file's name asks for.
 #include <fstream>
 #include <string>
 
@@ -31,11 +32,15 @@ bool HasPlyMagic(const std::string& path) {
 
 }  // namespace
 
-MeshFormat DetectMeshFormat(const std::string& path) {
+MeshFormat MeshFormatOfName(const std::string& path) {
   const std::string ext = LowerExtension(path);
-  if (HasPlyMagic(path) || ext == "ply") return MeshFormat::kPly;
+  if (ext == "ply") return MeshFormat::kPly;
   if (ext == "obj") return MeshFormat::kObj;
   return MeshFormat::kUnknown;
+}
+
+MeshFormat DetectMeshFormat(const std::string& path) {
+  return HasPlyMagic(path) ? MeshFormat::kPly : MeshFormatOfName(path);
 }
 
 StatusOr<Mesh> ReadMesh(const std::string& path, const ReadOptions& options) {

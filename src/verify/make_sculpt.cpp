@@ -431,6 +431,10 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
     return Status::Error(fmt::format("amplitude = {}: must be >= 0", options.amplitude));
   }
   if (options.output_path.empty()) return Status::Error("no output file given (output_path)");
+  if (MeshFormatOfName(options.output_path) == MeshFormat::kUnknown) {
+    return Status::Error(fmt::format("{}: output_path must name an OBJ or PLY file (.obj or .ply)",
+                                     options.output_path));
+  }
   if (options.output_path == options.cage_path) {
     return Status::Error("the output must differ from the cage");
   }
@@ -517,10 +521,10 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   const std::string how =
       jittered ? fmt::format("jittered {}x{} per Ptex face", options.density, options.density)
                : fmt::format("refined {} times", options.levels);
-  std::string header =
-      fmt::format("# dispex make-sculpt: {} {}, pattern {}, amplitude {}, seed {}\n",
-                  options.cage_path, how, pattern_name, frame.amplitude, options.seed);
-  DISPEX_RETURN_IF_ERROR(WriteObj(options.output_path, sculpt, header));
+  const std::string comment =
+      fmt::format("dispex make-sculpt: {} {}, pattern {}, amplitude {}, seed {}", options.cage_path,
+                  how, pattern_name, frame.amplitude, options.seed);
+  DISPEX_RETURN_IF_ERROR(WriteMesh(options.output_path, sculpt, comment));
   std::string truth_path =
       options.truth_path.empty() ? options.output_path + ".truth" : options.truth_path;
   DISPEX_RETURN_IF_ERROR(WriteGroundTruth(truth_path, truth));

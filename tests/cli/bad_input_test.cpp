@@ -136,6 +136,8 @@ TEST_F(BadInput, ZeroOrNegativeValuesOfPositiveOptions) {
   ExpectFailure(make + "--amplitude 0", "--amplitude", 2);
   ExpectFailure(make + "--amplitude -0.1", "--amplitude", 2);
   ExpectFailure(make + "--levels 0", "--levels", 2);
+  ExpectFailure("make-sculpt " + cage_ + " -o " + (dir_ / "s.stl"),
+                "s.stl: -o must name an OBJ or PLY file (.obj or .ply)");
   const std::string render = "render " + cage_ + " -o " + (dir_ / "r.png") + " ";
   for (const char* option : {"--density 0", "--min-density 0", "--max-density 0", "--supersample 0",
                              "--ao -1", "--ao-distance 0"}) {

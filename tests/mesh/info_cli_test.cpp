@@ -150,3 +150,50 @@ TEST(InfoCli, ErrorsExitOneWithOneLine) {
 }
 
 }  // namespace
+
+// `dispex convert`: OBJ to binary PLY and back keeps the mesh (the same summary, bounds and
+// median edge to the bit: positions are copied, not printed and parsed), says what it drops,
+// and refuses a name of neither format before reading anything.
+TEST(ConvertCli, ObjToPlyAndBackKeepsTheMesh) {
+  const std::string obj = Data("meshes/keenan_spot/spot_control_mesh.obj");
+  const std::string ply =
+      ::testing::TempDir() + "/dispex_convert_" + std::to_string(::getpid()) + ".ply";
+  const std::string back = ply + ".obj";
+  const CliRun to_ply = Dispex("convert " + obj + " " + ply);
+  ASSERT_EQ(to_ply.exit_code, 0) << to_ply.err;
+  EXPECT_EQ(to_ply.err,
+            "dispex: warning: " + obj + ": texture coordinates not written to " + ply + "\n");
+  EXPECT_NE(to_ply.out.find("(188 vertices, 180 faces) -> " + ply), std::string::npos)
+      << to_ply.out;
+  const CliRun to_obj = Dispex("convert -q " + ply + " " + back);
+  ASSERT_EQ(to_obj.exit_code, 0) << to_obj.err;
+  EXPECT_EQ(to_obj.out, "");
+  auto summary = [](const std::string& path) {
+    nlohmann::json j = nlohmann::json::parse(Dispex("info --json " + path).out);
+    return nlohmann::json{{"vertices", j["vertices"]},
+                          {"faces", j["faces"]},
+                          {"sizes", j["faces_by_size"]},
+                          {"bounds", j["bounds"]},
+                          {"median", j["median_edge_length"]}};
+  };
+  const nlohmann::json original = summary(obj);
+  EXPECT_EQ(summary(ply), original);
+  EXPECT_EQ(summary(back), original);
+  EXPECT_EQ(nlohmann::json::parse(Dispex("info --json " + ply).out)["format"], "PLY");
+  std::remove(ply.c_str());
+  std::remove(back.c_str());
+}
+
+TEST(ConvertCli, AnOutputOfNeitherFormatIsRefused) {
+  const std::string out =
+      ::testing::TempDir() + "/dispex_convert_" + std::to_string(::getpid()) + ".stl";
+  const CliRun run =
+      Dispex("convert " + Data("meshes/keenan_spot/spot_control_mesh.obj") + " " + out);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(run.err, "dispex: " + out + ": the output must be named .obj or .ply\n");
+  EXPECT_NE(::access(out.c_str(), F_OK), 0);
+  const CliRun missing =
+      Dispex("convert /nonexistent/in.obj " + out.substr(0, out.size() - 3) + "ply");
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("/nonexistent/in.obj"), std::string::npos) << missing.err;
+}
