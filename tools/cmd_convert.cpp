@@ -38,12 +38,12 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 int RunConvert(const ConvertArgs& args) {
   const MeshFormat format = MeshFormatOfName(args.output);
   if (format == MeshFormat::kUnknown) {
-    return ReportFailure(Status::Error(
-        fmt::format("{}: the output must be named .obj or .ply", args.output)));
+    return ReportFailure(
+        Status::Error(fmt::format("{}: the output must be named .obj or .ply", args.output)));
   }
   if (args.output == args.input) {
-    return ReportFailure(Status::Error(fmt::format("{}: the output must differ from the input",
-                                                  args.output)));
+    return ReportFailure(
+        Status::Error(fmt::format("{}: the output must differ from the input", args.output)));
   }
   const auto read_start = std::chrono::steady_clock::now();
   auto mesh = ReadMesh(args.input);

@@ -1,8 +1,10 @@
 // The machine's limits for one asset, each stage alone: OBJ read, BVH build, limit evaluation
 // of every sample extract would take, dispex's tracer kernel over exactly those queries
-// (packet8 and single rays: its -n ray cut at the +n hit, the vertex guard, exact t), and a
-// bare rtcIntersect8 loop over the same two rays per sample with none of that (Embree alone).
-// bench/run compares the extraction's phases with these.
+// (packet8 and single rays: its -n ray cut at the +n hit, the vertex guard, exact t), a bare
+// rtcIntersect8 loop over the same two rays per sample with none of that (Embree alone), the
+// spectral analysis of the traced samples at the automatic tolerance, and the Ptex write of the
+// faces it chose. bench/run compares the extraction's phases, and its total with the sum of
+// these parts (read, first BVH, limit evaluation, packet8 rays, spectral, write).
 //   dispex_components BASE SCULPT [--json FILE] [--threads N] [--repeat N]
 // --repeat N (default 3): each ray timing is taken N times and the fastest kept (the shared
 // machine's load moves single timings by tens of percent).
@@ -11,14 +13,19 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
 
 #include "core/system.h"
+#include "dispex/extract.h"
 #include "dispex/mesh.h"
+#include "dispex/ptex.h"
+#include "dispex/spectral.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
 #include "extract/oversampling.h"
@@ -35,6 +42,13 @@ T Must(StatusOr<T> value) {
     std::exit(1);
   }
   return std::move(value).value();
+}
+
+void MustOk(const Status& status) {
+  if (!status.ok()) {
+    fmt::print(stderr, "dispex_components: {}\n", status.message());
+    std::exit(1);
+  }
 }
 
 }  // namespace
@@ -112,6 +126,7 @@ int main(int argc, char** argv) {
   }
   auto estimate =
       Must(EstimateSearchDistance(*tracer, sparse, sparse_n, ComputeBounds(base).diagonal()));
+  std::vector<float> distances;  // packet8's, for the spectral stage
   for (RayMode mode : {RayMode::kPacket8, RayMode::kSingle}) {
     TracerOptions o;
     o.ray_mode = mode;
@@ -141,6 +156,7 @@ int main(int argc, char** argv) {
         {"seconds", seconds},
         {"rays", rays},
         {"mrays_per_s", double(rays) / 1e6 / seconds}};
+    if (mode == RayMode::kPacket8) distances = std::move(dist);
   }
   // Embree alone: a bare rtcIntersect8 loop over the same rays, +n over [0, d] then -n over
   // [0, the +n hit's t] (d on a miss), in 8-wide strips of each face, coherent context, the
@@ -219,6 +235,51 @@ int main(int argc, char** argv) {
     rtcReleaseScene(scene);
     rtcReleaseDevice(device);
   }
+
+  // Spectral analysis of every face's samples (misses as 0: extract fills them from their
+  // neighbours first) at the automatic tolerance, 5% of the sculpt's median edge; then the
+  // faces it chose written as a Ptex file with the default options, and removed.
+  for (float& d : distances) {
+    if (!std::isfinite(d)) d = 0;
+  }
+  SpectralOptions spectral;
+  spectral.tolerance = 0.05 * MedianEdgeLength(sculpt);
+  std::vector<std::vector<float>> texels(static_cast<std::size_t>(n));
+  std::vector<PtexFaceInfo> faces = PtexFaceTable(surface);
+  tbb::enumerable_thread_specific<SpectralAnalyzer> analyzers;
+  clock.Reset();
+  tbb::parallel_for(0, n, [&](int f) {
+    const int r = 1 << plan.log2[f];
+    if (start[f] == start[f + 1]) return;
+    SpectralFace face = Must(analyzers.local().Analyze(
+        {distances.data() + start[f], start[f + 1] - start[f]}, r, r, spectral));
+    faces[f].ulog2 = static_cast<std::int8_t>(face.ulog2);
+    faces[f].vlog2 = static_cast<std::int8_t>(face.vlog2);
+    texels[f].assign(face.texels.begin(), face.texels.end());
+  });
+  const double spectral_seconds = clock.seconds();
+  std::size_t written = 0;
+  for (const auto& t : texels) written += t.size();
+  out["spectral"] = {{"what", "spectral analysis of the traced samples, automatic tolerance"},
+                     {"seconds", spectral_seconds},
+                     {"samples", start[n]},
+                     {"texels", written}};
+  const std::string map_path =
+      std::filesystem::temp_directory_path() / fmt::format("dispex_components_{}.ptx", ::getpid());
+  clock.Reset();
+  {
+    PtexWriter writer = Must(PtexWriter::Create(map_path, PtexWriterOptions{}, n));
+    tbb::parallel_for(0, n, [&](int f) {
+      if (texels[f].empty()) return;
+      MustOk(writer.SetFace(PtexFaceId(f), faces[f], texels[f]));
+    });
+    MustOk(writer.Finish());
+  }
+  const double write_seconds = clock.seconds();
+  out["ptex_write"] = {{"what", "Ptex write of the faces the analysis chose (default options)"},
+                       {"seconds", write_seconds},
+                       {"bytes", std::filesystem::file_size(map_path)}};
+  std::filesystem::remove(map_path);
 
   std::string text = out.dump(2);
   fmt::print("{}\n", text);

@@ -36,7 +36,8 @@ Status WritePly(const std::string& path, const Mesh& mesh, std::string_view comm
   std::string header = "ply\nformat binary_little_endian 1.0\n";
   if (!comment.empty()) {
     std::string line(comment);
-    std::replace_if(line.begin(), line.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+    std::replace_if(
+        line.begin(), line.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
     header += fmt::format("comment {}\n", line);
   }
   header += fmt::format(

@@ -37,11 +37,14 @@ void ExpectSameMesh(const Mesh& a, const Mesh& b) {
   ASSERT_EQ(a.num_vertices(), b.num_vertices());
   for (std::size_t v = 0; v < a.num_vertices(); ++v) {
     EXPECT_EQ(std::bit_cast<std::uint32_t>(a.positions[v].x),
-              std::bit_cast<std::uint32_t>(b.positions[v].x)) << "vertex " << v;
+              std::bit_cast<std::uint32_t>(b.positions[v].x))
+        << "vertex " << v;
     EXPECT_EQ(std::bit_cast<std::uint32_t>(a.positions[v].y),
-              std::bit_cast<std::uint32_t>(b.positions[v].y)) << "vertex " << v;
+              std::bit_cast<std::uint32_t>(b.positions[v].y))
+        << "vertex " << v;
     EXPECT_EQ(std::bit_cast<std::uint32_t>(a.positions[v].z),
-              std::bit_cast<std::uint32_t>(b.positions[v].z)) << "vertex " << v;
+              std::bit_cast<std::uint32_t>(b.positions[v].z))
+        << "vertex " << v;
   }
   EXPECT_EQ(a.face_offsets, b.face_offsets);
   EXPECT_EQ(a.face_indices, b.face_indices);
@@ -57,8 +60,9 @@ TEST(PlyWriter, ReadsBackBitForBit) {
   std::ifstream in(path, std::ios::binary);
   std::string header(200, '\0');
   in.read(header.data(), 200);
-  EXPECT_NE(header.find("format binary_little_endian 1.0\ncomment made by a test with a line end\n"),
-            std::string::npos)
+  EXPECT_NE(
+      header.find("format binary_little_endian 1.0\ncomment made by a test with a line end\n"),
+      std::string::npos)
       << header;
   EXPECT_NE(header.find("property list uchar int vertex_indices"), std::string::npos) << header;
   std::filesystem::remove(path);
@@ -104,8 +108,7 @@ TEST(WriteMesh, AnUnknownNameIsAnErrorAndWritesNothing) {
   const std::string path = TempPath(".stl");
   const Status status = WriteMesh(path, MixedMesh());
   ASSERT_FALSE(status.ok());
-  EXPECT_EQ(status.message(),
-            path + ": unknown mesh format (the name must end in .obj or .ply)");
+  EXPECT_EQ(status.message(), path + ": unknown mesh format (the name must end in .obj or .ply)");
   EXPECT_FALSE(std::filesystem::exists(path));
   EXPECT_EQ(MeshFormatOfName(path), MeshFormat::kUnknown);
 }
