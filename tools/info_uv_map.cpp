@@ -23,10 +23,9 @@ int UvMapInfo(const InfoOptions& options) {
   j["resolution"] = map->resolution();
   j["channels"] = map->channels();
   nlohmann::json tiles = nlohmann::json::array();
-  std::string text = fmt::format("UV map      {} ({} tiles of {}x{}, {} channel{})\n",
-                                 options.path, map->tiles().size(), map->resolution(),
-                                 map->resolution(), map->channels(),
-                                 map->channels() == 1 ? "" : "s");
+  std::string text = fmt::format("UV map      {} ({} tiles of {}x{}, {} channel{})\n", options.path,
+                                 map->tiles().size(), map->resolution(), map->resolution(),
+                                 map->channels(), map->channels() == 1 ? "" : "s");
   for (std::size_t t = 0; t < map->tiles().size(); ++t) {
     const UvMapTile& tile = map->tiles()[t];
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -45,9 +44,9 @@ int UvMapInfo(const InfoOptions& options) {
                      {"min", lo},
                      {"max", hi},
                      {"not_finite", not_finite}});
-    text += fmt::format("  tile {}  values [{:.6g}, {:.6g}]{}  {}\n", tile.udim, lo, hi,
-                        not_finite ? fmt::format(", {} not finite", not_finite) : "",
-                        map->paths()[t]);
+    text +=
+        fmt::format("  tile {}  values [{:.6g}, {:.6g}]{}  {}\n", tile.udim, lo, hi,
+                    not_finite ? fmt::format(", {} not finite", not_finite) : "", map->paths()[t]);
   }
   j["tiles"] = tiles;
   nlohmann::json attributes = nlohmann::json::object();

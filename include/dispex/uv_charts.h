@@ -67,9 +67,9 @@ struct UvTile {
 };
 
 struct UvRaster {
-  int resolution = 0;          // N
-  std::vector<UvTile> tiles;   // by UDIM number, ascending
-  std::int64_t inside = 0;     // texel centres in some UV face
+  int resolution = 0;         // N
+  std::vector<UvTile> tiles;  // by UDIM number, ascending
+  std::int64_t inside = 0;    // texel centres in some UV face
   // Texel centres clearly inside two or more UV faces (more than 1e-4 of their Ptex (u, v)
   // range from each one's border): overlapping UVs. Each such texel goes to the face it lies
   // deepest in (the largest distance to that face's border in Ptex units; the lower Ptex face

@@ -21,8 +21,8 @@ namespace dispex {
 // One tile in memory: row j counts from v = 0 (the image's bottom row) up.
 struct UvMapTile {
   int udim = 0;
-  int resolution = 0;  // N
-  int channels = 1;    // 1 or 3
+  int resolution = 0;         // N
+  int channels = 1;           // 1 or 3
   std::vector<float> values;  // N * N * channels, row-major, i fastest, channels interleaved
   // String attributes of the header (name, value), in name order when read.
   std::vector<std::pair<std::string, std::string>> attributes;

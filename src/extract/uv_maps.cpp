@@ -66,7 +66,7 @@ std::string FaceList(const std::vector<std::int32_t>& faces) {
 }
 
 std::vector<std::pair<std::string, std::string>> TileAttributes(const ExtractOptions& options,
-                                                                 const ExtractReport& report) {
+                                                                const ExtractReport& report) {
   return {
       {"dispex:version", DISPEX_VERSION_STRING},
       {"dispex:space", "normal"},
@@ -106,9 +106,9 @@ void RemoveStaleTiles(const std::string& dir, const std::string& shape,
     }
     std::error_code remove_error;
     if (fs::remove(entry.path(), remove_error)) {
-      report.warnings.push_back(fmt::format(
-          "{}: removed, a tile of an earlier run that these UVs no longer touch",
-          entry.path().string()));
+      report.warnings.push_back(
+          fmt::format("{}: removed, a tile of an earlier run that these UVs no longer touch",
+                      entry.path().string()));
     }
   }
 }
@@ -134,14 +134,16 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
   std::vector<std::int64_t> face_misses(static_cast<std::size_t>(num_faces), 0);
   std::vector<int> faces;
   for (int f = 0; f < num_faces; ++f) {
-    if (by_face.offsets[static_cast<std::size_t>(f) + 1] > by_face.offsets[static_cast<std::size_t>(f)]) {
+    if (by_face.offsets[static_cast<std::size_t>(f) + 1] >
+        by_face.offsets[static_cast<std::size_t>(f)]) {
       faces.push_back(f);
     }
   }
   tbb::enumerable_thread_specific<UvScratch> scratches([&] { return UvScratch(inputs.surface); });
   const Status traced = ForEachFace(
       static_cast<int>(faces.size()), [&](int k) { return faces[static_cast<std::size_t>(k)]; },
-      scratches, nullptr, [&](PtexFaceId face, UvScratch& w) {
+      scratches, nullptr,
+      [&](PtexFaceId face, UvScratch& w) {
         const auto f = static_cast<std::size_t>(face.value);
         const std::size_t begin = by_face.offsets[f], count = by_face.offsets[f + 1] - begin;
         w.uv.resize(2 * count);
@@ -156,8 +158,8 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
         w.t.resize(count);
         w.flags.resize(count);
         DISPEX_RETURN_IF_ERROR(w.face.evaluator.EvaluatePoints(face, w.uv, w.positions, w.normals));
-        const std::span<const Float3> origins(
-            reinterpret_cast<const Float3*>(w.positions.data()), count);
+        const std::span<const Float3> origins(reinterpret_cast<const Float3*>(w.positions.data()),
+                                              count);
         const std::span<const Float3> normals(reinterpret_cast<const Float3*>(w.normals.data()),
                                               count);
         TraceRays(*inputs.tracer, settings, origins, normals, w.t, w.flags, w.face);
@@ -190,20 +192,19 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
     report.warnings.push_back(fmt::format(
         "{}: {} faces have UVs outside the UDIM tiles (u in [0, 10), v in [0, 99)) and are "
         "not in the UV maps: {}",
-        options.base_path, raster.faces_outside_udim.size(),
-        FaceList(raster.faces_outside_udim)));
+        options.base_path, raster.faces_outside_udim.size(), FaceList(raster.faces_outside_udim)));
   }
   if (report.uv_texels_missed > 0) {
-    report.warnings.push_back(fmt::format(
-        "{} of {} UV map texels missed the sculpt and were filled by dilation",
-        report.uv_texels_missed, raster.inside));
+    report.warnings.push_back(
+        fmt::format("{} of {} UV map texels missed the sculpt and were filled by dilation",
+                    report.uv_texels_missed, raster.inside));
   }
 
   std::error_code ec;
   fs::create_directories(options.uv_maps_dir, ec);
   if (ec) {
-    return Status::Error(fmt::format("{}: cannot create the directory: {}", options.uv_maps_dir,
-                                     ec.message()));
+    return Status::Error(
+        fmt::format("{}: cannot create the directory: {}", options.uv_maps_dir, ec.message()));
   }
   const std::string shape = fs::path(options.output_path).stem().string();
   const auto attributes = TileAttributes(options, report);

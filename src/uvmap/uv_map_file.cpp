@@ -70,9 +70,10 @@ Status WriteUvMapTile(const std::string& path, const UvMapTile& tile, bool half)
   const int n = tile.resolution, channels = tile.channels;
   const std::size_t texels = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
   if (n < 1 || (channels != 1 && channels != 3) || tile.values.size() != texels * channels) {
-    return Status::Error(fmt::format("{}: a tile of {} texels per side and {} channels with {} "
-                                     "values: not a square tile of 1 or 3 channels",
-                                     path, n, channels, tile.values.size()));
+    return Status::Error(
+        fmt::format("{}: a tile of {} texels per side and {} channels with {} "
+                    "values: not a square tile of 1 or 3 channels",
+                    path, n, channels, tile.values.size()));
   }
   try {
     Imf::Header header(n, n);
@@ -93,7 +94,8 @@ Status WriteUvMapTile(const std::string& path, const UvMapTile& tile, bool half)
     for (std::size_t i = 0; i < half_rows.size(); ++i) half_rows[i] = ::half(rows[i]);
     Imf::FrameBuffer frame;
     const std::size_t size = half ? sizeof(::half) : sizeof(float);
-    char* base = half ? reinterpret_cast<char*>(half_rows.data()) : reinterpret_cast<char*>(rows.data());
+    char* base =
+        half ? reinterpret_cast<char*>(half_rows.data()) : reinterpret_cast<char*>(rows.data());
     for (int c = 0; c < channels; ++c) {
       frame.insert(ChannelName(channels, c),
                    Imf::Slice(type, base + c * size, size * channels, size * row));
@@ -128,8 +130,8 @@ StatusOr<UvMapTile> ReadUvMapTile(const std::string& path) {
     } else if (list.findChannel("R") && list.findChannel("G") && list.findChannel("B")) {
       channels = 3;
     } else {
-      return Status::Error(fmt::format(
-          "{}: no channel Y (a scalar map) nor R, G and B (a vector map)", path));
+      return Status::Error(
+          fmt::format("{}: no channel Y (a scalar map) nor R, G and B (a vector map)", path));
     }
     UvMapTile tile;
     tile.udim = UdimFromName(path);
@@ -215,9 +217,9 @@ StatusOr<UvMap> UvMap::Open(const std::string& pattern) {
     DISPEX_ASSIGN_OR_RETURN(UvMapTile tile, ReadUvMapTile(path));
     if (!map.tiles_.empty() &&
         (tile.resolution != map.resolution_ || tile.channels != map.channels_)) {
-      return Status::Error(fmt::format("{}: {} texels per side and {} channels, but {} has {} and {}",
-                                       path, tile.resolution, tile.channels, map.paths_[0],
-                                       map.resolution_, map.channels_));
+      return Status::Error(fmt::format(
+          "{}: {} texels per side and {} channels, but {} has {} and {}", path, tile.resolution,
+          tile.channels, map.paths_[0], map.resolution_, map.channels_));
     }
     map.resolution_ = tile.resolution;
     map.channels_ = tile.channels;
@@ -243,8 +245,7 @@ bool UvMap::Sample(double u, double v, std::span<float> out) const {
   auto at = [&](int i, int j, int c) {
     i = std::clamp(i, 0, n - 1);
     j = std::clamp(j, 0, n - 1);
-    return static_cast<double>(
-        tile.values[(static_cast<std::size_t>(j) * n + i) * channels_ + c]);
+    return static_cast<double>(tile.values[(static_cast<std::size_t>(j) * n + i) * channels_ + c]);
   };
   for (int c = 0; c < channels_; ++c) {
     out[c] = static_cast<float>((1 - wy) * ((1 - wx) * at(x0, y0, c) + wx * at(x0 + 1, y0, c)) +

@@ -21,7 +21,9 @@ constexpr int kBandRows = 16;
 constexpr double kInsideSlack = 1e-9;
 constexpr double kOverlapDepth = 1e-4;
 
-double Cross(const double a[2], const double b[2]) { return a[0] * b[1] - a[1] * b[0]; }
+double Cross(const double a[2], const double b[2]) {
+  return a[0] * b[1] - a[1] * b[0];
+}
 
 // The Ptex (u, v) at which the face's bilinear UV map reaches `p`, and how deep inside [0,1]^2
 // that is (min(u, 1-u, v, 1-v); negative outside). Of the quadratic's two roots, the deeper.

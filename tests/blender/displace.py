@@ -12,7 +12,8 @@
 # level 0, strength 1, texture clamping off so that negative values displace inward, bilinear
 # interpolation, no mipmaps, tiles extended at their borders).
 # --wrong makes the map wrong on purpose before it is read: zero (every texel 0), flip-v
-# (rows upside down), transpose (u and v swapped within each tile); `copy` re-saves it as it is
+# (rows upside down), transpose (u and v swapped within each tile), swap-tiles (each tile
+# holding the next one's texels); `copy` re-saves it as it is
 # (the control: the same path of saving and loading, with the map right).
 import sys
 
@@ -51,22 +52,24 @@ def read_obj(path):
             elif t[0] == "f":
                 corners = [c.split("/") for c in t[1:]]
                 faces.append([int(c[0]) - 1 for c in corners])
-                face_uvs.append([int(c[1]) - 1 for c in corners])
+                if all(len(c) > 1 and c[1] for c in corners):
+                    face_uvs.append([int(c[1]) - 1 for c in corners])
     return verts, uvs, faces, face_uvs
 
 
-def build_object(path):
+def build_object(path, name="base"):
     verts, uvs, faces, face_uvs = read_obj(path)
-    mesh = bpy.data.meshes.new("base")
+    mesh = bpy.data.meshes.new(name)
     mesh.from_pydata(verts, [], faces)
-    layer = mesh.uv_layers.new(name="UVMap")
-    loop = 0
-    for poly_uvs in face_uvs:
-        for k in poly_uvs:
-            layer.data[loop].uv = uvs[k]
-            loop += 1
+    if face_uvs and len(face_uvs) == len(faces):
+        layer = mesh.uv_layers.new(name="UVMap")
+        loop = 0
+        for poly_uvs in face_uvs:
+            for k in poly_uvs:
+                layer.data[loop].uv = uvs[k]
+                loop += 1
     mesh.validate()
-    obj = bpy.data.objects.new("base", mesh)
+    obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     return obj
 
@@ -87,7 +90,10 @@ def wrong_map(pattern, kind, work):
     """The tiles made wrong, saved as EXR under `work`; returns the new pattern."""
     import os
     os.makedirs(work, exist_ok=True)
-    for udim, path in tile_paths(pattern):
+    tiles = tile_paths(pattern)
+    for t, (udim, path) in enumerate(tiles):
+        if kind == "swap-tiles":  # each tile holds the next one's texels
+            path = tiles[(t + 1) % len(tiles)][1]
         img = bpy.data.images.load(path)
         n = img.size[0]
         px = list(img.pixels[:])
@@ -96,14 +102,14 @@ def wrong_map(pattern, kind, work):
             for i in range(n):
                 if kind == "zero":
                     src = None
-                elif kind == "copy":
+                elif kind in ("copy", "swap-tiles"):
                     src = j * n + i
                 elif kind == "flip-v":
                     src = (n - 1 - j) * n + i
                 elif kind == "transpose":
                     src = i * n + j
                 else:
-                    sys.exit("displace.py: --wrong zero, flip-v, transpose or copy")
+                    sys.exit("displace.py: --wrong zero, flip-v, transpose, swap-tiles or copy")
                 d = 4 * (j * n + i)
                 if src is None:
                     out[d:d + 4] = [0.0, 0.0, 0.0, 1.0]
@@ -157,17 +163,23 @@ def main():
     disp.mid_level = 0.0
     disp.strength = 1.0
 
+    write_evaluated(obj, out, "%s displaced in Blender %s by %s" % (
+        base, bpy.app.version_string, pattern))
+    print("displace.py: %d tiles -> %s" % (len(tiles), out))
+
+
+def write_evaluated(obj, out, comment):
+    """The object with its modifiers applied, as OBJ."""
     depsgraph = bpy.context.evaluated_depsgraph_get()
     evaluated = obj.evaluated_get(depsgraph)
     mesh = evaluated.to_mesh()
     with open(out, "w") as f:
-        f.write("# %s displaced in Blender %s by %s\n" % (base, bpy.app.version_string, pattern))
+        f.write("# %s\n" % comment)
         f.write("".join("v %.9g %.9g %.9g\n" % tuple(v.co) for v in mesh.vertices))
         f.write("".join("f " + " ".join(str(i + 1) for i in p.vertices) + "\n"
                         for p in mesh.polygons))
-    print("displace.py: %d tiles, %d vertices, %d faces -> %s" %
-          (len(tiles), len(mesh.vertices), len(mesh.polygons), out))
     evaluated.to_mesh_clear()
 
 
-main()
+if __name__ == "__main__":
+    main()

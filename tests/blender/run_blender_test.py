@@ -6,7 +6,8 @@ For each case: a sculpt (generated with a known displacement, or a real pair), `
 displace.py: Subdivision Surface with limit surface and UV Smooth None, Displace along the
 normal, mid level 0, strength 1), and `dispex verify --displaced` measuring Blender's mesh
 against the sculpt both ways: the 99th percentile must be within P99_TOLERANCES x the map's
-tolerance. Wrong maps (zero, rows flipped in v, u and v transposed) must fail the same bound.
+tolerance. Wrong maps (zero, rows flipped in v, u and v transposed, tiles swapped) must fail
+the same bound; the add-on (blender/) is driven the same way.
 Exits 77 (skipped) when Blender is not installed.
 
     run_blender_test.py --dispex BUILD/tools/dispex --data tests/data --work DIR [--blender B]
@@ -27,7 +28,7 @@ CASES = [
     ("spot", "meshes/keenan_spot/spot_control_mesh.obj", (3, "detail", 0.005), 512, 4,
      ["zero"]),
     ("box_six_tiles", "uv_maps/udim_box.obj", (4, "detail", 0.02), 256, 5,
-     ["zero", "flip-v", "transpose"]),
+     ["zero", "flip-v", "transpose", "swap-tiles"]),
     ("wavy_plane_ngons", "image_pattern/wavy_plane.obj", (4, "smooth", 0.05), 256, 5, ["zero"]),
     ("spot_real_pair", "meshes/keenan_spot/spot_control_mesh.obj",
      "meshes/keenan_spot/spot_quadrangulated.obj", 512, 4, ["zero"]),
@@ -43,6 +44,42 @@ def must(cmd):
     if r.returncode != 0:
         sys.exit("FAILED: %s\n%s" % (" ".join(cmd), r.stdout))
     return r.stdout
+
+
+def addon_case(a, blender):
+    """The add-on (blender/dispex_displacement.py) on the box of six tiles: Extract
+    Displacement, then the base with the modifiers it set up against the sculpt."""
+    work = os.path.join(a.work, "addon")
+    os.makedirs(work)
+    base = os.path.join(a.data, "uv_maps/udim_box.obj")
+    sculpt = os.path.join(work, "sculpt.obj")
+    must([a.dispex, "make-sculpt", base, "--levels", "4", "--pattern", "detail",
+          "--amplitude", "0.02", "-o", sculpt, "-q"])
+    out = os.path.join(work, "blender_addon.obj")
+    env = dict(os.environ)
+    env["PATH"] = os.path.dirname(os.path.abspath(a.dispex)) + os.pathsep + env.get("PATH", "")
+    r = run([blender, "-b", "--factory-startup", "--python", os.path.join(HERE, "addon_test.py"),
+             "--", os.path.join(HERE, "..", "..", "blender"), base, sculpt,
+             os.path.join(work, "maps"), out], env=env)
+    if r.returncode != 0 or not os.path.exists(out):
+        return ["addon: Blender failed:\n" + r.stdout[-3000:]]
+    info = json.loads(must([a.dispex, "info", os.path.join(work, "maps", "base.<UDIM>.exr"),
+                            "--json"]))
+    tolerance = float(info["attributes"]["dispex:tolerance"])
+    verify_json = os.path.join(work, "verify.json")
+    v = run([a.dispex, "verify", "--displaced", out, sculpt, "--max-p99",
+             repr(P99_TOLERANCES * tolerance), "--report", verify_json, "-q"])
+    if v.returncode not in (0, 3):
+        return ["addon: verify failed:\n" + v.stdout]
+    m = json.load(open(verify_json))
+    p99s = (m["map_to_sculpt"]["p99"], m["sculpt_to_map"]["p99"])
+    print("%-18s %-10s %10.4g %10.4g %10.4g  %s (%.2f / %.2f tolerances, %d tiles)" % (
+        "addon (box)", "none", tolerance, p99s[0], p99s[1],
+        "ok" if v.returncode == 0 else "WRONG", p99s[0] / tolerance, p99s[1] / tolerance,
+        len(info["tiles"])))
+    if v.returncode != 0 or len(info["tiles"]) != 6:
+        return ["addon: the add-on's result fails the bound of %g tolerances" % P99_TOLERANCES]
+    return []
 
 
 def main():
@@ -110,6 +147,8 @@ def main():
             if passed != expected:
                 failures.append("%s/%s: %s the bound of %g tolerances" % (
                     name, wrong, "passes" if passed else "fails", P99_TOLERANCES))
+    if not a.only or a.only == "addon":
+        failures += addon_case(a, blender)
     for f in failures:
         print("FAILED: " + f)
     return 1 if failures else 0

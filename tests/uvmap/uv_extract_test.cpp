@@ -141,8 +141,8 @@ TEST(UvExtract, BoxOverSixTilesWithSeams) {
     auto at = [&](int i, int j) { return tile.values[static_cast<std::size_t>(j) * 64 + i]; };
     // One ring out: the mean of its three inside neighbours.
     EXPECT_FLOAT_EQ(at(5, 30), (at(6, 29) + at(6, 30) + at(6, 31)) / 3);
-    EXPECT_NE(at(0, 30), 0.0f);        // six rings out, still padded
-    EXPECT_EQ(at(0, 0), at(1, 1));     // the corner, from the diagonal
+    EXPECT_NE(at(0, 30), 0.0f);     // six rings out, still padded
+    EXPECT_EQ(at(0, 0), at(1, 1));  // the corner, from the diagonal
   }
 
   // Wrong maps the same check rejects: zero, V flipped, two tiles swapped.
@@ -223,10 +223,10 @@ TEST(UvExtract, InfoAndVerifyReadUvMaps) {
     std::fill(tile.values.begin(), tile.values.end(), 0.0f);
     ASSERT_TRUE(WriteUvMapTile(UvMapTilePath(dir / "zero", "shape", tile.udim), tile, false).ok());
   }
-  r = RunDispex(fmt::format("verify {} {} '{}' --truth {} --tolerance {}", cage, sculpt,
-                            dir / "zero/shape.<UDIM>.exr", truth,
-                            map->Attribute("dispex:tolerance")),
-                dir);
+  r = RunDispex(
+      fmt::format("verify {} {} '{}' --truth {} --tolerance {}", cage, sculpt,
+                  dir / "zero/shape.<UDIM>.exr", truth, map->Attribute("dispex:tolerance")),
+      dir);
   EXPECT_EQ(r.exit_code, 3) << r.out << r.err;
 }
 
@@ -235,8 +235,8 @@ TEST(UvExtract, VerifyMeasuresADisplacedMesh) {
   // 0.01 at 0.01, and --max-p99 below that fails.
   TempDir dir;
   const std::string cage = DataPath("uv_maps/udim_box.obj");
-  ASSERT_TRUE(MakeSculpt(testing::SculptOptions(cage, dir / "s.obj", 3, Pattern::kDetail, 0.02))
-                  .ok());
+  ASSERT_TRUE(
+      MakeSculpt(testing::SculptOptions(cage, dir / "s.obj", 3, Pattern::kDetail, 0.02)).ok());
   auto r = RunDispex("verify --displaced " + (dir / "s.obj") + " " + (dir / "s.obj") +
                          " --max-p99 1e-9 --report " + (dir / "same.json"),
                      dir);
@@ -253,13 +253,12 @@ TEST(UvExtract, VerifyMeasuresADisplacedMesh) {
     moved += "\n";
   }
   std::ofstream(dir / "moved.obj") << moved;
-  r = RunDispex("verify --displaced " + (dir / "moved.obj") + " " + (dir / "s.obj") +
-                    " --max-p99 0.02",
-                dir);
+  r = RunDispex(
+      "verify --displaced " + (dir / "moved.obj") + " " + (dir / "s.obj") + " --max-p99 0.02", dir);
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
-  r = RunDispex("verify --displaced " + (dir / "moved.obj") + " " + (dir / "s.obj") +
-                    " --max-p99 0.005",
-                dir);
+  r = RunDispex(
+      "verify --displaced " + (dir / "moved.obj") + " " + (dir / "s.obj") + " --max-p99 0.005",
+      dir);
   EXPECT_EQ(r.exit_code, 3) << r.out << r.err;
   EXPECT_NE(r.err.find("99th percentile"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("--max-p99"), std::string::npos) << r.err;
@@ -271,8 +270,8 @@ TEST(UvExtract, VerifyMeasuresADisplacedMesh) {
 TEST(UvExtract, CommandLineErrors) {
   TempDir dir;
   const std::string cage = DataPath("uv_maps/udim_box.obj");
-  ASSERT_TRUE(MakeSculpt(testing::SculptOptions(cage, dir / "s.obj", 2, Pattern::kDetail, 0.02))
-                  .ok());
+  ASSERT_TRUE(
+      MakeSculpt(testing::SculptOptions(cage, dir / "s.obj", 2, Pattern::kDetail, 0.02)).ok());
   auto r = RunDispex("extract " + cage + " " + (dir / "s.obj") + " -o " + (dir / "m.ptx") +
                          " --uv-maps " + (dir / "uv") + " --uv-resolution 0",
                      dir);
@@ -285,14 +284,13 @@ TEST(UvExtract, CommandLineErrors) {
   EXPECT_NE(r.err.find("--uv-padding -1: must be >= 0"), std::string::npos) << r.err;
   // A base without UVs: one line naming it, nothing written.
   const std::string plain = DataPath("meshes/opensubdiv/catmark_pole8.obj");
-  ASSERT_TRUE(MakeSculpt(testing::SculptOptions(plain, dir / "p.obj", 2, Pattern::kDetail, 0.02))
-                  .ok());
+  ASSERT_TRUE(
+      MakeSculpt(testing::SculptOptions(plain, dir / "p.obj", 2, Pattern::kDetail, 0.02)).ok());
   r = RunDispex("extract " + plain + " " + (dir / "p.obj") + " -o " + (dir / "p.ptx") +
                     " --uv-maps " + (dir / "uvp") + " -q",
                 dir);
   EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_NE(r.err.find("catmark_pole8.obj: the cage has no texture coordinates"),
-            std::string::npos)
+  EXPECT_NE(r.err.find("catmark_pole8.obj: the cage has no texture coordinates"), std::string::npos)
       << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(fs::exists(dir / "uvp"));

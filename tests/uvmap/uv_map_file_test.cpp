@@ -87,8 +87,8 @@ TEST_F(TileFiles, HalfRoundTripRoundsToHalf) {
     worst = std::max(worst, std::abs(double(back->values[i]) - tile.values[i]) /
                                 std::max(1e-3, std::abs(double(tile.values[i]))));
   }
-  EXPECT_GT(worst, 0);      // rounded ...
-  EXPECT_LT(worst, 1e-3);   // ... to 11 significant bits
+  EXPECT_GT(worst, 0);     // rounded ...
+  EXPECT_LT(worst, 1e-3);  // ... to 11 significant bits
 }
 
 TEST_F(TileFiles, SameTileSameBytes) {
@@ -146,8 +146,8 @@ TEST_F(TileFiles, RowsAreStoredTopDown) {
   file.setFrameBuffer(frame);
   file.readPixels(0, 3);
   for (int i = 0; i < 4; ++i) {
-    EXPECT_EQ(pixels[i], 0.0f);           // scanline 0: the top
-    EXPECT_EQ(pixels[12 + i], 1.0f);      // scanline 3: the bottom, v = 0
+    EXPECT_EQ(pixels[i], 0.0f);       // scanline 0: the top
+    EXPECT_EQ(pixels[12 + i], 1.0f);  // scanline 3: the bottom, v = 0
   }
   auto back = ReadUvMapTile(path);
   ASSERT_TRUE(back.ok());

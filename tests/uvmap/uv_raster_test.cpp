@@ -107,11 +107,11 @@ TEST(UvRaster, BoxInSixTilesCountsEveryTexelOnce) {
 TEST(UvRaster, NgonSubFacesMapBack) {
   // A triangle beside two quads: its Ptex sub-faces. UVs are the corner, edge
   // midpoints and centroid rule.
-  Charted c = Chart(ObjMesh(
-      "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 2 1 0\nv 1 1.5 0\nv 0 1 0\nv 3 0.5 0\n"
-      "vt 0.05 0.05\nvt 0.4 0.05\nvt 0.8 0.05\nvt 0.8 0.45\nvt 0.4 0.7\nvt 0.05 0.45\n"
-      "vt 0.95 0.25\n"
-      "f 1/1 2/2 5/5 6/6\nf 2/2 3/3 4/4 5/5\nf 3/3 7/7 4/4\n"));
+  Charted c = Chart(
+      ObjMesh("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 2 1 0\nv 1 1.5 0\nv 0 1 0\nv 3 0.5 0\n"
+              "vt 0.05 0.05\nvt 0.4 0.05\nvt 0.8 0.05\nvt 0.8 0.45\nvt 0.4 0.7\nvt 0.05 0.45\n"
+              "vt 0.95 0.25\n"
+              "f 1/1 2/2 5/5 6/6\nf 2/2 3/3 4/4 5/5\nf 3/3 7/7 4/4\n"));
   auto raster = RasterizeUvCharts(c.charts, c.surface, 64);
   ASSERT_TRUE(raster.ok());
   ExpectPlacesMapBack(c.charts, *raster);
@@ -149,10 +149,10 @@ TEST(UvRaster, NgonSubFacesMapBack) {
 
 TEST(UvRaster, OverlapsAreReportedAndResolvedByDepth) {
   // Two quads, the second's UVs over the right half of the first's.
-  Charted c = Chart(ObjMesh(
-      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n"
-      "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 0\nvt 0.5 1\n"
-      "f 1/1 2/2 3/3 4/4\nf 2/5 5/2 6/3 3/6\n"));
+  Charted c =
+      Chart(ObjMesh("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n"
+                    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 0\nvt 0.5 1\n"
+                    "f 1/1 2/2 3/3 4/4\nf 2/5 5/2 6/3 3/6\n"));
   auto raster = RasterizeUvCharts(c.charts, c.surface, 32);
   ASSERT_TRUE(raster.ok());
   EXPECT_GT(raster->overlap_texels, 0);
@@ -164,10 +164,10 @@ TEST(UvRaster, OverlapsAreReportedAndResolvedByDepth) {
 }
 
 TEST(UvRaster, FacesLeavingTheUdimRangeAreListed) {
-  Charted c = Chart(ObjMesh(
-      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
-      "vt -0.5 0.2\nvt 0.5 0.2\nvt 0.5 0.8\nvt -0.5 0.8\n"
-      "f 1/1 2/2 3/3 4/4\n"));
+  Charted c =
+      Chart(ObjMesh("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                    "vt -0.5 0.2\nvt 0.5 0.2\nvt 0.5 0.8\nvt -0.5 0.8\n"
+                    "f 1/1 2/2 3/3 4/4\n"));
   auto raster = RasterizeUvCharts(c.charts, c.surface, 16);
   ASSERT_TRUE(raster.ok());
   EXPECT_EQ(raster->faces_outside_udim, (std::vector<std::int32_t>{0}));
