@@ -8,7 +8,7 @@
 # reach (cmake/Options.cmake); this check also covers the public headers, which every target
 # sees.
 
-set(levels core 0 mesh 1 subdiv 2 trace 3 spectral 4 ptex 5 extract 6 verify 7 render 7)
+set(levels core 0 mesh 1 subdiv 2 trace 3 spectral 4 ptex 5 uvmap 5 extract 6 verify 7 render 7)
 # The module each public header belongs to.
 set(owners
   status core ids core version core files core cancel core
@@ -17,6 +17,7 @@ set(owners
   trace trace
   spectral spectral
   ptex ptex ptex_sampler ptex ptex_describe ptex
+  uv_charts uvmap uv_map uvmap
   extract extract
   verify verify
   render render)
@@ -76,7 +77,7 @@ foreach(header IN LISTS public_headers)
   endif()
 endforeach()
 
-foreach(module core mesh subdiv trace spectral ptex extract verify render)
+foreach(module core mesh subdiv trace spectral ptex uvmap extract verify render)
   file(GLOB sources ${SOURCE_DIR}/src/${module}/*.h ${SOURCE_DIR}/src/${module}/*.cpp)
   foreach(source IN LISTS sources)
     check_file(${source} ${module})

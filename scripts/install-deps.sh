@@ -8,10 +8,14 @@ packages=(
   libosd-dev libembree-dev libtbb-dev
   libdeflate-dev zlib1g-dev libfftw3-dev libxxhash-dev
   libfast-float-dev libcli11-dev libfmt-dev nlohmann-json3-dev
-  libpng-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libpng-dev libopenexr-dev libgtest-dev libgmock-dev libbenchmark-dev
 )
 if [[ "${DISPEX_WITH_FORMAT:-0}" == 1 ]]; then
   packages+=(clang-format-14)
+fi
+# Blender (headless) for `make test-blender`: a real renderer displacing with the UV maps.
+if [[ "${DISPEX_WITH_BLENDER:-0}" == 1 ]]; then
+  packages+=(blender)
 fi
 if [[ "${DISPEX_WITH_FUZZ:-0}" == 1 ]]; then
   packages+=(clang libclang-rt-14-dev)

@@ -4,6 +4,9 @@
 # 'detail' pattern, amplitude 0.005) and the map `dispex extract` takes from that sculpt; and
 # docs/images/overhang_scalar.png, overhang_vector.png (docs/VECTOR.md): the 'overhang' sculpt
 # (4 levels, amplitude 0.01) beside the base displaced by its scalar and its vector map.
+# docs/images/spot_blender.png: the same asset rendered by Blender (Cycles, CPU): the limit
+# surface, the base displaced by the UV-space map through Blender's modifiers, the sculpt
+# (scripts/blender-render.py; skipped with a note when Blender is not installed).
 # Usage: scripts/make-images.sh [build-dir]   (default: build; the dispex binary must exist)
 set -euo pipefail
 build="${1:-build}"
@@ -17,7 +20,7 @@ mkdir -p "$images"
 
 "$dispex" make-sculpt "$cage" --levels 4 --pattern detail --amplitude 0.005 \
   -o "$work/spot_sculpt.obj" -q
-"$dispex" extract "$cage" "$work/spot_sculpt.obj" -o "$work/spot.ptx" -q
+"$dispex" extract "$cage" "$work/spot_sculpt.obj" -o "$work/spot.ptx" --uv-maps "$work/uv" -q
 "$dispex" preview "$work/spot.ptx" -o "$images/spot_atlas.png" --mode signed
 "$dispex" render "$cage" "$work/spot.ptx" --compare --sculpt "$work/spot_sculpt.obj" \
   --size 960x360 --view iso --ao 16 -o "$images/spot_compare.png"
@@ -30,4 +33,10 @@ for kind in scalar vector; do
   "$dispex" render "$cage" "$work/overhang_$kind.ptx" --compare --sculpt "$work/overhang.obj" \
     --size 1050x350 --view left --elevation 10 -o "$images/overhang_$kind.png"
 done
+if command -v blender >/dev/null; then
+  blender -b --factory-startup --python "$root/scripts/blender-render.py" -- "$cage" \
+    "$work/uv/spot.<UDIM>.exr" "$work/spot_sculpt.obj" "$images/spot_blender.png" >/dev/null
+else
+  echo "make-images: blender not installed: docs/images/spot_blender.png left as it is" >&2
+fi
 ls -l "$images/spot_atlas.png" "$images/spot_compare.png" "$images"/overhang_*.png

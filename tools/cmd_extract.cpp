@@ -34,6 +34,9 @@ constexpr FlagName kExtractFlags[] = {
     {"max_memory", "--max-memory"},
     {"output_dir", "--out-dir"},
     {"method", "--method"},
+    {"uv_maps_dir", "--uv-maps"},
+    {"uv_resolution", "--uv-resolution"},
+    {"uv_padding", "--uv-padding"},
 };
 
 struct ExtractArgs {
@@ -325,6 +328,16 @@ void SetupExtract(CLI::App& app, int& exit_code) {
                   "write a vector displacement map (3 channels: sculpt - limit surface) in this "
                   "space: tangent (T, B, N), parametric (dP/du, dP/dv, N) or object (x, y, z); "
                   "the sculpt must be the base refined (see `dispex match`)");
+  cmd->add_option("--uv-maps", o.uv_maps_dir,
+                  "also write UV-space maps: DIR/<map>.<UDIM>.exr (OpenEXR, one float channel) "
+                  "for every UDIM tile the base's UVs touch, extracted at each texel (UVs "
+                  "interpolated face-varying linearly; docs/UV_MAPS.md)");
+  cmd->add_option("--uv-resolution", o.uv_resolution, "texels per side of each UDIM tile")
+      ->capture_default_str();
+  cmd->add_option("--uv-padding", o.uv_padding,
+                  "texels of dilation outside the UV faces, so that filtering at seams never "
+                  "reads empty texels")
+      ->capture_default_str();
   cmd->add_flag("--incremental", o.incremental,
                 "re-use the map at the output path: left as it is when made from the same "
                 "inputs and options, else only the faces whose inputs changed are extracted "

@@ -2,6 +2,7 @@
 
 #include "command.h"
 #include "dispex/files.h"
+#include "dispex/uv_map.h"
 #include "info.h"
 
 namespace dispex::cli {
@@ -18,19 +19,29 @@ bool LooksLikePtex(const std::string& path) {
 void SetupInfo(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<InfoOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "info", "Summarise a mesh (OBJ, PLY) or a Ptex file: counts, tags, bounds, warnings");
-  cmd->add_option("file", options->path, "mesh (.obj, .ply) or Ptex (.ptx) file")->required();
+      "info",
+      "Summarise a mesh (OBJ, PLY), a Ptex file or a UV-space map (UDIM OpenEXR tiles): counts, "
+      "tags, bounds, warnings");
+  cmd->add_option("file", options->path,
+                  "mesh (.obj, .ply), Ptex (.ptx) file, or UV map (DIR/NAME.<UDIM>.exr or a tile)")
+      ->required();
   cmd->add_flag("--json", options->json, "print a machine-readable JSON summary");
   cmd->add_flag("--faces", options->faces, "Ptex: one line per face");
   cmd->add_option("--dump", options->dump_face, "Ptex: print the texels of this face id");
   cmd->add_flag("--strict", options->strict, "mesh: treat validation warnings as errors");
   cmd->callback([options, &exit_code] {
+    if (options->path.find("<UDIM>") != std::string::npos) {
+      exit_code = UvMapInfo(*options);
+      return;
+    }
     Status readable = CheckReadableFile(options->path);
     if (!readable.ok()) {
       exit_code = ReportFailure(readable);
       return;
     }
-    exit_code = LooksLikePtex(options->path) ? PtexInfo(*options) : MeshInfo(*options);
+    exit_code = LooksLikePtex(options->path) ? PtexInfo(*options)
+                : IsUvMapPath(options->path) ? UvMapInfo(*options)
+                                             : MeshInfo(*options);
   });
 }
 

@@ -1,4 +1,5 @@
 // dispex verify BASE [SCULPT] MAP.ptx [--truth FILE] [--tolerance T] [--max-error E]
+//               or --displaced MESH SCULPT [--max-p99 E]
 //               [--max-edge-step K] [--max-edge-step-p99 K]
 #include <fmt/format.h>
 
@@ -13,9 +14,13 @@ namespace dispex::cli {
 namespace {
 
 constexpr FlagName kVerifyFlags[] = {
-    {"sculpt_path", "a SCULPT"},          {"truth_path", "--truth"},
-    {"samples_per_face", "--samples"},    {"max_error", "--max-error"},
-    {"max_error_rel", "--max-error-rel"}, {"max_rms", "--max-rms"},
+    {"sculpt_path", "a SCULPT"},
+    {"truth_path", "--truth"},
+    {"samples_per_face", "--samples"},
+    {"max_error", "--max-error"},
+    {"max_error_rel", "--max-error-rel"},
+    {"max_rms", "--max-rms"},
+    {"max_p99", "--max-p99"},
 };
 
 struct VerifyArgs {
@@ -27,7 +32,15 @@ struct VerifyArgs {
 
 int RunVerify(VerifyArgs& args) {
   VerifyOptions& o = args.options;
-  if (args.files.size() == 3) {
+  if (!o.displaced_path.empty()) {
+    if (args.files.size() != 1) {
+      return ReportFailure(
+          Status::Error("--displaced MESH takes one file, the SCULPT it is measured against"), 2);
+    }
+    o.sculpt_path = args.files[0];
+  } else if (args.files.size() == 1) {
+    return ReportFailure(Status::Error("BASE SCULPT MAP or BASE MAP expected"), 2);
+  } else if (args.files.size() == 3) {
     o.base_path = args.files[0];
     o.sculpt_path = args.files[1];
     o.map_path = args.files[2];
@@ -47,7 +60,8 @@ int RunVerify(VerifyArgs& args) {
     std::fputs(VerifyReportSummary(*report).c_str(), stdout);
   }
   if (!report->passed) {
-    return ReportFailure(Status::Error(o.map_path + ": " + report->failure), kVerifyFlags, 3);
+    const std::string& measured = o.displaced_path.empty() ? o.map_path : o.displaced_path;
+    return ReportFailure(Status::Error(measured + ": " + report->failure), kVerifyFlags, 3);
   }
   return 0;
 }
@@ -61,9 +75,16 @@ void SetupVerify(CLI::App& app, int& exit_code) {
       "sculpt, both ways (and/or against a make-sculpt truth file), and the steps at shared "
       "face edges");
   cmd->add_option("files", args->files,
-                  "BASE SCULPT MAP.ptx, or BASE MAP.ptx (edge steps, and --truth if given)")
+                  "BASE SCULPT MAP.ptx, or BASE MAP.ptx (edge steps, and --truth if given), or "
+                  "SCULPT with --displaced")
       ->required()
-      ->expected(2, 3);
+      ->expected(1, 3);
+  cmd->add_option("--displaced", o.displaced_path,
+                  "measure this already displaced mesh (e.g. a renderer's) against SCULPT, both "
+                  "ways, instead of a map");
+  cmd->add_option("--max-p99", o.max_p99,
+                  "fail (exit 3) when a 99th-percentile error exceeds this, object units")
+      ->check(Positive());
   cmd->add_option("--truth", o.truth_path, "make-sculpt truth file: compare with the exact h");
   cmd->add_option("--samples", o.samples_per_face,
                   "samples per side of each face (0: twice the map resolution, 8..64)")

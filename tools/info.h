@@ -1,4 +1,5 @@
-// `dispex info FILE`: a summary of a mesh (OBJ, PLY) or a Ptex file, chosen by content.
+// `dispex info FILE`: a summary of a mesh (OBJ, PLY), a Ptex file or a UV-space map (UDIM
+// OpenEXR tiles), chosen by content.
 #pragma once
 
 #include <string>
@@ -16,5 +17,6 @@ struct InfoOptions {
 // Each returns the process exit code and prints to stdout (errors on stderr).
 int MeshInfo(const InfoOptions& options);
 int PtexInfo(const InfoOptions& options);
+int UvMapInfo(const InfoOptions& options);  // UDIM OpenEXR tiles (dispex/uv_map.h)
 
 }  // namespace dispex::cli

@@ -124,6 +124,18 @@ struct ExtractOptions {
   // bounds how far a sculpt vertex may lie from its point on the limit surface
   // (MatchOptions::max_offset); ray, hole and watertight options do not apply.
   std::optional<VectorSpace> vector;
+
+  // UV-space maps beside the Ptex map (docs/UV_MAPS.md): when not empty, one OpenEXR file per
+  // UDIM tile the base's UVs touch, uv_maps_dir/<shape>.<UDIM>.exr (<shape>: the asset's shape
+  // name, else the output's file name without extension), uv_resolution texels per side,
+  // data_type's precision. Each texel centre inside a UV face is extracted where it lies on the
+  // limit surface (the cage's UVs interpolated face-varying linearly, include/dispex/
+  // uv_charts.h) with the same rays, search distance and policy as the Ptex map; texels outside
+  // every UV face (and those whose rays miss) are filled by dilation, uv_padding rings of
+  // texels. The base needs UVs on every face. Scalar maps only.
+  std::string uv_maps_dir;
+  int uv_resolution = 1024;  // 1..16384
+  int uv_padding = 16;       // >= 0
 };
 
 // The face table of every map of `surface`, taken from the limit surface (OpenSubdiv's Ptex
@@ -243,6 +255,15 @@ struct ExtractReport {
   double mapping_max_offset = 0, mapping_rms_offset = 0;
   double t_match = 0;
   double vector_length_max = 0, vector_tangential_max = 0;
+
+  // UV-space maps (ExtractOptions::uv_maps_dir): the files written, texel centres inside a UV
+  // face, those of them whose rays missed (filled by dilation as if outside), texel centres in
+  // two faces and the Ptex faces involved (UvRaster::overlap_texels), faces whose UVs leave the
+  // UDIM range, seconds.
+  std::vector<std::string> uv_map_paths;
+  std::int64_t uv_texels_inside = 0, uv_texels_missed = 0, uv_overlap_texels = 0;
+  std::vector<std::int32_t> uv_overlap_faces, uv_faces_outside_udim;
+  double t_uv_maps = 0;
 
   // Output.
   std::uint64_t bytes_written = 0;

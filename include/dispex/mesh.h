@@ -82,6 +82,7 @@ struct Mesh {
   // When some faces name texture coordinates and others do not, the reader keeps the mesh
   // without UVs (both arrays empty) and counts here the faces that had none; 0 otherwise.
   std::size_t faces_without_uvs = 0;
+  std::size_t first_face_without_uvs = 0;  // 0-based; meaningful when faces_without_uvs > 0
 
   SubdivTags tags;
 

@@ -191,6 +191,10 @@ namespace dispex {
 // is an error naming the map (DisplacementMapSpace).
 
 struct VerifyOptions {
+  // A mesh already displaced -- by a renderer (tests/blender), by another tool -- measured
+  // against the sculpt both ways instead of a map: its vertices to the sculpt, the sculpt's
+  // vertices to it. base_path and map_path are then unused; the distance bounds below apply.
+  std::string displaced_path;
   std::string base_path;
   std::string sculpt_path;  // may be empty with truth_path: then only the truth is compared
   std::string map_path;
@@ -204,6 +208,7 @@ struct VerifyOptions {
   double max_error = 0;      // fail when an error's max exceeds this (object units; 0: off)
   double max_error_rel = 0;  // the same relative to the base bounding-box diagonal
   double max_rms = 0;        // fail when an RMS error exceeds this (object units; 0: off)
+  double max_p99 = 0;        // fail when a 99th percentile exceeds this (object units; 0: off)
   // Bounds against the truth, scaled by the tolerance tau: this one, or 0 for the map's own
   // (its dispex:statistics meta data); with neither they are not checked.
   double tolerance = 0;
@@ -239,6 +244,9 @@ struct ErrorStats {
 };
 
 struct VerifyReport {
+  // VerifyOptions::displaced_path was measured (map_to_sculpt: its vertices to the sculpt;
+  // sculpt_to_map: the sculpt's vertices to it); nothing else is.
+  bool displaced_mesh = false;
   double diagonal = 0;
   std::size_t ptex_faces = 0;
   bool map_vector = false;                        // a vector map (else scalar)

@@ -26,6 +26,7 @@
 #include "extract/parallel_errors.h"
 #include "extract/previous_map.h"
 #include "extract/process_faces.h"
+#include "extract/uv_maps.h"
 #include "extract/vector_faces.h"
 
 namespace dispex::extract {
@@ -232,6 +233,9 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
 
   DISPEX_RETURN_IF_ERROR(AddFaceTotals(options, inputs, settings, faces, report));
   DISPEX_RETURN_IF_ERROR(CommitMap(writer, inputs, keys, faces, report));
+  if (!options.uv_maps_dir.empty()) {
+    DISPEX_RETURN_IF_ERROR(WriteUvMaps(options, inputs, settings, report));
+  }
   report.peak_rss_bytes = PeakResidentBytes();
   report.t_total = total_clock.seconds();
   return report;

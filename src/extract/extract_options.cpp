@@ -116,6 +116,18 @@ Status ValidateExtractOptions(const ExtractOptions& o) {
     return Status::Error(
         "method = rays: a vector map reads the sculpt through its correspondence, not rays");
   }
+  if (!o.uv_maps_dir.empty()) {
+    if (o.uv_resolution < 1 || o.uv_resolution > 16384) {
+      return Status::Error(fmt::format("uv_resolution = {}: must be 1..16384", o.uv_resolution));
+    }
+    if (o.uv_padding < 0) {
+      return Status::Error(fmt::format("uv_padding = {}: must be >= 0", o.uv_padding));
+    }
+    if (o.vector) return Status::Error("uv_maps_dir: UV-space maps are scalar maps only");
+    if (o.incremental) {
+      return Status::Error("uv_maps_dir: UV-space maps are not extracted incrementally");
+    }
+  }
   SpectralOptions spectral;
   spectral.rule = o.resolution_rule;
   spectral.tolerance = o.tolerance > 0 ? o.tolerance : 1.0;

@@ -63,6 +63,18 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
                       {"spectral", r.cpu_spectral},
                       {"compress", r.cpu_compress}};
   j["mrays_per_second"] = r.t_sample_trace > 0 ? double(r.rays_cast) / r.t_sample_trace / 1e6 : 0.0;
+  if (!r.options.uv_maps_dir.empty()) {
+    j["uv_maps"] = {{"dir", r.options.uv_maps_dir},
+                    {"resolution", r.options.uv_resolution},
+                    {"padding", r.options.uv_padding},
+                    {"files", r.uv_map_paths},
+                    {"texels_inside", r.uv_texels_inside},
+                    {"texels_missed", r.uv_texels_missed},
+                    {"overlap_texels", r.uv_overlap_texels},
+                    {"overlap_faces", r.uv_overlap_faces},
+                    {"faces_outside_udim", r.uv_faces_outside_udim},
+                    {"seconds", r.t_uv_maps}};
+  }
   j["peak_rss_bytes"] = r.peak_rss_bytes;
   j["tracer"] = r.tracer;
   j["warnings"] = r.warnings;
@@ -208,6 +220,11 @@ std::string ExtractReportSummary(const ExtractReport& r) {
       "write {:.2f})  {:.1f} MB  peak {:.0f} MB\n",
       r.t_total, r.t_read_base, r.t_read_sculpt, r.t_bvh, r.t_sample_trace, r.t_write,
       double(r.bytes_written) / 1e6, double(r.peak_rss_bytes) / 1e6);
+  if (!r.uv_map_paths.empty()) {
+    out += fmt::format("  UV maps: {} tiles of {}x{} in {} ({} texels inside UV faces), {:.2f}s\n",
+                       r.uv_map_paths.size(), r.options.uv_resolution, r.options.uv_resolution,
+                       r.options.uv_maps_dir, r.uv_texels_inside, r.t_uv_maps);
+  }
   for (const std::string& w : r.warnings) out += "  warning: " + w + "\n";
   return out;
 }

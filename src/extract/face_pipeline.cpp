@@ -15,40 +15,6 @@ std::span<const Float3> AsFloat3(const std::vector<float>& v, std::size_t n) {
   return {reinterpret_cast<const Float3*>(v.data()), n};
 }
 
-// Rays along +-n from each origin; with a retry distance, the samples that missed are searched
-// again that far. Returns how many the second search found.
-std::int32_t TraceRays(const Tracer& tracer, const ExtractSettings& settings,
-                       std::span<const Float3> origins, std::span<const Float3> normals,
-                       std::span<float> t, std::span<std::uint8_t> flags, FaceScratch& w) {
-  const std::size_t count = origins.size();
-  tracer.TraceNormals(origins, normals, settings.query, NormalHits{t, {}, flags}, w.counters);
-  if (!(settings.retry_query.distance > 0)) return 0;
-  w.retry_origins.clear();
-  w.retry_normals.clear();
-  w.retry_index.clear();
-  for (std::size_t i = 0; i < count; ++i) {
-    if (flags[i] & HitFlags::kHit) continue;
-    w.retry_index.push_back(static_cast<std::int32_t>(i));
-    w.retry_origins.push_back(origins[i]);
-    w.retry_normals.push_back(normals[i]);
-  }
-  if (w.retry_index.empty()) return 0;
-  const std::size_t m = w.retry_index.size();
-  w.retry_t.resize(m);
-  w.retry_flags.resize(m);
-  tracer.TraceNormals(w.retry_origins, w.retry_normals, settings.retry_query,
-                      NormalHits{w.retry_t, {}, w.retry_flags}, w.counters);
-  std::int32_t recovered = 0;
-  for (std::size_t k = 0; k < m; ++k) {
-    if (!(w.retry_flags[k] & HitFlags::kHit)) continue;
-    const auto i = static_cast<std::size_t>(w.retry_index[k]);
-    t[i] = w.retry_t[k];
-    flags[i] = w.retry_flags[k];
-    ++recovered;
-  }
-  return recovered;
-}
-
 const Tracer* TracerFor(const ExtractInputs& inputs, PtexFaceId face) {
   if (!inputs.tracer) return nullptr;
   if (!inputs.traced.empty() && !inputs.traced[static_cast<std::size_t>(face.value)]) {
@@ -136,6 +102,40 @@ void TakeDistances(std::size_t count, FaceScratch& w, FaceStats& stats) {
 }
 
 }  // namespace
+
+// Rays along +-n from each origin; with a retry distance, the samples that missed are searched
+// again that far. Returns how many the second search found.
+std::int32_t TraceRays(const Tracer& tracer, const ExtractSettings& settings,
+                       std::span<const Float3> origins, std::span<const Float3> normals,
+                       std::span<float> t, std::span<std::uint8_t> flags, FaceScratch& w) {
+  const std::size_t count = origins.size();
+  tracer.TraceNormals(origins, normals, settings.query, NormalHits{t, {}, flags}, w.counters);
+  if (!(settings.retry_query.distance > 0)) return 0;
+  w.retry_origins.clear();
+  w.retry_normals.clear();
+  w.retry_index.clear();
+  for (std::size_t i = 0; i < count; ++i) {
+    if (flags[i] & HitFlags::kHit) continue;
+    w.retry_index.push_back(static_cast<std::int32_t>(i));
+    w.retry_origins.push_back(origins[i]);
+    w.retry_normals.push_back(normals[i]);
+  }
+  if (w.retry_index.empty()) return 0;
+  const std::size_t m = w.retry_index.size();
+  w.retry_t.resize(m);
+  w.retry_flags.resize(m);
+  tracer.TraceNormals(w.retry_origins, w.retry_normals, settings.retry_query,
+                      NormalHits{w.retry_t, {}, w.retry_flags}, w.counters);
+  std::int32_t recovered = 0;
+  for (std::size_t k = 0; k < m; ++k) {
+    if (!(w.retry_flags[k] & HitFlags::kHit)) continue;
+    const auto i = static_cast<std::size_t>(w.retry_index[k]);
+    t[i] = w.retry_t[k];
+    flags[i] = w.retry_flags[k];
+    ++recovered;
+  }
+  return recovered;
+}
 
 StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
                                  const ExtractSettings& settings, FaceScratch& w,

@@ -75,6 +75,12 @@ struct FaceScratch {
   double cpu_limit = 0, cpu_trace = 0, cpu_spectral = 0, cpu_write = 0;  // this thread's seconds
 };
 
+// Rays along +-n from each origin under settings.query; with a retry distance, the samples that
+// missed are searched again that far. Returns how many the second search found.
+std::int32_t TraceRays(const Tracer& tracer, const ExtractSettings& settings,
+                       std::span<const Float3> origins, std::span<const Float3> normals,
+                       std::span<float> t, std::span<std::uint8_t> flags, FaceScratch& w);
+
 // Fails on an evaluation or analysis error, or on a miss under HolePolicy::kFail.
 // `least_log2`: the least resolution (log2 of u and v texels) the face may get, e.g. for its
 // neighbours to meet it without a step (SpectralOptions::min_ulog2); beyond the planned

@@ -254,7 +254,10 @@ class ChunkParser {
     }
     if (textured == count) {
       ++out_.faces_with_uvs;
-    } else if (keep_uvs_) {
+    } else if (out_.first_face_without_uvs < 0) {
+      out_.first_face_without_uvs = out_.faces;
+    }
+    if (textured != count && keep_uvs_) {
       out_.uv_indices.pop_back(textured);
       keep_uvs_ = false;  // the file has no UVs: stop keeping them
     }

@@ -54,8 +54,9 @@ struct ChunkOutput {
   std::int64_t vertices = 0;       // parsed (equals the counting pass unless error)
   std::int64_t texcoords = 0;
   std::int64_t faces = 0;
-  std::int64_t faces_with_uvs = 0;  // faces that name a texture coordinate at every corner
-  std::optional<ChunkError> error;  // the first error in the chunk; parsing stopped there
+  std::int64_t faces_with_uvs = 0;           // faces that name a texture coordinate at every corner
+  std::int64_t first_face_without_uvs = -1;  // within the chunk; -1: none
+  std::optional<ChunkError> error;           // the first error in the chunk; parsing stopped there
 };
 
 // Parses the chunk. Never throws for bad bytes; an error stops the chunk and is recorded.

@@ -205,7 +205,7 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   if (out_of_memory.load()) return Status::Error(name + ": out of memory while reading");
 
   std::uint64_t corners = 0;
-  std::int64_t faces_without_uvs = 0;
+  std::int64_t faces_without_uvs = 0, first_face_without_uvs = -1, faces_before = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const mesh::ChunkOutput& out = outputs[i];
     if (out.error) return LineError(name, out.error->line, out.error->message);
@@ -214,6 +214,10 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     DISPEX_CHECK_EQ(out.faces, counts[i].faces);
     corners += out.indices.size();
     faces_without_uvs += out.faces - out.faces_with_uvs;
+    if (first_face_without_uvs < 0 && out.first_face_without_uvs >= 0) {
+      first_face_without_uvs = faces_before + out.first_face_without_uvs;
+    }
+    faces_before += out.faces;
   }
   if (faces == 0) {
     return Status::Error(
@@ -247,8 +251,10 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   } else {
     for (auto& out : outputs) out.uv_indices.Release();
     std::vector<float>().swap(mesh.uvs);
-    if (faces_without_uvs < faces)
+    if (faces_without_uvs < faces) {
       mesh.faces_without_uvs = static_cast<std::size_t>(faces_without_uvs);
+      mesh.first_face_without_uvs = static_cast<std::size_t>(first_face_without_uvs);
+    }
   }
 
   MergeGroups(outputs, mesh);

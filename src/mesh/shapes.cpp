@@ -472,6 +472,7 @@ void BuildShapeMesh(const Mesh& parent, std::int32_t shape, std::span<const std:
     }
   }
   mesh.faces_without_uvs = parent.faces_without_uvs;
+  mesh.first_face_without_uvs = parent.first_face_without_uvs;
 }
 
 std::string SourceStem(const std::string& source) {

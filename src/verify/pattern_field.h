@@ -1,7 +1,7 @@
 // h and D over the base's limit surface for one MakeSculpt run, in one place for every pattern:
 // the closed-form patterns of the position (EvaluatePattern, EvaluatePatternVector) and the
 // image pattern of the point's place on the base (Ptex face, u, v) through the cage's UVs
-// (uv_charts.h, height_image.h).
+// (dispex/uv_charts.h, height_image.h).
 // make_sculpt.cpp evaluates it at the sculpt's vertices and at its faces' centres.
 #pragma once
 
@@ -9,9 +9,9 @@
 
 #include "dispex/mesh.h"
 #include "dispex/subdiv.h"
+#include "dispex/uv_charts.h"
 #include "dispex/verify.h"
 #include "verify/height_image.h"
-#include "verify/uv_charts.h"
 
 namespace dispex::verify {
 

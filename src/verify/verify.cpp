@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -30,6 +31,8 @@
 #include "dispex/ptex_sampler.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
+#include "dispex/uv_charts.h"
+#include "dispex/uv_map.h"
 #include "dispex/vector_space.h"
 
 namespace dispex {
@@ -74,6 +77,43 @@ Float3 MapVector(const PtexFile& map, VectorSpace space, PtexFaceId face, float 
   return VectorFromChannels(space, frame, c);
 }
 
+// The map under test as the displaced surface reads it: a Ptex map per face, or a UV-space
+// map through the cage's UVs (dispex/uv_charts.h), bilinear within its UDIM tile.
+struct MapReader {
+  std::string name;
+  const PtexFile* ptex = nullptr;
+  const UvMap* uv = nullptr;
+  const PtexUvCharts* charts = nullptr;
+  std::optional<VectorSpace> space;  // Ptex vector maps only
+
+  float Scalar(PtexFaceId face, float u, float v) const {
+    if (ptex != nullptr) return ptex->Sample(face, u, v);
+    double at[2];
+    charts->Evaluate(face, u, v, at);
+    float h = 0;
+    uv->Sample(at[0], at[1], {&h, 1});
+    return h;
+  }
+  Float3 Vector(PtexFaceId face, float u, float v, const SurfaceFrame& frame) const {
+    return MapVector(*ptex, *space, face, u, v, frame);
+  }
+  // Samples per side of a face's displaced grid: twice the Ptex face's resolution within
+  // [8, 64]; for a UV map, twice the texels its UV footprint spans within [8, 64].
+  int SamplesPerSide(PtexFaceId face) const {
+    if (ptex != nullptr) {
+      const PtexFaceInfo& info = ptex->face_info(face);
+      return std::clamp(2 * std::max(info.ures(), info.vres()), 8, 64);
+    }
+    const double* c = charts->corners(face);
+    double span = 0;
+    for (int k = 0; k < 4; ++k) {
+      const int l = (k + 1) % 4;
+      span = std::max(span, std::hypot(c[2 * l] - c[2 * k], c[2 * l + 1] - c[2 * k + 1]));
+    }
+    return std::clamp(static_cast<int>(std::ceil(2 * span * uv->resolution())), 8, 64);
+  }
+};
+
 // Limit points with their frames, 3 floats per point in each array.
 struct FrameScratch {
   std::vector<float> uv, p, nrm, du, dv;
@@ -95,8 +135,9 @@ struct DisplacedSurface {
   std::vector<int> k;  // per face, 0 for holes
 };
 
-StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const PtexFile& map,
-                                    std::optional<VectorSpace> space, int fixed_k) {
+StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const MapReader& map,
+                                    int fixed_k) {
+  const std::optional<VectorSpace> space = map.space;
   const int n = surface.num_ptex_faces();
   DisplacedSurface d;
   d.k.assign(static_cast<std::size_t>(n), 0);
@@ -105,15 +146,12 @@ StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const PtexFile&
   for (int f = 0; f < n; ++f) {
     PtexFaceId face(f);
     int k = 0;
-    if (!surface.is_hole(face)) {
-      const PtexFaceInfo& info = map.face_info(face);
-      k = fixed_k > 0 ? fixed_k : std::clamp(2 * std::max(info.ures(), info.vres()), 8, 64);
-    }
+    if (!surface.is_hole(face)) k = fixed_k > 0 ? fixed_k : map.SamplesPerSide(face);
     d.k[static_cast<std::size_t>(f)] = k;
     vertex_start[f + 1] = vertex_start[f] + (k ? std::size_t(k + 1) * (k + 1) : 0);
     sample_start[f + 1] = sample_start[f] + std::size_t(k) * k;
   }
-  d.mesh.source = map.name() + " (displaced)";
+  d.mesh.source = map.name + " (displaced)";
   d.mesh.positions.reserve(vertex_start[n] + 1);
   d.mesh.positions.resize(vertex_start[n]);
   d.samples.resize(sample_start[n]);
@@ -160,10 +198,10 @@ StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const PtexFile&
     auto displaced = [&](std::size_t j) {
       const float u = s.uv[2 * j], v = s.uv[2 * j + 1];
       if (space) {
-        const Float3 m = MapVector(map, *space, face, u, v, s.At(j));
+        const Float3 m = map.Vector(face, u, v, s.At(j));
         return Float3{s.p[3 * j] + m.x, s.p[3 * j + 1] + m.y, s.p[3 * j + 2] + m.z};
       }
-      float h = map.Sample(face, u, v);
+      const float h = map.Scalar(face, u, v);
       return Float3{s.p[3 * j] + h * s.nrm[3 * j], s.p[3 * j + 1] + h * s.nrm[3 * j + 1],
                     s.p[3 * j + 2] + h * s.nrm[3 * j + 2]};
     };
@@ -188,7 +226,7 @@ StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const PtexFile&
   DISPEX_RETURN_IF_ERROR(error);
   for (const Float3& p : d.mesh.positions) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      return Status::Error(map.name() + ": the map holds values that are not finite");
+      return Status::Error(map.name + ": the map holds values that are not finite");
     }
   }
   return d;
@@ -223,8 +261,9 @@ struct TruthComparison {
   std::vector<Float3> map_d;         // with D in the truth: the map's D (map N for a scalar map)
 };
 
-StatusOr<TruthComparison> CompareTruth(const LimitSurface& surface, const PtexFile& map,
-                                       std::optional<VectorSpace> space, const GroundTruth& truth) {
+StatusOr<TruthComparison> CompareTruth(const LimitSurface& surface, const MapReader& map,
+                                       const GroundTruth& truth) {
+  const std::optional<VectorSpace> space = map.space;
   const std::size_t n = truth.size();
   TruthComparison out;
   out.errors.resize(n);
@@ -233,7 +272,7 @@ StatusOr<TruthComparison> CompareTruth(const LimitSurface& surface, const PtexFi
   const bool vector_truth = !truth.d.empty();
   if (!space && !vector_truth) {  // the map's value against h: no frames needed
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      float value = map.Sample(truth.faces[i], truth.uvs[2 * i], truth.uvs[2 * i + 1]);
+      float value = map.Scalar(truth.faces[i], truth.uvs[2 * i], truth.uvs[2 * i + 1]);
       out.map_normal[i] = value;
       out.signed_errors[i] = value - truth.h[i];
       out.errors[i] = std::abs(out.signed_errors[i]);
@@ -281,14 +320,14 @@ StatusOr<TruthComparison> CompareTruth(const LimitSurface& surface, const PtexFi
       double error_value, signed_error, map_normal;
       Vec3d map_d;
       if (space) {
-        map_d = ToVec3d(MapVector(map, *space, face, u, v, frame));
+        map_d = ToVec3d(map.Vector(face, u, v, frame));
         map_normal = Dot(map_d, normal);
         signed_error = vector_truth ? Dot(map_d - d, normal) : map_normal - h;
         error_value = vector_truth ? Length(map_d - d) : std::abs(signed_error);
       } else {
         // The normal part from the record's own h, so that a map of a scalar pattern measures
         // as against a scalar truth; the tangential part of D, which h N lacks, on top.
-        map_normal = map.Sample(face, u, v);
+        map_normal = map.Scalar(face, u, v);
         map_d = normal * map_normal;
         signed_error = map_normal - h;
         const double tangential = Length(d - normal * h);
@@ -315,6 +354,66 @@ void RmsThreshold(VerifyReport& r, const char* what, const ErrorStats& s, double
   if (!r.passed || limit <= 0 || s.rms <= limit) return;
   r.passed = false;
   r.failure = fmt::format("{} RMS error {:.6g} exceeds max_rms = {:.6g}", what, s.rms, limit);
+}
+
+void P99Threshold(VerifyReport& r, const char* what, const ErrorStats& s, double limit) {
+  if (!r.passed || limit <= 0 || s.p99 <= limit) return;
+  r.passed = false;
+  r.failure = fmt::format("{} 99th percentile {:.6g} exceeds max_p99 = {:.6g}", what, s.p99, limit);
+}
+
+// Sculpt vertices, evenly strided to at most `max_points` (0: all).
+std::vector<Float3> SculptPoints(const Mesh& sculpt, std::size_t max_points) {
+  std::size_t stride = 1;
+  if (max_points > 0 && sculpt.num_vertices() > max_points) {
+    stride = (sculpt.num_vertices() + max_points - 1) / max_points;
+  }
+  std::vector<Float3> points;
+  points.reserve(sculpt.num_vertices() / stride + 1);
+  for (std::size_t v = 0; v < sculpt.num_vertices(); v += stride) {
+    points.push_back(sculpt.positions[v]);
+  }
+  return points;
+}
+
+// VerifyOptions::displaced_path: a displaced mesh against the sculpt, both ways.
+StatusOr<VerifyReport> VerifyDisplacedMesh(const VerifyOptions& options) {
+  Stopwatch clock;
+  if (options.sculpt_path.empty()) {
+    return Status::Error(options.displaced_path +
+                         ": a displaced mesh is measured against a sculpt");
+  }
+  DISPEX_ASSIGN_OR_RETURN(Mesh displaced, ReadMesh(options.displaced_path));
+  DISPEX_ASSIGN_OR_RETURN(Mesh sculpt, ReadMesh(options.sculpt_path));
+  VerifyReport r;
+  r.displaced_mesh = true;
+  r.diagonal = ComputeBounds(displaced).diagonal();
+  {
+    DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> sculpt_tracer, MakeEmbreeTracer(sculpt));
+    std::vector<float> d = ClosestDistances(*sculpt_tracer, displaced.positions);
+    r.map_to_sculpt = Summarise(d);
+  }
+  {
+    DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer, MakeEmbreeTracer(displaced));
+    std::vector<float> d =
+        ClosestDistances(*tracer, SculptPoints(sculpt, options.max_sculpt_points));
+    r.sculpt_to_map = Summarise(d);
+  }
+  r.measured_distances = true;
+  double limit_abs = options.max_error;
+  if (options.max_error_rel > 0) {
+    const double rel = options.max_error_rel * r.diagonal;
+    limit_abs = limit_abs > 0 ? std::min(limit_abs, rel) : rel;
+  }
+  const char* option = options.max_error_rel > 0 ? "max_error_rel" : "max_error";
+  Threshold(r, "displaced->sculpt", r.map_to_sculpt, limit_abs, option);
+  Threshold(r, "sculpt->displaced", r.sculpt_to_map, limit_abs, option);
+  P99Threshold(r, "displaced->sculpt", r.map_to_sculpt, options.max_p99);
+  P99Threshold(r, "sculpt->displaced", r.sculpt_to_map, options.max_p99);
+  RmsThreshold(r, "displaced->sculpt", r.map_to_sculpt, options.max_rms);
+  RmsThreshold(r, "sculpt->displaced", r.sculpt_to_map, options.max_rms);
+  r.seconds = clock.seconds();
+  return r;
 }
 
 // The map's face table for the sampler: resolutions from the map, adjacency and sub-face
@@ -524,6 +623,7 @@ void EdgeThresholds(VerifyReport& r, const VerifyOptions& options) {
 }  // namespace
 
 StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
+  if (!options.displaced_path.empty()) return VerifyDisplacedMesh(options);
   Stopwatch clock;
   if (options.samples_per_face < 0 || options.samples_per_face > 512) {
     return Status::Error(
@@ -535,58 +635,79 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   }
   DISPEX_ASSIGN_OR_RETURN(Mesh base, ReadMesh(options.base_path));
   DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
-  DISPEX_ASSIGN_OR_RETURN(PtexFile map, PtexFile::Open(options.map_path));
   VerifyReport r;
   r.ptex_faces = static_cast<std::size_t>(surface.num_ptex_faces());
   r.diagonal = ComputeBounds(base).diagonal();
   r.warnings = IgnoredTagWarnings(base);
-  if (map.num_faces() != surface.num_ptex_faces()) {
-    return Status::Error(fmt::format(
-        "{}: {} faces, but {} has {} Ptex faces: not a map of this "
-        "base mesh",
-        options.map_path, map.num_faces(), options.base_path, surface.num_ptex_faces()));
-  }
-  DISPEX_ASSIGN_OR_RETURN(const std::optional<VectorSpace> space, MapSpace(map));
-  r.map_vector = space.has_value();
-  if (space) {
-    r.map_space = *space;
-    const PtexEdgeFilterMode expected = *space == VectorSpace::kObject
-                                            ? PtexEdgeFilterMode::kNone
-                                            : PtexEdgeFilterMode::kTangentVector;
-    if (map.header().edge_filter != expected) {
-      r.warnings.push_back(fmt::format(
-          "{}: a {} vector map with edge filter mode {} ({} expected): filters across faces "
-          "will not turn its vectors as they should",
-          options.map_path, VectorSpaceName(*space),
-          PtexEdgeFilterModeName(map.header().edge_filter), PtexEdgeFilterModeName(expected)));
+  MapReader reader;
+  reader.name = options.map_path;
+  std::optional<PtexFile> ptex;
+  std::optional<UvMap> uv;
+  std::optional<PtexUvCharts> charts;
+  if (IsUvMapPath(options.map_path)) {
+    DISPEX_ASSIGN_OR_RETURN(uv, UvMap::Open(options.map_path));
+    if (uv->channels() != 1) {
+      return Status::Error(options.map_path +
+                           ": a UV map of 3 channels: verify reads scalar UV maps only");
     }
-  }
-  if (const PtexMetaItem* stats = map.FindMetaData("dispex:statistics")) {
-    auto j = nlohmann::json::parse(stats->AsString(), nullptr, false);
-    if (j.is_object()) {
-      r.map_misses = j.value("misses", std::int64_t{-1});
-      r.map_holes_filled = j.value("holes_filled", std::int64_t{-1});
-      r.map_faces_filled_from_neighbours =
-          j.value("faces_filled_from_neighbours", std::int64_t{-1});
-      r.map_tolerance = j.value("tolerance", 0.0);
+    DISPEX_ASSIGN_OR_RETURN(charts, PtexUvCharts::Build(base, surface));
+    reader.uv = &*uv;
+    reader.charts = &*charts;
+    const std::string tolerance = uv->Attribute("dispex:tolerance");
+    if (!tolerance.empty()) r.map_tolerance = std::strtod(tolerance.c_str(), nullptr);
+  } else {
+    DISPEX_ASSIGN_OR_RETURN(ptex, PtexFile::Open(options.map_path));
+    const PtexFile& map = *ptex;
+    if (map.num_faces() != surface.num_ptex_faces()) {
+      return Status::Error(fmt::format(
+          "{}: {} faces, but {} has {} Ptex faces: not a map of this "
+          "base mesh",
+          options.map_path, map.num_faces(), options.base_path, surface.num_ptex_faces()));
     }
+    DISPEX_ASSIGN_OR_RETURN(const std::optional<VectorSpace> space, MapSpace(map));
+    r.map_vector = space.has_value();
+    if (space) {
+      r.map_space = *space;
+      const PtexEdgeFilterMode expected = *space == VectorSpace::kObject
+                                              ? PtexEdgeFilterMode::kNone
+                                              : PtexEdgeFilterMode::kTangentVector;
+      if (map.header().edge_filter != expected) {
+        r.warnings.push_back(fmt::format(
+            "{}: a {} vector map with edge filter mode {} ({} expected): filters across faces "
+            "will not turn its vectors as they should",
+            options.map_path, VectorSpaceName(*space),
+            PtexEdgeFilterModeName(map.header().edge_filter), PtexEdgeFilterModeName(expected)));
+      }
+    }
+    if (const PtexMetaItem* stats = map.FindMetaData("dispex:statistics")) {
+      auto j = nlohmann::json::parse(stats->AsString(), nullptr, false);
+      if (j.is_object()) {
+        r.map_misses = j.value("misses", std::int64_t{-1});
+        r.map_holes_filled = j.value("holes_filled", std::int64_t{-1});
+        r.map_faces_filled_from_neighbours =
+            j.value("faces_filled_from_neighbours", std::int64_t{-1});
+        r.map_tolerance = j.value("tolerance", 0.0);
+      }
+    }
+    reader.ptex = &map;
+    reader.space = space;
+    DISPEX_RETURN_IF_ERROR(MeasureEdges(base, surface, map, space, options, r));
   }
-
-  DISPEX_RETURN_IF_ERROR(MeasureEdges(base, surface, map, space, options, r));
+  const std::optional<VectorSpace> space = reader.space;
 
   if (!options.truth_path.empty()) {
     DISPEX_ASSIGN_OR_RETURN(GroundTruth truth, ReadGroundTruth(options.truth_path));
     for (std::size_t i = 0; i < truth.size(); ++i) {
       int f = truth.faces[i].value;
       float u = truth.uvs[2 * i], v = truth.uvs[2 * i + 1];
-      if (f < 0 || f >= map.num_faces() || !(u >= 0 && u <= 1 && v >= 0 && v <= 1)) {
+      if (f < 0 || f >= surface.num_ptex_faces() || !(u >= 0 && u <= 1 && v >= 0 && v <= 1)) {
         return Status::Error(fmt::format("{}: record {} names face {} at ({}, {}), outside {}",
                                          options.truth_path, i, f, u, v, options.map_path));
       }
     }
     r.truth_version = truth.version();
     r.truth_quantity = TruthQuantity(space.has_value(), !truth.d.empty());
-    DISPEX_ASSIGN_OR_RETURN(TruthComparison compared, CompareTruth(surface, map, space, truth));
+    DISPEX_ASSIGN_OR_RETURN(TruthComparison compared, CompareTruth(surface, reader, truth));
     std::vector<float>& errors = compared.errors;
     const std::vector<float>& signed_errors = compared.signed_errors;
     double sum = 0;
@@ -634,7 +755,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   if (!options.sculpt_path.empty()) {
     DISPEX_ASSIGN_OR_RETURN(Mesh sculpt, ReadMesh(options.sculpt_path));
     DISPEX_ASSIGN_OR_RETURN(DisplacedSurface displaced,
-                            Displace(surface, map, space, options.samples_per_face));
+                            Displace(surface, reader, options.samples_per_face));
     r.samples_per_face_min = 1 << 30;
     for (int k : displaced.k) {
       if (k == 0) continue;
@@ -661,17 +782,8 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     }
     {
       DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> map_tracer, MakeEmbreeTracer(displaced.mesh));
-      std::size_t stride = 1;
-      if (options.max_sculpt_points > 0 && sculpt.num_vertices() > options.max_sculpt_points) {
-        stride =
-            (sculpt.num_vertices() + options.max_sculpt_points - 1) / options.max_sculpt_points;
-      }
-      std::vector<Float3> points;
-      points.reserve(sculpt.num_vertices() / stride + 1);
-      for (std::size_t v = 0; v < sculpt.num_vertices(); v += stride) {
-        points.push_back(sculpt.positions[v]);
-      }
-      std::vector<float> d = ClosestDistances(*map_tracer, points);
+      std::vector<float> d =
+          ClosestDistances(*map_tracer, SculptPoints(sculpt, options.max_sculpt_points));
       r.sculpt_to_map = Summarise(d);
     }
     r.measured_distances = true;
@@ -719,6 +831,8 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   if (r.measured_distances) {
     RmsThreshold(r, "map->sculpt", r.map_to_sculpt, options.max_rms);
     RmsThreshold(r, "sculpt->map", r.sculpt_to_map, options.max_rms);
+    P99Threshold(r, "map->sculpt", r.map_to_sculpt, options.max_p99);
+    P99Threshold(r, "sculpt->map", r.sculpt_to_map, options.max_p99);
   }
   r.seconds = clock.seconds();
   return r;
@@ -747,7 +861,7 @@ std::string VerifyReportJson(const VerifyReport& r) {
   nlohmann::json j;
   j["diagonal"] = r.diagonal;
   j["ptex_faces"] = r.ptex_faces;
-  j["map_kind"] = r.map_vector ? "vector" : "scalar";
+  j["map_kind"] = r.displaced_mesh ? "displaced mesh" : r.map_vector ? "vector" : "scalar";
   if (r.map_vector) j["vector_space"] = VectorSpaceName(r.map_space);
   if (r.measured_distances) {
     j["samples_per_face"] = {r.samples_per_face_min, r.samples_per_face_max};
@@ -827,6 +941,13 @@ std::string VerifyReportJson(const VerifyReport& r) {
 }
 
 std::string VerifyReportSummary(const VerifyReport& r) {
+  if (r.displaced_mesh) {
+    return fmt::format(
+               "verify: a displaced mesh against the sculpt, bounding-box diagonal {:.4g}\n",
+               r.diagonal) +
+           StatsLine("displaced->sculpt", r.map_to_sculpt, r.diagonal) +
+           StatsLine("sculpt->displaced", r.sculpt_to_map, r.diagonal);
+  }
   std::string out = fmt::format(
       "verify: {} Ptex faces, bounding-box diagonal {:.4g}, {}\n", r.ptex_faces, r.diagonal,
       r.map_vector ? fmt::format("vector map ({} space: P + D)", VectorSpaceName(r.map_space))

@@ -22,9 +22,9 @@
 #include "core/png_io.h"
 #include "dispex/mesh.h"
 #include "dispex/subdiv.h"
+#include "dispex/uv_charts.h"
 #include "dispex/verify.h"
 #include "verify/height_image.h"
-#include "verify/uv_charts.h"
 
 namespace dispex {
 namespace {
@@ -480,7 +480,9 @@ TEST(ImagePatternErrors, OneLineNamingTheFile) {
                           "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
                           "f 1/1 2/2 3/3 4/4\nf 2 5 6 3\n";
   m = MakeSculptError(mixed, image, dir);
-  EXPECT_EQ(m.rfind(mixed + ": 1 of 2 faces have no texture coordinates", 0), 0u) << m;
+  EXPECT_EQ(m.rfind(mixed + ": face 1 has no texture coordinates (vt; 1 of 2 faces have none)", 0),
+            0u)
+      << m;
 
   const std::string missing = dir / "missing.png";
   m = MakeSculptError(spot, missing, dir);

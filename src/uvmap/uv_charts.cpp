@@ -1,22 +1,22 @@
-// Per-Ptex-face corner UVs (see uv_charts.h).
-#include "verify/uv_charts.h"
+// Per-Ptex-face corner UVs (see dispex/uv_charts.h).
+#include "dispex/uv_charts.h"
 
 #include <fmt/format.h>
 
-namespace dispex::verify {
+#include <cmath>
+
+namespace dispex {
 
 StatusOr<PtexUvCharts> PtexUvCharts::Build(const Mesh& cage, const LimitSurface& surface) {
   if (!cage.has_uvs()) {
     if (cage.faces_without_uvs > 0) {
       return Status::Error(fmt::format(
-          "{}: {} of {} faces have no texture coordinates (vt), so the cage has no UVs; the "
-          "image pattern needs them on every face",
-          cage.source, cage.faces_without_uvs, cage.num_faces()));
+          "{}: face {} has no texture coordinates (vt; {} of {} faces have none): UVs are "
+          "needed on every face",
+          cage.source, cage.first_face_without_uvs, cage.faces_without_uvs, cage.num_faces()));
     }
-    return Status::Error(fmt::format(
-        "{}: the cage has no texture coordinates (vt on its faces); the image pattern reads "
-        "the image through the cage's UVs",
-        cage.source));
+    return Status::Error(
+        fmt::format("{}: the cage has no texture coordinates (vt on its faces)", cage.source));
   }
   if (static_cast<std::size_t>(surface.num_base_faces()) != cage.num_faces()) {
     return Status::Error(fmt::format("{}: the limit surface has {} faces, the cage {}", cage.source,
@@ -62,4 +62,10 @@ StatusOr<PtexUvCharts> PtexUvCharts::Build(const Mesh& cage, const LimitSurface&
   return charts;
 }
 
-}  // namespace dispex::verify
+int UdimOfUv(double u, double v) {
+  const double tu = std::floor(u), tv = std::floor(v);
+  if (!(tu >= 0 && tu <= 9 && tv >= 0 && tv <= 98)) return 0;
+  return 1001 + static_cast<int>(tu) + 10 * static_cast<int>(tv);
+}
+
+}  // namespace dispex

@@ -1,0 +1,232 @@
+// See uv_maps.h.
+#include "extract/uv_maps.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <set>
+
+#include "core/system.h"
+#include "dispex/cancel.h"
+#include "dispex/uv_charts.h"
+#include "dispex/uv_map.h"
+#include "dispex/version.h"
+#include "extract/face_pipeline.h"
+#include "extract/parallel_errors.h"
+
+namespace dispex::extract {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The texels of each Ptex face, in tile and texel order: (tile index, texel index) pairs.
+struct FaceTexels {
+  std::vector<std::size_t> offsets;  // num_faces + 1
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> texels;
+};
+
+FaceTexels GroupByFace(const UvRaster& raster, int num_faces) {
+  FaceTexels out;
+  out.offsets.assign(static_cast<std::size_t>(num_faces) + 1, 0);
+  for (const UvTile& tile : raster.tiles) {
+    for (const UvTexelPlace& p : tile.places) {
+      if (p.face >= 0) ++out.offsets[static_cast<std::size_t>(p.face) + 1];
+    }
+  }
+  for (std::size_t f = 1; f < out.offsets.size(); ++f) out.offsets[f] += out.offsets[f - 1];
+  out.texels.resize(out.offsets.back());
+  std::vector<std::size_t> next(out.offsets.begin(), out.offsets.end() - 1);
+  for (std::size_t t = 0; t < raster.tiles.size(); ++t) {
+    const auto& places = raster.tiles[t].places;
+    for (std::size_t i = 0; i < places.size(); ++i) {
+      if (places[i].face < 0) continue;
+      out.texels[next[static_cast<std::size_t>(places[i].face)]++] = {
+          static_cast<std::uint32_t>(t), static_cast<std::uint32_t>(i)};
+    }
+  }
+  return out;
+}
+
+struct UvScratch {
+  explicit UvScratch(const LimitSurface& surface) : face(surface) {}
+  FaceScratch face;  // its evaluator and the rays' retry buffers
+  std::vector<float> uv, positions, normals, t;
+  std::vector<std::uint8_t> flags;
+};
+
+std::string FaceList(const std::vector<std::int32_t>& faces) {
+  std::string out;
+  for (std::size_t i = 0; i < faces.size() && i < 10; ++i) {
+    out += fmt::format("{}{}", i ? ", " : "", faces[i]);
+  }
+  if (faces.size() > 10) out += ", ...";
+  return out;
+}
+
+std::vector<std::pair<std::string, std::string>> TileAttributes(const ExtractOptions& options,
+                                                                const ExtractReport& report) {
+  return {
+      {"dispex:version", DISPEX_VERSION_STRING},
+      {"dispex:space", "normal"},
+      {"dispex:channels", "Y: signed distance along the limit surface's unit normal"},
+      {"dispex:midpoint", "0"},
+      {"dispex:scale", "1"},
+      {"dispex:units", "object units of the base mesh"},
+      {"dispex:uv_rule",
+       "face-varying linear (OpenSubdiv FVAR_LINEAR_ALL; Blender Subdivision Surface UV "
+       "Smooth: None); texel (i, j) centred at ((i+0.5)/N, (j+0.5)/N) of its UDIM tile"},
+      {"dispex:padding", fmt::format("{}", options.uv_padding)},
+      {"dispex:base", report.base_path},
+      {"dispex:sculpt", report.sculpt_path},
+      {"dispex:base_fingerprint", report.base_fingerprint},
+      {"dispex:sculpt_fingerprint", report.sculpt_fingerprint},
+      {"dispex:search_distance", fmt::format("{}", report.search_distance)},
+      // The Ptex map's tolerance, which verify's truth bounds scale with (the texels
+      // themselves are samples, not fitted to it).
+      {"dispex:tolerance", fmt::format("{}", report.tolerance)},
+  };
+}
+
+// Tiles of `shape` in `dir` that this run did not write.
+void RemoveStaleTiles(const std::string& dir, const std::string& shape,
+                      const std::set<std::string>& written, ExtractReport& report) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() != shape.size() + 9 || name.compare(0, shape.size() + 1, shape + ".") != 0 ||
+        name.compare(name.size() - 4, 4, ".exr") != 0) {
+      continue;
+    }
+    const std::string digits = name.substr(shape.size() + 1, 4);
+    if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
+        written.count(entry.path().string()) != 0) {
+      continue;
+    }
+    std::error_code remove_error;
+    if (fs::remove(entry.path(), remove_error)) {
+      report.warnings.push_back(
+          fmt::format("{}: removed, a tile of an earlier run that these UVs no longer touch",
+                      entry.path().string()));
+    }
+  }
+}
+
+}  // namespace
+
+Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
+                   const ExtractSettings& settings, ExtractReport& report) {
+  Stopwatch clock;
+  DISPEX_ASSIGN_OR_RETURN(PtexUvCharts charts, PtexUvCharts::Build(inputs.base, inputs.surface));
+  DISPEX_ASSIGN_OR_RETURN(UvRaster raster,
+                          RasterizeUvCharts(charts, inputs.surface, options.uv_resolution));
+  if (inputs.mapping != nullptr || inputs.tracer == nullptr || !inputs.traced.empty()) {
+    DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
+  }
+  const int num_faces = inputs.surface.num_ptex_faces();
+  const FaceTexels by_face = GroupByFace(raster, num_faces);
+  const int n = raster.resolution;
+  const std::size_t tile_texels = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+  std::vector<std::vector<float>> values(raster.tiles.size(), std::vector<float>(tile_texels, 0));
+  std::vector<std::vector<std::uint8_t>> filled(raster.tiles.size(),
+                                                std::vector<std::uint8_t>(tile_texels, 0));
+  std::vector<std::int64_t> face_misses(static_cast<std::size_t>(num_faces), 0);
+  std::vector<int> faces;
+  for (int f = 0; f < num_faces; ++f) {
+    if (by_face.offsets[static_cast<std::size_t>(f) + 1] >
+        by_face.offsets[static_cast<std::size_t>(f)]) {
+      faces.push_back(f);
+    }
+  }
+  tbb::enumerable_thread_specific<UvScratch> scratches([&] { return UvScratch(inputs.surface); });
+  const Status traced = ForEachFace(
+      static_cast<int>(faces.size()), [&](int k) { return faces[static_cast<std::size_t>(k)]; },
+      scratches, nullptr,
+      [&](PtexFaceId face, UvScratch& w) {
+        const auto f = static_cast<std::size_t>(face.value);
+        const std::size_t begin = by_face.offsets[f], count = by_face.offsets[f + 1] - begin;
+        w.uv.resize(2 * count);
+        for (std::size_t k = 0; k < count; ++k) {
+          const auto [tile, texel] = by_face.texels[begin + k];
+          const UvTexelPlace& p = raster.tiles[tile].places[texel];
+          w.uv[2 * k] = p.u;
+          w.uv[2 * k + 1] = p.v;
+        }
+        w.positions.resize(3 * count);
+        w.normals.resize(3 * count);
+        w.t.resize(count);
+        w.flags.resize(count);
+        DISPEX_RETURN_IF_ERROR(w.face.evaluator.EvaluatePoints(face, w.uv, w.positions, w.normals));
+        const std::span<const Float3> origins(reinterpret_cast<const Float3*>(w.positions.data()),
+                                              count);
+        const std::span<const Float3> normals(reinterpret_cast<const Float3*>(w.normals.data()),
+                                              count);
+        TraceRays(*inputs.tracer, settings, origins, normals, w.t, w.flags, w.face);
+        for (std::size_t k = 0; k < count; ++k) {
+          const auto [tile, texel] = by_face.texels[begin + k];
+          if (!(w.flags[k] & HitFlags::kHit)) {
+            ++face_misses[f];
+            continue;
+          }
+          values[tile][texel] = w.t[k];
+          filled[tile][texel] = 1;
+        }
+        return Status::Ok();
+      });
+  DISPEX_RETURN_IF_ERROR(traced);
+  DISPEX_RETURN_IF_ERROR(inputs.tracer->status());
+  for (std::int64_t m : face_misses) report.uv_texels_missed += m;
+  report.uv_texels_inside = raster.inside;
+  report.uv_overlap_texels = raster.overlap_texels;
+  report.uv_overlap_faces = raster.overlap_faces;
+  report.uv_faces_outside_udim = raster.faces_outside_udim;
+  if (raster.overlap_texels > 0) {
+    report.warnings.push_back(fmt::format(
+        "{}: {} texel centres of the UV maps lie in more than one UV face (overlapping UVs, "
+        "{} faces: {}); each takes the face it lies deepest in",
+        options.base_path, raster.overlap_texels, raster.overlap_faces.size(),
+        FaceList(raster.overlap_faces)));
+  }
+  if (!raster.faces_outside_udim.empty()) {
+    report.warnings.push_back(fmt::format(
+        "{}: {} faces have UVs outside the UDIM tiles (u in [0, 10), v in [0, 99)) and are "
+        "not in the UV maps: {}",
+        options.base_path, raster.faces_outside_udim.size(), FaceList(raster.faces_outside_udim)));
+  }
+  if (report.uv_texels_missed > 0) {
+    report.warnings.push_back(
+        fmt::format("{} of {} UV map texels missed the sculpt and were filled by dilation",
+                    report.uv_texels_missed, raster.inside));
+  }
+
+  std::error_code ec;
+  fs::create_directories(options.uv_maps_dir, ec);
+  if (ec) {
+    return Status::Error(
+        fmt::format("{}: cannot create the directory: {}", options.uv_maps_dir, ec.message()));
+  }
+  const std::string shape = fs::path(options.output_path).stem().string();
+  const auto attributes = TileAttributes(options, report);
+  std::set<std::string> written;
+  for (std::size_t t = 0; t < raster.tiles.size(); ++t) {
+    if (CancelRequested()) return Cancelled();
+    UvMapTile tile;
+    tile.udim = raster.tiles[t].udim;
+    tile.resolution = n;
+    tile.channels = 1;
+    DilateTile(n, 1, options.uv_padding, values[t], filled[t]);
+    tile.values = std::move(values[t]);
+    tile.attributes = attributes;
+    tile.attributes.emplace_back("dispex:udim", fmt::format("{}", tile.udim));
+    const std::string path = UvMapTilePath(options.uv_maps_dir, shape, tile.udim);
+    DISPEX_RETURN_IF_ERROR(WriteUvMapTile(path, tile, options.data_type == PtexDataType::kHalf));
+    written.insert(path);
+    report.uv_map_paths.push_back(path);
+  }
+  RemoveStaleTiles(options.uv_maps_dir, shape, written, report);
+  report.t_uv_maps = clock.seconds();
+  return Status::Ok();
+}
+
+}  // namespace dispex::extract

@@ -1,0 +1,300 @@
+// extract --uv-maps end to end: every texel inside a UV face against the exact displacement
+// of a generated sculpt at the texel's place on the limit surface; the tiles of a box spread
+// over six UDIM tiles with seams on every edge, the padding around them, determinism at any
+// thread count, and wrong maps (zero, V flipped, tiles swapped) that the same check rejects.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "../extract/e2e_support.h"
+#include "dispex/extract.h"
+#include "dispex/subdiv.h"
+#include "dispex/uv_charts.h"
+#include "dispex/uv_map.h"
+#include "dispex/verify.h"
+
+namespace dispex {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::DataPath;
+using testing::RunDispex;
+using testing::TempDir;
+
+struct TexelErrors {
+  std::size_t count = 0;
+  double p99 = 0, max = 0;
+};
+
+// |texel - h| at every texel centre inside a UV face, h the pattern's exact displacement at
+// the texel's limit point.
+TexelErrors CompareWithTruth(const std::string& cage_path, const UvMap& map,
+                             const MakeSculptReport& sculpt, Pattern pattern) {
+  auto cage = ReadMesh(cage_path);
+  EXPECT_TRUE(cage.ok());
+  auto surface = LimitSurface::Build(*cage);
+  EXPECT_TRUE(surface.ok());
+  auto charts = PtexUvCharts::Build(*cage, *surface);
+  EXPECT_TRUE(charts.ok());
+  auto raster = RasterizeUvCharts(*charts, *surface, map.resolution());
+  EXPECT_TRUE(raster.ok());
+  LimitEvaluator evaluator(*surface);
+  std::vector<double> errors;
+  const int n = map.resolution();
+  for (const UvTile& tile : raster->tiles) {
+    const int tu = (tile.udim - 1001) % 10, tv = (tile.udim - 1001) / 10;
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const UvTexelPlace& p = tile.places[static_cast<std::size_t>(j) * n + i];
+        if (p.face < 0) continue;
+        const float uv[2] = {p.u, p.v};
+        float position[3];
+        EXPECT_TRUE(evaluator.EvaluatePoints(PtexFaceId(p.face), uv, position, {}).ok());
+        const double h = EvaluatePattern(pattern, sculpt.frame, position);
+        float value[1];
+        map.Sample(tu + (i + 0.5) / n, tv + (j + 0.5) / n, value);
+        errors.push_back(std::abs(value[0] - h));
+      }
+    }
+  }
+  TexelErrors e;
+  e.count = errors.size();
+  if (errors.empty()) return e;
+  std::sort(errors.begin(), errors.end());
+  e.p99 = errors[errors.size() * 99 / 100];
+  e.max = errors.back();
+  return e;
+}
+
+struct Extracted {
+  MakeSculptReport sculpt;
+  ExtractReport report;
+};
+
+Extracted ExtractUv(const TempDir& dir, const std::string& cage, int levels, double amplitude,
+                    int resolution, int threads = 0, const std::string& sub = "uv") {
+  auto sculpt = MakeSculpt(
+      testing::SculptOptions(cage, dir / "sculpt.obj", levels, Pattern::kDetail, amplitude));
+  EXPECT_TRUE(sculpt.ok()) << sculpt.status().message();
+  ExtractOptions options;
+  options.base_path = cage;
+  options.sculpt_path = dir / "sculpt.obj";
+  options.output_path = dir / "shape.ptx";
+  options.uv_maps_dir = dir / sub;
+  options.uv_resolution = resolution;
+  options.threads = threads;
+  auto report = Extract(options);
+  EXPECT_TRUE(report.ok()) << report.status().message();
+  return {*sculpt, *report};
+}
+
+TEST(UvExtract, SpotTexelsMatchTheExactDisplacement) {
+  TempDir dir;
+  const std::string cage = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
+  Extracted e = ExtractUv(dir, cage, 3, 0.005, 256);
+  ASSERT_EQ(e.report.uv_map_paths.size(), 2u);  // 1001 and the sliver of 1011
+  EXPECT_EQ(e.report.uv_map_paths[0], dir / "uv/shape.1001.exr");
+  EXPECT_EQ(e.report.uv_texels_missed, 0);
+  EXPECT_GT(e.report.uv_overlap_texels, 0);  // spot's flipped UV faces, reported
+  auto map = UvMap::Open(dir / "uv/shape.<UDIM>.exr");
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  EXPECT_EQ(map->Attribute("dispex:space"), "normal");
+  EXPECT_EQ(map->Attribute("dispex:midpoint"), "0");
+  const TexelErrors err = CompareWithTruth(cage, *map, e.sculpt, Pattern::kDetail);
+  EXPECT_GT(err.count, 30000u);
+  // A texel is the ray's hit on the piecewise-linear sculpt: within its linear error of h
+  // (measured: p99 under 0.2 of it, max under 0.4).
+  const double bound = 0.5 * e.sculpt.linear_error;
+  EXPECT_LT(err.p99, bound) << "linear error " << e.sculpt.linear_error;
+  EXPECT_LT(err.max, 3 * bound);
+  std::printf("spot: p99 %.3g max %.3g, bound %.3g\n", err.p99, err.max, bound);
+}
+
+TEST(UvExtract, BoxOverSixTilesWithSeams) {
+  TempDir dir;
+  const std::string cage = DataPath("uv_maps/udim_box.obj");
+  Extracted e = ExtractUv(dir, cage, 5, 0.02, 64);
+  ASSERT_EQ(e.report.uv_map_paths.size(), 6u);
+  const int udims[] = {1001, 1002, 1003, 1011, 1012, 1013};
+  for (int t = 0; t < 6; ++t) {
+    EXPECT_EQ(e.report.uv_map_paths[t], dir / ("uv/shape." + std::to_string(udims[t]) + ".exr"));
+  }
+  EXPECT_EQ(e.report.uv_overlap_texels, 0);
+  EXPECT_EQ(e.report.uv_texels_inside, 6 * 52 * 52);  // centres in [0.1, 0.9]: 6..57
+  auto map = UvMap::Open(dir / "uv/shape.<UDIM>.exr");
+  ASSERT_TRUE(map.ok());
+  const TexelErrors err = CompareWithTruth(cage, *map, e.sculpt, Pattern::kDetail);
+  EXPECT_EQ(err.count, 6u * 52 * 52);
+  const double bound = 0.5 * e.sculpt.linear_error;
+  EXPECT_LT(err.p99, bound) << "linear error " << e.sculpt.linear_error;
+  EXPECT_LT(err.max, 3 * bound);
+  std::printf("box: p99 %.3g max %.3g, bound %.3g\n", err.p99, err.max, bound);
+
+  // Padding: 16 rings of texels around each side's square copy its edge; beyond, nothing.
+  for (const UvMapTile& tile : map->tiles()) {
+    auto at = [&](int i, int j) { return tile.values[static_cast<std::size_t>(j) * 64 + i]; };
+    // One ring out: the mean of its three inside neighbours.
+    EXPECT_FLOAT_EQ(at(5, 30), (at(6, 29) + at(6, 30) + at(6, 31)) / 3);
+    EXPECT_NE(at(0, 30), 0.0f);     // six rings out, still padded
+    EXPECT_EQ(at(0, 0), at(1, 1));  // the corner, from the diagonal
+  }
+
+  // Wrong maps the same check rejects: zero, V flipped, two tiles swapped.
+  std::vector<UvMapTile> tiles = map->tiles();
+  auto rewrite = [&](const std::string& name, auto change) {
+    fs::create_directories(dir / name);
+    std::vector<UvMapTile> wrong = tiles;
+    change(wrong);
+    for (const UvMapTile& tile : wrong) {
+      ASSERT_TRUE(WriteUvMapTile(UvMapTilePath(dir / name, "shape", tile.udim), tile, false).ok());
+    }
+    auto wrong_map = UvMap::Open(dir / (name + "/shape.<UDIM>.exr"));
+    ASSERT_TRUE(wrong_map.ok());
+    const TexelErrors w = CompareWithTruth(cage, *wrong_map, e.sculpt, Pattern::kDetail);
+    EXPECT_GT(w.p99, bound) << name;  // fails the check the map passes
+    std::printf("%s: p99 %.3g\n", name.c_str(), w.p99);
+  };
+  rewrite("zero", [](std::vector<UvMapTile>& w) {
+    for (auto& t : w) std::fill(t.values.begin(), t.values.end(), 0.0f);
+  });
+  rewrite("flipped_v", [](std::vector<UvMapTile>& w) {
+    for (auto& t : w) {
+      for (int j = 0; j < 32; ++j) {
+        std::swap_ranges(t.values.begin() + j * 64, t.values.begin() + (j + 1) * 64,
+                         t.values.begin() + (63 - j) * 64);
+      }
+    }
+  });
+  rewrite("swapped_tiles", [](std::vector<UvMapTile>& w) { std::swap(w[0].values, w[4].values); });
+}
+
+TEST(UvExtract, SameBytesAtAnyThreadCount) {
+  TempDir dir;
+  const std::string cage = DataPath("uv_maps/udim_box.obj");
+  ExtractUv(dir, cage, 3, 0.02, 48, 1, "one");
+  ExtractUv(dir, cage, 3, 0.02, 48, 3, "three");
+  for (int udim : {1001, 1002, 1003, 1011, 1012, 1013}) {
+    const std::string name = "shape." + std::to_string(udim) + ".exr";
+    EXPECT_EQ(testing::Slurp(dir / ("one/" + name)), testing::Slurp(dir / ("three/" + name)))
+        << name;
+  }
+}
+
+TEST(UvExtract, StaleTilesOfTheShapeAreRemoved) {
+  TempDir dir;
+  fs::create_directories(dir / "uv");
+  std::ofstream(dir / "uv/shape.1099.exr") << "old";
+  std::ofstream(dir / "uv/other.1099.exr") << "another shape's";
+  Extracted e = ExtractUv(dir, DataPath("uv_maps/udim_box.obj"), 2, 0.02, 16);
+  EXPECT_FALSE(fs::exists(dir / "uv/shape.1099.exr"));
+  EXPECT_TRUE(fs::exists(dir / "uv/other.1099.exr"));
+}
+
+TEST(UvExtract, InfoAndVerifyReadUvMaps) {
+  TempDir dir;
+  const std::string cage = DataPath("uv_maps/udim_box.obj");
+  ExtractUv(dir, cage, 4, 0.02, 256);
+  const std::string tiles = fmt::format("'{}'", dir / "uv/shape.<UDIM>.exr");
+  auto r = RunDispex("info " + tiles, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("6 tiles of 256x256, 1 channel"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("tile 1013"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("dispex:space"), std::string::npos) << r.out;
+  r = RunDispex("info " + (dir / "uv/shape.1002.exr") + " --json", dir);  // one tile's name
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"udim\": 1011"), std::string::npos) << r.out;
+
+  // verify through the UV rule: against the sculpt both ways and against the exact truth.
+  const std::string sculpt = dir / "sculpt.obj", truth = dir / "sculpt.obj.truth";
+  r = RunDispex("verify " + cage + " " + sculpt + " " + tiles + " --truth " + truth, dir);
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("truth"), std::string::npos) << r.out;
+  // The same map zeroed fails it (exit 3).
+  auto map = UvMap::Open(dir / "uv/shape.<UDIM>.exr");
+  ASSERT_TRUE(map.ok());
+  fs::create_directories(dir / "zero");
+  for (UvMapTile tile : map->tiles()) {
+    std::fill(tile.values.begin(), tile.values.end(), 0.0f);
+    ASSERT_TRUE(WriteUvMapTile(UvMapTilePath(dir / "zero", "shape", tile.udim), tile, false).ok());
+  }
+  r = RunDispex(
+      fmt::format("verify {} {} '{}' --truth {} --tolerance {}", cage, sculpt,
+                  dir / "zero/shape.<UDIM>.exr", truth, map->Attribute("dispex:tolerance")),
+      dir);
+  EXPECT_EQ(r.exit_code, 3) << r.out << r.err;
+}
+
+TEST(UvExtract, VerifyMeasuresADisplacedMesh) {
+  // The Blender test's measure: a mesh against the sculpt both ways; itself at 0, moved by
+  // 0.01 at 0.01, and --max-p99 below that fails.
+  TempDir dir;
+  const std::string cage = DataPath("uv_maps/udim_box.obj");
+  ASSERT_TRUE(
+      MakeSculpt(testing::SculptOptions(cage, dir / "s.obj", 3, Pattern::kDetail, 0.02)).ok());
+  auto r = RunDispex("verify --displaced " + (dir / "s.obj") + " " + (dir / "s.obj") +
+                         " --max-p99 1e-9 --report " + (dir / "same.json"),
+                     dir);
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  auto sculpt = ReadMesh(dir / "s.obj");
+  ASSERT_TRUE(sculpt.ok());
+  std::string moved;
+  for (const Float3& p : sculpt->positions) {
+    moved += fmt::format("v {} {} {}\n", p.x, p.y, p.z + 0.01f);
+  }
+  for (std::size_t f = 0; f < sculpt->num_faces(); ++f) {
+    moved += "f";
+    for (std::int32_t v : sculpt->face(f)) moved += fmt::format(" {}", v + 1);
+    moved += "\n";
+  }
+  std::ofstream(dir / "moved.obj") << moved;
+  r = RunDispex(
+      "verify --displaced " + (dir / "moved.obj") + " " + (dir / "s.obj") + " --max-p99 0.02", dir);
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = RunDispex(
+      "verify --displaced " + (dir / "moved.obj") + " " + (dir / "s.obj") + " --max-p99 0.005",
+      dir);
+  EXPECT_EQ(r.exit_code, 3) << r.out << r.err;
+  EXPECT_NE(r.err.find("99th percentile"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--max-p99"), std::string::npos) << r.err;
+  r = RunDispex("verify --displaced " + (dir / "moved.obj") + " " + cage + " " + (dir / "s.obj"),
+                dir);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+}
+
+TEST(UvExtract, CommandLineErrors) {
+  TempDir dir;
+  const std::string cage = DataPath("uv_maps/udim_box.obj");
+  ASSERT_TRUE(
+      MakeSculpt(testing::SculptOptions(cage, dir / "s.obj", 2, Pattern::kDetail, 0.02)).ok());
+  auto r = RunDispex("extract " + cage + " " + (dir / "s.obj") + " -o " + (dir / "m.ptx") +
+                         " --uv-maps " + (dir / "uv") + " --uv-resolution 0",
+                     dir);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--uv-resolution 0: must be 1..16384"), std::string::npos) << r.err;
+  r = RunDispex("extract " + cage + " " + (dir / "s.obj") + " -o " + (dir / "m.ptx") +
+                    " --uv-maps " + (dir / "uv") + " --uv-padding -1",
+                dir);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--uv-padding -1: must be >= 0"), std::string::npos) << r.err;
+  // A base without UVs: one line naming it, nothing written.
+  const std::string plain = DataPath("meshes/opensubdiv/catmark_pole8.obj");
+  ASSERT_TRUE(
+      MakeSculpt(testing::SculptOptions(plain, dir / "p.obj", 2, Pattern::kDetail, 0.02)).ok());
+  r = RunDispex("extract " + plain + " " + (dir / "p.obj") + " -o " + (dir / "p.ptx") +
+                    " --uv-maps " + (dir / "uvp") + " -q",
+                dir);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("catmark_pole8.obj: the cage has no texture coordinates"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "uvp"));
+}
+
+}  // namespace
+}  // namespace dispex
