@@ -64,6 +64,8 @@ def extract(base, sculpt, output, *, progress=None, **options):
     JSON report as a dict). Ctrl-C (KeyboardInterrupt) or an exception raised by `progress`
     cancels the extraction; nothing is written then. The GIL is released while it runs.
     """
+    if progress is not None and not callable(progress):
+        raise ValueError(f"progress: {progress!r} is not callable")
     return _dispex._extract(_mesh_or_path(base, "base"), _mesh_or_path(sculpt, "sculpt"),
                             _path(output, "output"), progress, options)
 

@@ -2,8 +2,9 @@
 // Python threads run meanwhile; the calling thread wakes every 50 ms to run Python's signal
 // handlers (Ctrl-C raises KeyboardInterrupt there) and the progress callback. A Python
 // exception from either requests the library's cooperative cancellation (dispex/cancel.h):
-// the work stops within a face, its outputs unwound (no file, no temporary left), and the
-// exception propagates once the worker has returned. One call runs at a time; others wait.
+// the work stops at the next face (or at the end of a phase that does not poll, such as a
+// read), its outputs unwound (no file, no temporary left), and the exception propagates once
+// the worker has returned. One call runs at a time; others wait.
 #pragma once
 
 #include <pybind11/pybind11.h>

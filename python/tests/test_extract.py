@@ -102,6 +102,7 @@ def test_incremental_run_of_an_unchanged_array_mesh_leaves_the_map(tmp_path, scu
     ({"holes": "maybe"}, "holes"),
     ({"colour": 1}, "colour: unknown option"),
     ({"threads": 1.5}, "threads: 1.5 is not an integer"),
+    ({"progress": 3}, "progress: 3 is not callable"),
 ])
 def test_bad_options_raise_value_error_naming_them(tmp_path, sculpts, options, message):
     with pytest.raises(ValueError, match=message.replace("(", r"\(")):

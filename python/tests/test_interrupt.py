@@ -80,5 +80,6 @@ def test_other_threads_run_during_an_extraction(tmp_path, long_job):
     finally:
         stop.set()
         thread.join()
-    # Holding the GIL would leave the spinning thread a few switch intervals at most.
-    assert during > 100_000
+    # Measured: 10.7 million with the GIL released, 41 thousand with it held (the few switch
+    # intervals around the call).
+    assert during > 1_000_000
