@@ -17,7 +17,7 @@ import os
 from ._dispex import Error, Map, Mesh, __version__, read_mesh as _read_mesh
 from . import _dispex
 
-__all__ = ["Error", "Map", "Mesh", "__version__", "extract", "make_sculpt", "read_mesh",
+__all__ = ["Error", "Map", "Mesh", "__version__", "extract", "info", "make_sculpt", "read_mesh",
            "verify"]
 
 
@@ -95,3 +95,11 @@ def make_sculpt(cage, output, **options):
     if "truth" in options:
         options["truth"] = _path(options["truth"], "truth")
     return _dispex._make_sculpt(_path(cage, "cage"), _path(output, "output"), options)
+
+
+def info(path, *, faces=False, strict=False):
+    """The summary `dispex info --json` prints of a mesh (OBJ, PLY) or a Ptex map, as a dict.
+
+    faces: a map's face_list too; strict: a mesh's validation warnings raise dispex.Error.
+    """
+    return _dispex._info(_path(path, "path"), bool(faces), bool(strict))

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "dispex/mesh_summary.h"
 #include "errors.h"
 
 namespace dispex::python {
@@ -85,37 +86,17 @@ std::vector<float> Sharpness(const py::handle& value, const std::string& what, s
   return {s.begin(), s.end()};
 }
 
-// The subdivision rules by name, as OBJ `t` tags set them.
+// A subdivision rule by its library name (dispex/mesh_summary.h), as OBJ `t` tags set it.
 template <class Enum, std::size_t N>
-struct Names {
-  std::array<std::pair<const char*, Enum>, N> pairs;
-  const char* what;
-
-  Enum Parse(const std::string& name, const std::string& argument) const {
-    std::string known;
-    for (const auto& [text, value] : pairs) {
-      if (name == text) return value;
-      known += fmt::format("{}{}", known.empty() ? "" : ", ", text);
-    }
-    throw py::value_error(fmt::format("{}{}: '{}' is not one of {}", argument, what, name, known));
+Enum ParseRule(const std::string& name, const std::array<Enum, N>& values,
+               std::string_view (*name_of)(Enum), const std::string& what) {
+  std::string known;
+  for (Enum value : values) {
+    if (name == name_of(value)) return value;
+    known += fmt::format("{}{}", known.empty() ? "" : ", ", name_of(value));
   }
-  const char* Name(Enum value) const {
-    for (const auto& [text, v] : pairs) {
-      if (v == value) return text;
-    }
-    return "";
-  }
-};
-constexpr Names<BoundaryInterpolation, 3> kBoundary{
-    {{{"none", BoundaryInterpolation::kNone},
-      {"edge_only", BoundaryInterpolation::kEdgeOnly},
-      {"edge_and_corner", BoundaryInterpolation::kEdgeAndCorner}}},
-    "boundary_interpolation"};
-constexpr Names<CreaseMethod, 2> kCreaseMethod{
-    {{{"uniform", CreaseMethod::kUniform}, {"chaikin", CreaseMethod::kChaikin}}}, "crease_method"};
-constexpr Names<TriangleSubdivision, 2> kTriangles{
-    {{{"catmark", TriangleSubdivision::kCatmark}, {"smooth", TriangleSubdivision::kSmooth}}},
-    "triangle_subdivision"};
+  throw py::value_error(fmt::format("{}: '{}' is not one of {}", what, name, known));
+}
 
 struct Rules {
   std::optional<std::string> boundary, crease_method, triangles;
@@ -126,15 +107,23 @@ struct Rules {
 void SetRules(Mesh& mesh, const Rules& rules, const std::string& at) {
   SubdivTags& t = mesh.tags;
   if (rules.boundary) {
-    t.boundary = kBoundary.Parse(*rules.boundary, at);
+    t.boundary =
+        ParseRule(*rules.boundary,
+                  std::array{BoundaryInterpolation::kNone, BoundaryInterpolation::kEdgeOnly,
+                             BoundaryInterpolation::kEdgeAndCorner},
+                  BoundaryInterpolationName, at + "boundary_interpolation");
     t.boundary_from_file = true;
   }
   if (rules.crease_method) {
-    t.crease_method = kCreaseMethod.Parse(*rules.crease_method, at);
+    t.crease_method =
+        ParseRule(*rules.crease_method, std::array{CreaseMethod::kUniform, CreaseMethod::kChaikin},
+                  CreaseMethodName, at + "crease_method");
     t.crease_method_from_file = true;
   }
   if (rules.triangles) {
-    t.triangles = kTriangles.Parse(*rules.triangles, at);
+    t.triangles = ParseRule(*rules.triangles,
+                            std::array{TriangleSubdivision::kCatmark, TriangleSubdivision::kSmooth},
+                            TriangleSubdivisionName, at + "triangle_subdivision");
     t.triangles_from_file = true;
   }
 }
@@ -337,19 +326,20 @@ void AddMesh(py::module_& module) {
                                for (const auto& c : m.mesh->tags.corners) s.push_back(c.sharpness);
                                return ToArray(s);
                              })
-      .def_property_readonly("subdivision_rules",
-                             [](const PyMesh& m) {
-                               // The rules tags set, by name, as the constructor takes them.
-                               const SubdivTags& t = m.mesh->tags;
-                               py::dict d;
-                               if (t.boundary_from_file)
-                                 d["boundary_interpolation"] = kBoundary.Name(t.boundary);
-                               if (t.crease_method_from_file)
-                                 d["crease_method"] = kCreaseMethod.Name(t.crease_method);
-                               if (t.triangles_from_file)
-                                 d["triangle_subdivision"] = kTriangles.Name(t.triangles);
-                               return d;
-                             })
+      .def_property_readonly(
+          "subdivision_rules",
+          [](const PyMesh& m) {
+            // The rules tags set, by name, as the constructor takes them.
+            const SubdivTags& t = m.mesh->tags;
+            py::dict d;
+            if (t.boundary_from_file)
+              d["boundary_interpolation"] = std::string(BoundaryInterpolationName(t.boundary));
+            if (t.crease_method_from_file)
+              d["crease_method"] = std::string(CreaseMethodName(t.crease_method));
+            if (t.triangles_from_file)
+              d["triangle_subdivision"] = std::string(TriangleSubdivisionName(t.triangles));
+            return d;
+          })
       .def("__repr__", [](const PyMesh& m) {
         return fmt::format("<dispex.Mesh {}: {} vertices, {} faces>",
                            m.name.empty() ? "(unnamed)" : m.name, m.mesh->num_vertices(),

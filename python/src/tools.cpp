@@ -1,4 +1,4 @@
-// dispex.verify and dispex.make_sculpt: the commands' library calls with their options by name.
+// dispex.verify, dispex.make_sculpt and dispex.info: the commands' library calls, options by name.
 #include <pybind11/stl.h>
 
 #include <optional>
@@ -6,6 +6,9 @@
 
 #include "bindings.h"
 #include "cancellable.h"
+#include "dispex/files.h"
+#include "dispex/mesh_summary.h"
+#include "dispex/ptex_describe.h"
 #include "dispex/verify.h"
 #include "errors.h"
 
@@ -158,11 +161,30 @@ py::dict RunMakeSculpt(const std::string& cage, const std::string& output, const
   return d;
 }
 
+// `dispex info --json [--faces] [--strict]`: the summary of a mesh or a Ptex map (chosen by its
+// first bytes, as the command chooses), as a dict.
+py::object Info(const std::string& path, bool faces, bool strict) {
+  CheckOk(CheckReadableFile(path));
+  std::string json;
+  if (HasPtexMagic(path)) {
+    const PtexFile file = ValueOrRaise(PtexFile::Open(path));
+    CheckOk(file.Validate());  // every block inflated and checked, as the command does
+    json = PtexSummaryJson(file, faces);
+  } else {
+    const Mesh mesh = ValueOrRaise(ReadMesh(path));
+    const MeshSummary summary = SummarizeMesh(mesh, DetectMeshFormat(path));
+    if (strict) CheckOk(RequireClean(mesh, summary.validation));
+    json = MeshSummaryJson(path, mesh, summary);
+  }
+  return py::module_::import("json").attr("loads")(json);
+}
+
 }  // namespace
 
 void AddTools(py::module_& module) {
   module.def("_verify", &RunVerify, py::arg("base"), py::arg("sculpt"), py::arg("map"),
              py::arg("check"), py::arg("options"));
+  module.def("_info", &Info, py::arg("path"), py::arg("faces"), py::arg("strict"));
   module.def("_make_sculpt", &RunMakeSculpt, py::arg("cage"), py::arg("output"),
              py::arg("options"));
 }

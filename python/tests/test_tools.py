@@ -52,3 +52,23 @@ def test_verify_failing_a_bound(tmp_path, sculpts):
         dispex.verify(CUBE, sculpt, tmp_path / "m.ptx", max_error=1e-6)
     report = dispex.verify(CUBE, sculpt, tmp_path / "m.ptx", max_error=1e-6, check=False)
     assert report["passed"] is False
+
+
+@pytest.mark.parametrize("faces", [False, True])
+def test_info_is_the_command_lines_json(tmp_path, sculpts, faces):
+    dispex.extract(CUBE, sculpts(CUBE), tmp_path / "m.ptx")
+    for path in (CUBE, tmp_path / "m.ptx"):
+        flags = ["--faces"] if faces and path != CUBE else []
+        expected = json.loads(run_cli("info", path, "--json", *flags).stdout)
+        assert dispex.info(path, faces=faces) == expected
+    assert "face_list" in dispex.info(tmp_path / "m.ptx", faces=True)
+
+
+def test_info_errors(tmp_path):
+    with pytest.raises(dispex.Error, match="missing.obj"):
+        dispex.info(tmp_path / "missing.obj")
+    open_mesh = tmp_path / "dangling.obj"
+    open_mesh.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 5 5 5\nf 1 2 3 4\n")
+    assert dispex.info(open_mesh)["validation"]["unreferenced_vertices"] == 1
+    with pytest.raises(dispex.Error, match="dangling.obj: mesh is not clean: 1 unreferenced"):
+        dispex.info(open_mesh, strict=True)
