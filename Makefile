@@ -5,7 +5,7 @@ JOBS        ?= $(shell nproc)
 WERROR      ?= OFF
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build demo test test-blender test-sanitize test-tsan bench bench-peers fuzz format format-check clean
+.PHONY: all deps configure build python install demo test test-blender test-sanitize test-tsan bench bench-peers fuzz format format-check clean
 
 all: build
 
@@ -18,6 +18,16 @@ configure: deps
 
 build: configure
 	@cmake --build $(BUILD) -j$(JOBS)
+
+# The Python module alone (build/python/dispex; PYTHONPATH=build/python, docs/PYTHON.md).
+python: configure
+	@cmake --build $(BUILD) -j$(JOBS) --target dispex_python
+
+# The library, headers, CMake package, pkg-config file, Python module and the command into
+# PREFIX (docs/LIBRARY.md).
+PREFIX ?= /usr/local
+install: build
+	@cmake --install $(BUILD) --prefix $(PREFIX)
 
 # The demo needs only the command-line tool: tests and benchmarks are built by `make test`.
 demo: configure

@@ -11,8 +11,8 @@
 set(levels core 0 mesh 1 subdiv 2 trace 3 spectral 4 ptex 5 uvmap 5 extract 6 verify 7 render 7)
 # The module each public header belongs to.
 set(owners
-  status core ids core version core files core cancel core
-  mesh mesh shapes mesh
+  status core ids core version core files core cancel core progress core
+  mesh mesh shapes mesh mesh_summary mesh
   subdiv subdiv vector_space subdiv correspondence subdiv
   trace trace
   spectral spectral

@@ -22,6 +22,16 @@ find_package(OpenEXR 3 REQUIRED CONFIG)
 pkg_check_modules(LIBDEFLATE REQUIRED IMPORTED_TARGET libdeflate)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)
 pkg_check_modules(FFTW3F REQUIRED IMPORTED_TARGET fftw3f)
+if(DISPEX_BUILD_PYTHON)
+  # Debian's interpreter, the one python3-numpy and python3-pytest are installed for
+  # (scripts/install-deps.sh), ahead of any other python3 on PATH; -DPython_EXECUTABLE=...
+  # picks another. pybind11 builds against the Python found here.
+  if(NOT DEFINED Python_EXECUTABLE AND EXISTS /usr/bin/python3)
+    set(Python_EXECUTABLE /usr/bin/python3)
+  endif()
+  find_package(Python 3 REQUIRED COMPONENTS Interpreter Development.Module)
+  find_package(pybind11 2.6 REQUIRED CONFIG)
+endif()
 if(DISPEX_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()

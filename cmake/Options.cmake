@@ -36,6 +36,9 @@ endif()
 function(dispex_add_library name)
   add_library(dispex_${name} STATIC ${ARGN})
   add_library(dispex::${name} ALIAS dispex_${name})
+  # Position independent: the objects also make up the shared library (libdispex) and the
+  # Python extension.
+  set_target_properties(dispex_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   set(root ${PROJECT_BINARY_DIR}/internal_include/${name})
   file(MAKE_DIRECTORY ${root})
   file(CREATE_LINK ${PROJECT_SOURCE_DIR}/src/${name} ${root}/${name} SYMBOLIC)

@@ -1,20 +1,11 @@
-#include <fstream>
-
 #include "command.h"
 #include "dispex/files.h"
+#include "dispex/ptex_describe.h"
 #include "dispex/uv_map.h"
 #include "info.h"
 
 namespace dispex::cli {
 namespace {
-
-bool LooksLikePtex(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char magic[4] = {};
-  in.read(magic, 4);
-  return in.gcount() == 4 && magic[0] == 'P' && magic[1] == 't' && magic[2] == 'e' &&
-         magic[3] == 'x';
-}
 
 void SetupInfo(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<InfoOptions>();
@@ -39,7 +30,7 @@ void SetupInfo(CLI::App& app, int& exit_code) {
       exit_code = ReportFailure(readable);
       return;
     }
-    exit_code = LooksLikePtex(options->path) ? PtexInfo(*options)
+    exit_code = HasPtexMagic(options->path)    ? PtexInfo(*options)
                 : IsUvMapPath(options->path) ? UvMapInfo(*options)
                                              : MeshInfo(*options);
   });

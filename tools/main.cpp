@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
   using namespace dispex::cli;
   CLI::App app{"dispex " DISPEX_VERSION_STRING
                ": displacement maps (Ptex) from a Catmull-Clark base mesh and its sculpt"};
-  app.set_version_flag("--version", DISPEX_VERSION_STRING);
+  app.set_version_flag("--version", dispex::Version());
   app.require_subcommand(1);
   int exit_code = 0;
   auto registry = Registry();

@@ -10,10 +10,13 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "dispex/mesh.h"
+#include "dispex/progress.h"
 #include "dispex/ptex.h"
 #include "dispex/spectral.h"
 #include "dispex/status.h"
@@ -67,6 +70,14 @@ struct ExtractOptions {
   std::string base_path;
   std::string sculpt_path;
   std::string output_path;
+  // Meshes already in memory (a program that holds them, e.g. the Python module), used instead
+  // of reading base_path / sculpt_path, which then only name them: in messages, the report and
+  // the map's dispex:base / dispex:sculpt meta data ("base" / "sculpt" when empty). Each is
+  // checked as the readers check a file's (CheckMeshArrays; its `source` names it in those
+  // errors) and fingerprinted by its content as a file's mesh is, so the map is the one the
+  // same mesh read from a file of that name gives, and incremental runs compare it the same way.
+  // Extract only: ExtractAsset reads its files.
+  std::shared_ptr<const Mesh> base_mesh, sculpt_mesh;
 
   // Samples per side of each Ptex face's grid: a power of two 4..512, or 0 for automatic
   // (from the sculpt's density over each face: a face covered by k sculpt quads is sampled at
@@ -105,6 +116,8 @@ struct ExtractOptions {
 
   int threads = 0;        // 0: all cores; the output does not depend on it
   bool progress = false;  // draw a progress bar on stderr
+  // When given, counts the Ptex faces done of the total (drawn or not); must outlive Extract.
+  ProgressCounter* progress_counter = nullptr;
 
   // Refuse, before the work starts, an extraction estimated to need more memory than this
   // (bytes; 0: the memory the machine has available). See EstimateExtractMemory.
@@ -147,6 +160,13 @@ std::vector<PtexFaceInfo> PtexFaceTable(const LimitSurface& surface);
 
 // Checks ranges and combinations; the message names the option.
 Status ValidateExtractOptions(const ExtractOptions& options);
+
+// Sets one option by its ExtractOptions field name from a value as a manifest gives it
+// (ReadExtractManifest, docs/SHAPES.md) -- JSON text: "0.001", "\"auto\"", "\"64x64\"" --,
+// for a program that takes options by name (the Python module). Errors start with the name:
+// "tolerance: \"x\" is not a number", "colour: unknown option (known: ...)".
+Status SetExtractOption(ExtractOptions& options, const std::string& name,
+                        const std::string& json_value);
 
 struct ExtractReport {
   std::string version;

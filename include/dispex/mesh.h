@@ -189,6 +189,14 @@ Status WriteMesh(const std::string& path, const Mesh& mesh, std::string_view com
 
 // ---- Validation and summary ----------------------------------------------------------------
 
+// What the readers guarantee (ReadMesh), checked for a mesh built in memory: at least one face;
+// face_offsets from 0 to face_indices.size(), each face of 3 or more vertices; vertex indices
+// in range; finite positions; crease and corner vertices in range with finite sharpness >= 0,
+// hole faces in range; face_groups empty or one in-range id per face; UVs absent or as
+// Mesh::uvs states. The first problem, in that order, as "<source>: face 3: vertex index 9 out
+// of range (8 vertices)" ("mesh" when source is empty).
+Status CheckMeshArrays(const Mesh& mesh);
+
 // What ValidateMesh finds. clean() ignores boundary edges (open meshes are fine).
 struct MeshValidation {
   std::size_t unreferenced_vertices = 0;

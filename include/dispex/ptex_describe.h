@@ -10,6 +10,14 @@
 
 namespace dispex {
 
+// Whether the file at `path` starts with the Ptex magic ("Ptex"); false when it cannot be read.
+bool HasPtexMagic(const std::string& path);
+
+// The summary as JSON, pretty-printed (2 spaces, no final newline): header, face and texel
+// counts, levels, border modes, meta data (arrays cut after 64 values, flagged "truncated"),
+// and with `with_faces` a face_list (resolution, flags, adjacency, average).
+std::string PtexSummaryJson(const PtexFile& file, bool with_faces);
+
 // Header, levels, border modes, meta data (arrays cut after `max_values` values), texel
 // counts, size on disk.
 std::string FormatPtexSummary(const PtexFile& file, std::size_t max_values = 8);

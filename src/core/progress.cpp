@@ -30,12 +30,18 @@ std::string Progress::Format(const std::string& label, std::uint64_t done, std::
                      done >= total ? "in" : "ETA", eta);
 }
 
-Progress::Progress(std::string label, std::uint64_t total, std::string unit, bool enabled)
+Progress::Progress(std::string label, std::uint64_t total, std::string unit, bool enabled,
+                   ProgressCounter* counter)
     : label_(std::move(label)),
       total_(total),
       unit_(std::move(unit)),
       enabled_(enabled),
+      counter_(counter),
       start_(std::chrono::steady_clock::now()) {
+  if (counter_ != nullptr) {
+    counter_->done.store(0);
+    counter_->total.store(total);
+  }
   if (!enabled_) return;
   thread_ = std::thread([this] {
     std::unique_lock lock(mutex_);

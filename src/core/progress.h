@@ -13,16 +13,23 @@
 #include <string>
 #include <thread>
 
+#include "dispex/progress.h"
+
 namespace dispex {
 
 class Progress {
  public:
-  Progress(std::string label, std::uint64_t total, std::string unit, bool enabled);
+  // `counter`, when given, is set to 0 of `total` and counts along (drawn or not).
+  Progress(std::string label, std::uint64_t total, std::string unit, bool enabled,
+           ProgressCounter* counter = nullptr);
   ~Progress();
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
 
-  void Advance(std::uint64_t n = 1) { done_.fetch_add(n, std::memory_order_relaxed); }
+  void Advance(std::uint64_t n = 1) {
+    done_.fetch_add(n, std::memory_order_relaxed);
+    if (counter_ != nullptr) counter_->done.fetch_add(n, std::memory_order_relaxed);
+  }
   std::uint64_t done() const { return done_.load(std::memory_order_relaxed); }
   // Draws the final state and stops the redraw thread (also done by the destructor).
   void Finish();
@@ -38,6 +45,7 @@ class Progress {
   std::uint64_t total_;
   std::string unit_;
   bool enabled_;
+  ProgressCounter* counter_;
   std::atomic<std::uint64_t> done_{0};
   std::chrono::steady_clock::time_point start_;
   std::mutex mutex_;

@@ -138,7 +138,7 @@ StatusOr<std::vector<ShapeJob>> PlanFromManifest(const ExtractAssetOptions& o,
 StatusOr<AssetReport> ExtractAssetInArena(const ExtractAssetOptions& o, int threads) {
   Stopwatch total_clock;
   AssetReport report;
-  report.version = DISPEX_VERSION_STRING;
+  report.version = Version();
   report.output_dir = o.output_dir;
 
   std::vector<std::string> bases, sculpts;

@@ -156,7 +156,7 @@ std::uint64_t MemoryLimit(const ExtractOptions& options) {
 
 ExtractReport StartReport(const ExtractOptions& options, int threads) {
   ExtractReport report;
-  report.version = DISPEX_VERSION_STRING;
+  report.version = Version();
   report.options = options;
   report.base_path = options.base_path;
   report.sculpt_path = options.sculpt_path;
@@ -217,7 +217,7 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   Stopwatch faces_clock;
   DISPEX_ASSIGN_OR_RETURN(ProcessedFaces faces,
                           ProcessFaces(inputs, settings, previous.usable() ? &previous : nullptr,
-                                       keys, options.progress, writer));
+                                       keys, options.progress, options.progress_counter, writer));
   report.faces_copied = faces.faces_copied;
   report.faces_extracted = static_cast<std::int64_t>(num_faces) - faces.faces_copied -
                            inputs.surface.stats().hole_ptex_faces;
@@ -245,8 +245,11 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
 
 namespace dispex {
 
-StatusOr<ExtractReport> Extract(const ExtractOptions& options) {
-  DISPEX_RETURN_IF_ERROR(ValidateExtractOptions(options));
+StatusOr<ExtractReport> Extract(const ExtractOptions& given) {
+  DISPEX_RETURN_IF_ERROR(ValidateExtractOptions(given));
+  ExtractOptions options = given;
+  if (options.base_mesh && options.base_path.empty()) options.base_path = "base";
+  if (options.sculpt_mesh && options.sculpt_path.empty()) options.sculpt_path = "sculpt";
   return extract::RunInArena(
       options.threads, [&](int threads) { return extract::ExtractInArena(options, threads); });
 }

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <optional>
+#include <string>
 
 #include "core/system.h"
 #include "dispex/cancel.h"
@@ -27,6 +29,18 @@ struct MeshesRead {
   LimitSurface surface;
 };
 
+// The file at `path`, or a copy of the mesh given in memory (ExtractOptions::base_mesh,
+// sculpt_mesh) once it passes the readers' checks.
+StatusOr<Mesh> ReadOrCopy(const std::string& path, const std::shared_ptr<const Mesh>& given,
+                          const ReadOptions& read_options) {
+  if (!given) return ReadMesh(path, read_options);
+  Mesh mesh = *given;
+  if (mesh.source.empty()) mesh.source = path;
+  DISPEX_RETURN_IF_ERROR(CheckMeshArrays(mesh));
+  mesh.positions.reserve(mesh.positions.size() + 1);  // Embree reads 16 bytes at the last vertex
+  return mesh;
+}
+
 // The sculpt is read while the base's topology is built.
 StatusOr<MeshesRead> ReadMeshes(const ExtractOptions& options, ExtractReport& report) {
   ReadOptions read_options;
@@ -38,12 +52,12 @@ StatusOr<MeshesRead> ReadMeshes(const ExtractOptions& options, ExtractReport& re
     tbb::task_group group;
     group.run([&] {
       Stopwatch clock;
-      sculpt_read.emplace(ReadMesh(options.sculpt_path, read_options));
+      sculpt_read.emplace(ReadOrCopy(options.sculpt_path, options.sculpt_mesh, read_options));
       report.t_read_sculpt = clock.seconds();
       if (sculpt_read->ok()) report.sculpt_fingerprint = Fingerprint(sculpt_read->value());
     });
     Stopwatch clock;
-    base_read.emplace(ReadMesh(options.base_path, read_options));
+    base_read.emplace(ReadOrCopy(options.base_path, options.base_mesh, read_options));
     report.t_read_base = clock.seconds();
     if (base_read->ok()) {
       clock.Reset();

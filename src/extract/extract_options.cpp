@@ -73,10 +73,11 @@ bool IsPowerOfTwoIn(int v, int lo, int hi) {
 }  // namespace
 
 Status ValidateExtractOptions(const ExtractOptions& o) {
-  if (o.base_path.empty()) return Status::Error("no base mesh given");
-  if (o.sculpt_path.empty()) return Status::Error("no sculpt mesh given");
+  if (o.base_path.empty() && !o.base_mesh) return Status::Error("no base mesh given");
+  if (o.sculpt_path.empty() && !o.sculpt_mesh) return Status::Error("no sculpt mesh given");
   if (o.output_path.empty()) return Status::Error("no output file given (output_path)");
-  if (o.output_path == o.base_path || o.output_path == o.sculpt_path) {
+  if ((!o.base_mesh && o.output_path == o.base_path) ||
+      (!o.sculpt_mesh && o.output_path == o.sculpt_path)) {
     return Status::Error(
         fmt::format("output {} is also an input; refusing to overwrite it", o.output_path));
   }

@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <span>
+#include <string>
 
 #include "dispex/version.h"
 
@@ -206,7 +207,7 @@ Hash128 MeshContentKey(const Mesh& mesh) {
 
 Hash128 SettingsKey(const ExtractSettings& s) {
   Hasher h;
-  h.Add(std::string_view("dispex face key 1 " DISPEX_VERSION_STRING));
+  h.Add(std::string_view(std::string("dispex face key 1 ") + Version()));
   h.Add(s.query.distance).Add(static_cast<int>(s.query.policy));
   h.Add(s.retry_query.distance).Add(static_cast<int>(s.retry_query.policy));
   h.Add(static_cast<int>(s.spectral.rule)).Add(s.spectral.tolerance);

@@ -130,6 +130,13 @@ StatusOr<std::string> PathIn(const json& entry, const char* key, const fs::path&
 
 }  // namespace
 
+Status SetExtractOption(ExtractOptions& options, const std::string& name,
+                        const std::string& json_value) {
+  const json value = json::parse(json_value, nullptr, /*allow_exceptions=*/false);
+  if (value.is_discarded()) return Status::Error(name + ": not a JSON value: " + json_value);
+  return SetOption(options, name, value).WithPrefix(name);
+}
+
 StatusOr<ExtractAssetOptions> ReadExtractManifest(const std::string& path,
                                                   const ExtractAssetOptions& defaults) {
   std::ifstream in(path, std::ios::binary);

@@ -37,9 +37,10 @@ Status TooBig(std::uint64_t need, std::uint64_t limit, const std::string& what) 
 Status CheckMemoryBeforeReading(const ExtractOptions& options, std::uint64_t limit) {
   if (limit == 0) return Status::Ok();
   std::error_code ec;
-  std::uint64_t base = std::filesystem::file_size(options.base_path, ec);
+  std::uint64_t base = options.base_mesh ? 0 : std::filesystem::file_size(options.base_path, ec);
   if (ec) base = 0;
-  std::uint64_t sculpt = std::filesystem::file_size(options.sculpt_path, ec);
+  std::uint64_t sculpt =
+      options.sculpt_mesh ? 0 : std::filesystem::file_size(options.sculpt_path, ec);
   if (ec) sculpt = 0;
   auto need =
       static_cast<std::uint64_t>(double(base + sculpt) * kArraysPerFileByte * kReadPeakFactor);

@@ -21,9 +21,8 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces) {
   if (!file.ok()) return ignore("cannot be read (" + file.status().message() + ")");
   const PtexMetaItem* version = file->FindMetaData("dispex:version");
   if (version == nullptr) return ignore("not written by dispex");
-  if (version->AsString() != DISPEX_VERSION_STRING) {
-    return ignore(
-        fmt::format("written by dispex {}, not {}", version->AsString(), DISPEX_VERSION_STRING));
+  if (version->AsString() != Version()) {
+    return ignore(fmt::format("written by dispex {}, not {}", version->AsString(), Version()));
   }
   const PtexMetaItem* keys = file->FindMetaData(kFaceKeysMetaKey);
   const PtexMetaItem* records = file->FindMetaData(kFaceRecordsMetaKey);
@@ -51,7 +50,7 @@ std::string StoredInputsKey(const std::string& path) {
   if (!file.ok()) return "";
   const PtexMetaItem* version = file->FindMetaData("dispex:version");
   const PtexMetaItem* key = file->FindMetaData(kInputsKeyMetaKey);
-  if (version == nullptr || key == nullptr || version->AsString() != DISPEX_VERSION_STRING) {
+  if (version == nullptr || key == nullptr || version->AsString() != Version()) {
     return "";
   }
   return key->AsString();

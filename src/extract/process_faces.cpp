@@ -85,7 +85,7 @@ Status WriteConstantFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFa
 
 StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
                                       const PreviousMap* previous, std::span<const Hash128> keys,
-                                      bool progress, PtexWriter& writer) {
+                                      bool progress, ProgressCounter* counter, PtexWriter& writer) {
   const int num_faces = inputs.surface.num_ptex_faces();
   const bool keep = settings.watertight != WatertightEdges::kOff;
   ProcessedFaces out;
@@ -97,7 +97,7 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
   std::vector<std::int32_t> fallback(static_cast<std::size_t>(num_faces), 0);
   tbb::enumerable_thread_specific<FaceScratch> scratches(
       [&] { return FaceScratch(inputs.surface); });
-  Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", progress);
+  Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", progress, counter);
 
   // The face's first pass as the previous map holds it.
   auto copy = [&](PtexFaceId face) -> Status {

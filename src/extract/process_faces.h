@@ -52,7 +52,7 @@ class PreviousMap;
 // the cancellation.
 StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
                                       const PreviousMap* previous, std::span<const Hash128> keys,
-                                      bool progress, PtexWriter& writer);
+                                      bool progress, ProgressCounter* counter, PtexWriter& writer);
 
 // Runs ProcessFace again for `faces` with their least resolutions (`least_log2`, per Ptex
 // face), replacing their kept texels and statistics; the rays cast count in the totals. Swaps

@@ -157,7 +157,8 @@ Status ProcessVectorFaces(const ExtractOptions& options, const ExtractInputs& in
   stats.assign(static_cast<std::size_t>(num_faces), {});
   tbb::enumerable_thread_specific<VectorScratch> scratches(
       [&] { return VectorScratch(inputs.surface); });
-  Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", options.progress);
+  Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", options.progress,
+               options.progress_counter);
   Status status = ForEachFace(
       num_faces, [](int k) { return k; }, scratches, &bar,
       [&](PtexFaceId face, VectorScratch& w) {

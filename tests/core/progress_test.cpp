@@ -24,6 +24,18 @@ TEST(Progress, DisabledDrawsNothingAndCounts) {
   p.Finish();
 }
 
+TEST(Progress, CountsIntoTheProgramsCounter) {
+  ProgressCounter counter;
+  counter.done = 99;
+  Progress p("x", 10, "faces", false, &counter);
+  EXPECT_EQ(counter.done.load(), 0u);
+  EXPECT_EQ(counter.total.load(), 10u);
+  p.Advance(3);
+  p.Advance();
+  EXPECT_EQ(counter.done.load(), 4u);
+  EXPECT_EQ(p.done(), 4u);
+}
+
 TEST(ContentHash, MatchesKnownCrc32) {
   // The standard CRC-32 check value.
   EXPECT_EQ(Crc32("123456789"), 0xCBF43926u);
