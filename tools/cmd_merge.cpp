@@ -52,8 +52,7 @@ void SetupMerge(CLI::App& app, int& exit_code) {
       "writes, byte for byte; reads the base and sculpt the parts name");
   cmd->add_option("parts", args->options.parts, "the parts, one per shard, in any order")
       ->required();
-  cmd->add_option("-o,--output", args->options.output_path, "output Ptex file (.ptx)")
-      ->required();
+  cmd->add_option("-o,--output", args->options.output_path, "output Ptex file (.ptx)")->required();
   cmd->add_option("--threads", args->options.threads, "worker threads (0: all cores)")
       ->capture_default_str();
   cmd->add_option("--report", args->report_path, "write a JSON report to this file");
