@@ -5,7 +5,7 @@ JOBS        ?= $(shell nproc)
 WERROR      ?= OFF
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build demo test test-sanitize test-tsan bench fuzz format format-check clean
+.PHONY: all deps configure build demo test test-slurm test-sanitize test-tsan bench fuzz format format-check clean
 
 all: build
 
@@ -25,7 +25,13 @@ demo: configure
 	@scripts/demo.sh $(BUILD)
 
 test: build
-	@cd $(BUILD) && ctest --output-on-failure -j$(JOBS) --timeout 900
+	@cd $(BUILD) && ctest --output-on-failure -j$(JOBS) --timeout 900 -LE slurm
+
+# The farm on a real Slurm (tests/farm): starts munged, slurmctld and slurmd on localhost for
+# the test's length; needs root (skips otherwise) and Debian's slurm-wlm and munge.
+test-slurm: build
+	@DISPEX_WITH_SLURM=1 scripts/install-deps.sh
+	@cd $(BUILD) && ctest --output-on-failure -L slurm
 
 # The production-scale benchmark (bench/run): assets generated on first use in
 # $$DISPEX_BENCH_CACHE (default ~/.cache/dispex/bench), table on stdout, JSON in out/bench/.

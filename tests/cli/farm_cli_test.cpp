@@ -27,8 +27,8 @@ class Farm : public ::testing::Test {
     for (const auto& [name, cage] : {std::pair{"spot", "keenan_spot/spot_control_mesh.obj"},
                                      std::pair{"blub", "keenan_blub/blub_control_mesh.obj"}}) {
       ASSERT_TRUE(MakeSculpt(testing::SculptOptions(DataPath(std::string("meshes/") + cage),
-                                                    dir_ / (std::string(name) + "_sculpt.obj"),
-                                                    2, Pattern::kDetail, 0.004))
+                                                    dir_ / (std::string(name) + "_sculpt.obj"), 2,
+                                                    Pattern::kDetail, 0.004))
                       .ok());
       fs::copy_file(DataPath(std::string("meshes/") + cage), dir_ / (std::string(name) + ".obj"));
     }
@@ -52,8 +52,7 @@ class Farm : public ::testing::Test {
     return Slurp(out);
   }
   std::string fmt(const std::string& name) const {
-    return "extract " + (dir_ / (name + ".obj")) + " " +
-           (dir_ / (name + "_sculpt.obj"));
+    return "extract " + (dir_ / (name + ".obj")) + " " + (dir_ / (name + "_sculpt.obj"));
   }
 
   TempDir dir_;
@@ -64,9 +63,7 @@ TEST_F(Farm, ABatchRunsEveryAssetAndAFailingOneDoesNotStopTheOthers) {
       {"name": "spot", "base": "spot.obj", "sculpt": "spot_sculpt.obj", "output_dir": "maps"},
       {"name": "gone", "base": "spot.obj", "sculpt": "missing.obj", "output_dir": "maps"},
       {"name": "blub", "base": "blub.obj", "sculpt": "blub_sculpt.obj", "output_dir": "maps"}]})");
-  auto r = RunDispex("batch " + (dir_ / "bad.json") + " --report " +
-                         (dir_ / "report.json"),
-                     dir_);
+  auto r = RunDispex("batch " + (dir_ / "bad.json") + " --report " + (dir_ / "report.json"), dir_);
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("[1/3] spot: ok"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("[2/3] gone: FAILED: "), std::string::npos) << r.err;
@@ -127,17 +124,15 @@ TEST_F(Farm, ShardsThroughTheCommandLineMergeIntoTheMapExtractWrites) {
   EXPECT_NE(r.err.find("merged 3 parts"), std::string::npos) << r.err;
   EXPECT_TRUE(Slurp(dir_ / "merged.ptx") == Expected("spot", ""));
 
-  r = RunDispex("merge " + (dir_ / "p1.ptx") + " " + (dir_ / "p3.ptx") +
-                    " -o " + (dir_ / "two.ptx"),
-                dir_);
+  r = RunDispex(
+      "merge " + (dir_ / "p1.ptx") + " " + (dir_ / "p3.ptx") + " -o " + (dir_ / "two.ptx"), dir_);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_EQ(r.err, "dispex: shard 2/3 is missing (2 of 3 parts given)\n");
   EXPECT_FALSE(fs::exists(dir_ / "two.ptx"));
   r = RunDispex(fmt("spot") + " -o " + (dir_ / "x.ptx") + " --shard 4/3", dir_);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--shard: '4/3': expected I/N"), std::string::npos) << r.err;
-  r = RunDispex(fmt("spot") + " -o " + (dir_ / "x.ptx") + " --shard 1/2 --vector tangent",
-                dir_);
+  r = RunDispex(fmt("spot") + " -o " + (dir_ / "x.ptx") + " --shard 1/2 --vector tangent", dir_);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("vector maps are not made in shards"), std::string::npos) << r.err;
   r = RunDispex(fmt("spot") + " --out-dir " + (dir_ / "d") + " --shard 1/2", dir_);
@@ -167,8 +162,7 @@ TEST_F(Farm, SlurmScriptsRunAsSlurmWouldMakeTheMaps) {
       << shards;
   const std::string merge = Slurp(work / "merge-blub.sbatch");
   EXPECT_NE(merge.find("blub.part-3-of-3.ptx"), std::string::npos) << merge;
-  EXPECT_NE(merge.find(" -o '" + (dir_ / "maps/blub.ptx") + "'"), std::string::npos)
-      << merge;
+  EXPECT_NE(merge.find(" -o '" + (dir_ / "maps/blub.ptx") + "'"), std::string::npos) << merge;
 
   for (int task = 0; task < 6; ++task) {
     const std::string command = "cd " + dir_.path().string() +
@@ -188,27 +182,22 @@ TEST_F(Farm, SlurmScriptsRunAsSlurmWouldMakeTheMaps) {
 // Submission through a stand-in sbatch that records its arguments: the array job first, then
 // each asset's merge after exactly its own shards' tasks.
 TEST_F(Farm, SubmissionMakesEachMergeWaitForItsOwnShards) {
-  Write("sbatch", "#!/bin/bash\necho \"$@\" >> " + (dir_ / "calls.txt") +
-                      "\nn=$(wc -l < " + (dir_ / "calls.txt") +
-                      ")\necho \"$((40 + n));cluster\"\n");
+  Write("sbatch", "#!/bin/bash\necho \"$@\" >> " + (dir_ / "calls.txt") + "\nn=$(wc -l < " +
+                      (dir_ / "calls.txt") + ")\necho \"$((40 + n));cluster\"\n");
   fs::permissions(dir_ / "sbatch", fs::perms::owner_all);
-  auto r = RunDispex("farm slurm " + (dir_ / "batch.json") + " --shards 2 --sbatch " +
-                         (dir_ / "sbatch"),
-                     dir_);
+  auto r = RunDispex(
+      "farm slurm " + (dir_ / "batch.json") + " --shards 2 --sbatch " + (dir_ / "sbatch"), dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out, "shards 41\nmerge spot 42\nmerge blub 43\n");
   const std::string calls = Slurp(dir_ / "calls.txt");
   const std::string work = (dir_ / "dispex-farm");
   EXPECT_EQ(calls, "--parsable " + work + "/shards.sbatch\n" +
                        "--parsable --dependency=afterok:41_0:41_1 " + work +
-                       "/merge-spot.sbatch\n" +
-                       "--parsable --dependency=afterok:41_2:41_3 " + work +
-                       "/merge-blub.sbatch\n");
+                       "/merge-spot.sbatch\n" + "--parsable --dependency=afterok:41_2:41_3 " +
+                       work + "/merge-blub.sbatch\n");
   // An sbatch that fails: its message, non-zero.
   Write("sbatch", "#!/bin/bash\necho 'sbatch: error: invalid partition specified' >&2\nexit 1\n");
-  r = RunDispex("farm slurm " + (dir_ / "batch.json") + " --sbatch " +
-                    (dir_ / "sbatch"),
-                dir_);
+  r = RunDispex("farm slurm " + (dir_ / "batch.json") + " --sbatch " + (dir_ / "sbatch"), dir_);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("invalid partition specified"), std::string::npos) << r.err;
 }

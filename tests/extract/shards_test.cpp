@@ -134,8 +134,8 @@ INSTANTIATE_TEST_SUITE_P(
         Variant{"spot_rays_given_distance_filter", "keenan_spot/spot_control_mesh.obj", 3,
                 PtexDataType::kFloat, WatertightEdges::kFilter, false, ExtractMethod::kRays},
         // Automatic settings measured by every shard over the whole sculpt; the correspondence.
-        Variant{"spot_auto_half_all", "keenan_spot/spot_control_mesh.obj", 3,
-                PtexDataType::kHalf, WatertightEdges::kAll, true, ExtractMethod::kAuto},
+        Variant{"spot_auto_half_all", "keenan_spot/spot_control_mesh.obj", 3, PtexDataType::kHalf,
+                WatertightEdges::kAll, true, ExtractMethod::kAuto},
         // N-gons, boundaries, no edge pass.
         Variant{"car_ngons_boundary_off", "opensubdiv/catmark_car.obj", 3, PtexDataType::kFloat,
                 WatertightEdges::kOff, true, ExtractMethod::kRays}),
@@ -145,7 +145,8 @@ class ShardParts : public ::testing::Test {
  protected:
   void SetUp() override {
     sculpt_ = dir_ / "sculpt.obj";
-    ASSERT_TRUE(MakeSculpt(testing::SculptOptions(base_, sculpt_, 2, Pattern::kDetail, 0.005)).ok());
+    ASSERT_TRUE(
+        MakeSculpt(testing::SculptOptions(base_, sculpt_, 2, Pattern::kDetail, 0.005)).ok());
   }
   ExtractOptions Options(int i, int n, const std::string& name) const {
     ExtractOptions o;
@@ -222,8 +223,7 @@ TEST_F(ShardParts, AMergeOfPartsThatDoNotBelongTogetherFailsNamingThePart) {
   const std::string first_sculpt = Slurp(sculpt_);
   ASSERT_TRUE(MakeSculpt(testing::SculptOptions(base_, sculpt_, 2, Pattern::kDetail, 0.007)).ok());
   ASSERT_TRUE(Extract(Options(3, 3, "new3.ptx")).ok());
-  ExpectMergeFails({"p1.ptx", "p2.ptx", "new3.ptx"},
-                   "new3.ptx: made from another sculpt than");
+  ExpectMergeFails({"p1.ptx", "p2.ptx", "new3.ptx"}, "new3.ptx: made from another sculpt than");
   // Parts made from the sculpt as it was: the sculpt there now is another.
   ExpectMergeFails({"p1.ptx", "p2.ptx", "p3.ptx"}, "than the file there now");
   { std::ofstream(sculpt_, std::ios::binary) << first_sculpt; }
