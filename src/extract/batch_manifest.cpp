@@ -36,7 +36,8 @@ Status OnlyKeys(const json& object, std::initializer_list<const char*> known,
       ok = ok || key == k;
       list += (list.empty() ? "" : ", ") + std::string(k);
     }
-    if (!ok) return Status::Error(fmt::format("{}: unknown key \"{}\" (known: {})", where, key, list));
+    if (!ok)
+      return Status::Error(fmt::format("{}: unknown key \"{}\" (known: {})", where, key, list));
   }
   return Status::Ok();
 }

@@ -88,12 +88,12 @@ StatusOr<ShardPart> OpenShardPart(const std::string& path) {
   const auto j = nlohmann::json::parse(item->AsString(), nullptr, /*allow_exceptions=*/false);
   ShardPart part{path, std::move(*file), {}};
   ShardInfo& info = part.info;
-  const bool valid =
-      j.is_object() && j.contains("index") && j["index"].is_number_integer() &&
-      j.contains("count") && j["count"].is_number_integer() && j.contains("faces") &&
-      j["faces"].is_array() && j["faces"].size() == 2 && j["faces"][0].is_number_integer() &&
-      j["faces"][1].is_number_integer() && j.value("map_inputs_key", "") != "" &&
-      j.value("base", "") != "" && j.value("sculpt", "") != "" && j.value("options", "") != "";
+  const bool valid = j.is_object() && j.contains("index") && j["index"].is_number_integer() &&
+                     j.contains("count") && j["count"].is_number_integer() && j.contains("faces") &&
+                     j["faces"].is_array() && j["faces"].size() == 2 &&
+                     j["faces"][0].is_number_integer() && j["faces"][1].is_number_integer() &&
+                     j.value("map_inputs_key", "") != "" && j.value("base", "") != "" &&
+                     j.value("sculpt", "") != "" && j.value("options", "") != "";
   if (valid) {
     info.index = j["index"].get<int>();
     info.count = j["count"].get<int>();
@@ -137,7 +137,8 @@ StatusOr<std::vector<ShardPart>> CheckShardParts(std::vector<ShardPart> parts) {
     }
   }
   for (int i = 1, k = 0; i <= count; ++i, ++k) {
-    if (static_cast<std::size_t>(k) >= parts.size() || parts[static_cast<std::size_t>(k)].info.index != i) {
+    if (static_cast<std::size_t>(k) >= parts.size() ||
+        parts[static_cast<std::size_t>(k)].info.index != i) {
       return Status::Error(fmt::format("shard {}/{} is missing ({} of {} parts given)", i, count,
                                        parts.size(), count));
     }
@@ -161,14 +162,16 @@ StatusOr<std::vector<ShardPart>> CheckShardParts(std::vector<ShardPart> parts) {
 Status CheckPartsMatchInputs(const std::vector<ShardPart>& parts, const ExtractReport& report) {
   const ShardPart& part = parts.front();
   if (Meta(part.file, "dispex:base_fingerprint") != report.base_fingerprint) {
-    return Status::Error(fmt::format("{}: made from another {} than the file there now (its "
-                                     "fingerprint differs); run the shards again",
-                                     part.path, report.base_path));
+    return Status::Error(
+        fmt::format("{}: made from another {} than the file there now (its "
+                    "fingerprint differs); run the shards again",
+                    part.path, report.base_path));
   }
   if (Meta(part.file, "dispex:sculpt_fingerprint") != report.sculpt_fingerprint) {
-    return Status::Error(fmt::format("{}: made from another {} than the file there now (its "
-                                     "fingerprint differs); run the shards again",
-                                     part.path, report.sculpt_path));
+    return Status::Error(
+        fmt::format("{}: made from another {} than the file there now (its "
+                    "fingerprint differs); run the shards again",
+                    part.path, report.sculpt_path));
   }
   if (part.info.map_inputs_key != report.inputs_key) {
     return Status::Error(fmt::format("{}: made from other inputs than {} and {} now", part.path,

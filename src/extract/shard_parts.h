@@ -17,8 +17,8 @@ inline constexpr const char* kShardMetaKey = "dispex:shard";
 
 struct ShardInfo {
   int index = 0, count = 0;
-  std::int64_t begin = 0, end = 0;  // Ptex faces [begin, end)
-  std::string map_inputs_key;       // the InputsKey of the map the parts merge into
+  std::int64_t begin = 0, end = 0;     // Ptex faces [begin, end)
+  std::string map_inputs_key;          // the InputsKey of the map the parts merge into
   std::string base_path, sculpt_path;  // absolute: the merge reads them again
   std::string options;                 // ExtractOptionsJson
 };
