@@ -111,10 +111,11 @@ constexpr int kLocalRings = 2;
 // The tracer of a run with a given search distance that extracts only some faces (an
 // incremental run, a shard, a merge): the sculpt within reach of the faces whose first pass
 // runs (`only` flags those it may run, empty: all; not copied from `previous`) and of the faces
-// `rings` around them; the whole sculpt when that is most of it.
+// `rings` around them; the whole sculpt when that is most of it, unless `part_always` (a
+// shard: its memory is the point).
 Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previous,
-                        std::span<const std::uint8_t> only, int rings, const FaceKeys& keys,
-                        ExtractInputs& inputs, ExtractReport& report) {
+                        std::span<const std::uint8_t> only, int rings, bool part_always,
+                        const FaceKeys& keys, ExtractInputs& inputs, ExtractReport& report) {
   const auto n = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
   std::vector<std::uint8_t> traced(n, 0);
   std::vector<int> ring;
@@ -139,7 +140,7 @@ Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previo
     ring = std::move(next);
   }
   const auto count = static_cast<std::size_t>(std::count(traced.begin(), traced.end(), 1));
-  if (2 * count > n) return BuildTracer(options, inputs, report);
+  if (2 * count > n && !part_always) return BuildTracer(options, inputs, report);
   SetTracerOptions(options, inputs);
   Stopwatch clock;
   Mesh part = SculptWithinReach(inputs, keys, traced);
@@ -258,7 +259,7 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   }
   if (local) {
     DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, in_shard, shard ? 0 : kLocalRings,
-                                            face_keys, inputs, report));
+                                            shard, face_keys, inputs, report));
   }
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateMap(options, inputs));
 
