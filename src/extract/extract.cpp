@@ -108,26 +108,22 @@ std::string RedoReason(const PreviousMap& previous, const ExtractReport& report)
 // if the edge pass asks for a face beyond (EnsureTraced).
 constexpr int kLocalRings = 2;
 
-// The tracer of a run with a given search distance that extracts only some faces (an
-// incremental run, a shard, a merge): the sculpt within reach of the faces whose first pass
-// runs (`only` flags those it may run, empty: all; not copied from `previous`) and of the faces
-// `rings` around them; the whole sculpt when that is most of it, unless `part_always` (a
-// shard: its memory is the point).
+// The tracer of an incremental run with a given search distance: the sculpt within reach of
+// the faces whose first pass runs (not copied) and of the faces kLocalRings around them; the
+// whole sculpt when that is most of it.
 Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previous,
-                        std::span<const std::uint8_t> only, int rings, bool part_always,
                         const FaceKeys& keys, ExtractInputs& inputs, ExtractReport& report) {
   const auto n = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
   std::vector<std::uint8_t> traced(n, 0);
   std::vector<int> ring;
   for (std::size_t f = 0; f < n; ++f) {
     if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
-    if (!only.empty() && !only[f]) continue;
     if (!previous.Reusable(f, keys.keys[f])) {
       traced[f] = 1;
       ring.push_back(static_cast<int>(f));
     }
   }
-  for (int step = 0; step < rings && !ring.empty(); ++step) {
+  for (int step = 0; step < kLocalRings && !ring.empty(); ++step) {
     std::vector<int> next;
     for (int f : ring) {
       for (std::int32_t g : inputs.faces[static_cast<std::size_t>(f)].adjfaces) {
@@ -140,7 +136,7 @@ Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previo
     ring = std::move(next);
   }
   const auto count = static_cast<std::size_t>(std::count(traced.begin(), traced.end(), 1));
-  if (2 * count > n && !part_always) return BuildTracer(options, inputs, report);
+  if (2 * count > n) return BuildTracer(options, inputs, report);
   SetTracerOptions(options, inputs);
   Stopwatch clock;
   Mesh part = SculptWithinReach(inputs, keys, traced);
@@ -232,9 +228,11 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   DISPEX_RETURN_IF_ERROR(ChooseMethod(options, inputs, report));
   const bool mapping = inputs.mapping != nullptr;
   // The automatic search distance is estimated with rays over the whole surface; a given one
-  // lets a run that extracts only some faces trace only the sculpt within their reach.
+  // lets an incremental run or a merge trace only the sculpt within reach of the faces it
+  // extracts. A shard traces against the whole sculpt: a BVH of part of it may answer a ray
+  // that meets two sculpt triangles at once with the other one (docs/FARM.md).
   const bool local = !mapping && options.search_distance.kind != SearchDistanceSpec::Kind::kAuto &&
-                     (shard || (previous.usable() && (options.incremental || merge)));
+                     previous.usable() && (options.incremental || merge);
   if (mapping) {
     SetTracerOptions(options, inputs);
   } else if (!local) {
@@ -257,10 +255,7 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
     in_shard.assign(num_faces, 0);
     std::fill(in_shard.begin() + range.begin, in_shard.begin() + range.end, 1);
   }
-  if (local) {
-    DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, in_shard, shard ? 0 : kLocalRings,
-                                            shard, face_keys, inputs, report));
-  }
+  if (local) DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, face_keys, inputs, report));
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateMap(options, inputs));
 
   Stopwatch faces_clock;

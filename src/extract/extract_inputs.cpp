@@ -186,33 +186,14 @@ Status BuildPartTracer(Mesh part, std::vector<std::uint8_t> traced, ExtractInput
 
 Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces) {
   if (inputs.traced.empty()) return Status::Ok();
-  std::vector<std::uint8_t> traced = inputs.traced;
-  bool grown = false;
   for (int f : faces) {
-    grown = grown || !traced[static_cast<std::size_t>(f)];
-    traced[static_cast<std::size_t>(f)] = 1;
-  }
-  if (!grown) return Status::Ok();
-  // The part grown by those faces' reach while that stays under half the faces (a merge's
-  // tracer starts empty); else the whole sculpt.
-  const auto count = static_cast<std::size_t>(std::count(traced.begin(), traced.end(), 1));
-  Mesh part;
-  if (inputs.face_keys != nullptr && 2 * count <= traced.size()) {
-    part = SculptWithinReach(inputs, *inputs.face_keys, traced);
-  }
-  if (part.num_faces() > 0) {
-    inputs.tracer.reset();
-    inputs.traced_part = std::move(part);
-    DISPEX_ASSIGN_OR_RETURN(inputs.tracer,
-                            MakeEmbreeTracer(inputs.traced_part, inputs.tracer_options));
-    inputs.traced = std::move(traced);
+    if (inputs.traced[static_cast<std::size_t>(f)]) continue;
+    DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, inputs.tracer_options));
+    inputs.traced.clear();
+    inputs.traced_part = Mesh{};
+    inputs.widened = true;
     return Status::Ok();
   }
-  inputs.tracer.reset();
-  DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, inputs.tracer_options));
-  inputs.traced.clear();
-  inputs.traced_part = Mesh{};
-  inputs.widened = true;
   return Status::Ok();
 }
 
