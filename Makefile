@@ -5,7 +5,7 @@ JOBS        ?= $(shell nproc)
 WERROR      ?= OFF
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build python install demo test test-blender test-sanitize test-tsan bench bench-peers fuzz format format-check clean
+.PHONY: all deps configure build python install demo test test-blender test-slurm test-sanitize test-tsan bench bench-peers fuzz format format-check clean
 
 all: build
 
@@ -35,13 +35,19 @@ demo: configure
 	@scripts/demo.sh $(BUILD)
 
 test: build
-	@cd $(BUILD) && ctest --output-on-failure -j$(JOBS) --timeout 900 -LE blender
+	@cd $(BUILD) && ctest --output-on-failure -j$(JOBS) --timeout 900 -LE 'blender|slurm'
 
 # Blender 3.4 headless displacing with dispex's UV-space maps (tests/blender), Blender
 # installed first (DISPEX_WITH_BLENDER=1). About 40 s.
 test-blender: build
 	@DISPEX_WITH_BLENDER=1 scripts/install-deps.sh
 	@cd $(BUILD) && ctest --output-on-failure -L blender --timeout 900
+
+# The farm on a real Slurm (tests/farm): starts munged, slurmctld and slurmd on localhost for
+# the test's length; needs root (skips otherwise) and Debian's slurm-wlm and munge.
+test-slurm: build
+	@DISPEX_WITH_SLURM=1 scripts/install-deps.sh
+	@cd $(BUILD) && ctest --output-on-failure -L slurm
 
 # The production-scale benchmark (bench/run): assets generated on first use in
 # $$DISPEX_BENCH_CACHE (default ~/.cache/dispex/bench), table on stdout, JSON in out/bench/.
@@ -61,7 +67,7 @@ test-sanitize: deps
 	@cmake --build $(BUILD)-sanitize -j$(JOBS)
 	@cd $(BUILD)-sanitize && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-	  ctest --output-on-failure -j$(JOBS) --timeout 900 -LE blender
+	  ctest --output-on-failure -j$(JOBS) --timeout 900 -LE 'blender|slurm'
 
 # The extraction pipeline (TBB tasks at 4 threads) under ThreadSanitizer.
 test-tsan: deps

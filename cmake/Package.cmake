@@ -6,7 +6,7 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(DISPEX_MODULES core mesh subdiv trace spectral ptex extract verify render)
+set(DISPEX_MODULES core mesh subdiv trace spectral ptex uvmap extract verify render)
 set(module_objects "")
 foreach(module IN LISTS DISPEX_MODULES)
   list(APPEND module_objects $<TARGET_OBJECTS:dispex_${module}>)
@@ -19,7 +19,7 @@ set_target_properties(dispex_library PROPERTIES
   VERSION ${PROJECT_VERSION} SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
 target_link_libraries(dispex_library PRIVATE $<BUILD_INTERFACE:dispex_options>
   OpenSubdiv::osdCPU embree TBB::tbb PkgConfig::FFTW3F PkgConfig::LIBDEFLATE PkgConfig::XXHASH
-  PNG::PNG ZLIB::ZLIB fmt::fmt Threads::Threads)
+  PNG::PNG ZLIB::ZLIB OpenEXR::OpenEXR fmt::fmt Threads::Threads)
 target_link_options(dispex_library PRIVATE -Wl,--no-undefined)
 target_include_directories(dispex_library PUBLIC
   $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>

@@ -18,6 +18,9 @@ fi
 if [[ "${DISPEX_WITH_BLENDER:-0}" == 1 ]]; then
   packages+=(blender)
 fi
+if [[ "${DISPEX_WITH_SLURM:-0}" == 1 ]]; then
+  packages+=(slurm-wlm munge)  # make test-slurm: a one-node cluster on localhost
+fi
 if [[ "${DISPEX_WITH_FUZZ:-0}" == 1 ]]; then
   packages+=(clang libclang-rt-14-dev)
 fi

@@ -34,6 +34,7 @@ constexpr FlagName kExtractFlags[] = {
     {"max_memory", "--max-memory"},
     {"output_dir", "--out-dir"},
     {"method", "--method"},
+    {"shard_count", "--shard"},
     {"uv_maps_dir", "--uv-maps"},
     {"uv_resolution", "--uv-resolution"},
     {"uv_padding", "--uv-padding"},
@@ -59,6 +60,7 @@ struct ExtractArgs {
   std::string output_dir;
   std::vector<std::string> shapes;
   std::string manifest_path;
+  std::string shard;
   bool quiet = false;
 
   bool asset() const { return !output_dir.empty() || !manifest_path.empty(); }
@@ -162,6 +164,10 @@ Status Resolve(ExtractArgs& a) {
   if (!method.ok()) return method.status().WithPrefix("--method");
   o.method = *method;
   o.progress = !a.quiet && StderrIsInteractive();
+  if (!a.shard.empty()) {
+    Status shard = ParseShard(a.shard, o.shard_index, o.shard_count);
+    if (!shard.ok()) return shard.WithPrefix("--shard");
+  }
   if (!a.max_memory.empty()) {
     auto bytes = ParseBytes(a.max_memory);
     if (!bytes.ok()) return bytes.status();
@@ -181,6 +187,9 @@ Status Resolve(ExtractArgs& a) {
     return Status::Ok();
   }
   if (!a.shapes.empty()) return Status::Error("--shapes needs --out-dir (one map per shape)");
+  if (o.shard_count > 0 && !a.preview_dir.empty()) {
+    return Status::Error("--preview needs a whole map, not a shard's part: preview the merged map");
+  }
   if (o.base_path.empty() || o.sculpt_path.empty()) {
     return Status::Error("give BASE and SCULPT (or --manifest)");
   }
@@ -342,6 +351,9 @@ void SetupExtract(CLI::App& app, int& exit_code) {
                 "re-use the map at the output path: left as it is when made from the same "
                 "inputs and options, else only the faces whose inputs changed are extracted "
                 "(the result is the file a full extraction writes)");
+  cmd->add_option("--shard", args->shard,
+                  "I/N: extract only the I-th of N shards of the faces (balanced by estimated "
+                  "cost) into a part for `dispex merge` (docs/FARM.md)");
   cmd->add_option("--report", args->report_path, "write a JSON report to this file");
   cmd->add_option("--preview", args->preview_dir,
                   "also write DIR/<map>_atlas.png and DIR/<map>_compare.png (base and base + "

@@ -30,7 +30,7 @@ void SetupInfo(CLI::App& app, int& exit_code) {
       exit_code = ReportFailure(readable);
       return;
     }
-    exit_code = HasPtexMagic(options->path)    ? PtexInfo(*options)
+    exit_code = HasPtexMagic(options->path)  ? PtexInfo(*options)
                 : IsUvMapPath(options->path) ? UvMapInfo(*options)
                                              : MeshInfo(*options);
   });

@@ -149,6 +149,14 @@ struct ExtractOptions {
   std::string uv_maps_dir;
   int uv_resolution = 1024;  // 1..16384
   int uv_padding = 16;       // >= 0
+
+  // A farm shard (docs/FARM.md): with shard_count > 0, only the shard_index-th (1..shard_count)
+  // of shard_count runs of Ptex faces, balanced by estimated cost (samples and sculpt faces
+  // within reach), is extracted: output_path receives a part holding their first pass, for
+  // MergeShards. The parts of every shard merge into the map this extraction without shards
+  // writes, byte for byte. Scalar maps of one shape only.
+  int shard_index = 0;
+  int shard_count = 0;
 };
 
 // The face table of every map of `surface`, taken from the limit surface (OpenSubdiv's Ptex
@@ -289,12 +297,57 @@ struct ExtractReport {
   std::uint64_t bytes_written = 0;
   std::uint64_t peak_rss_bytes = 0;
   std::string tracer;  // TracerStats::backend: Embree version, ISA, build
+
+  // A shard (ExtractOptions::shard_count > 0): the Ptex faces [shard_begin, shard_end) it
+  // extracted, and their estimated cost against the whole map's.
+  std::int64_t shard_begin = 0, shard_end = 0;
+  double shard_cost_fraction = 0;
+  // A merge (MergeShards): the parts merged.
+  std::int64_t parts_merged = 0;
 };
 
 // Runs the whole pipeline. Errors (bad inputs, nothing hit, a miss under HolePolicy::kFail,
 // cancellation) leave no output file. A base made of several shapes (ExtractAsset) is an error
 // that names them.
 StatusOr<ExtractReport> Extract(const ExtractOptions& options);
+
+// ---- Farm shards (docs/FARM.md) --------------------------------------------------------------
+
+struct MergeOptions {
+  // The parts written by the shards of one extraction (ExtractOptions::shard_count), in any
+  // order. They name the base, sculpt and options they were made from; merging reads those
+  // files again (the stages after each face's first pass cross faces).
+  std::vector<std::string> parts;
+  std::string output_path;
+  int threads = 0;
+  bool progress = false;
+  std::uint64_t max_memory = 0;  // as ExtractOptions::max_memory
+};
+
+// The map the extraction without shards writes, byte for byte, from the parts of all its
+// shards. Fails, writing nothing, in one line naming the part when a shard is missing or given
+// twice, or when parts differ in version, inputs (fingerprints), options or shard count.
+StatusOr<ExtractReport> MergeShards(const MergeOptions& options);
+
+// "I/N" (1 <= I <= N) as a shard's index and count.
+Status ParseShard(std::string_view text, int& index, int& count);
+
+// ---- Batches of assets (docs/FARM.md) ----------------------------------------------------------
+
+// One map of a batch: options with the base, sculpt and output path set.
+struct BatchAsset {
+  std::string name;
+  ExtractOptions options;
+};
+
+// A batch manifest (JSON): {"options": {...}, "assets": [{"name": "spot", "base": "spot.obj",
+// "sculpt": "spot_sculpt.obj", "output_dir": "maps", "options": {"tolerance": 0.001}}, ...]}.
+// Each asset's map is output_dir/<name>.ptx; names are letters, digits, '_', '-' and '.'
+// (they name files and farm jobs) and unique. Paths are relative to the manifest's folder;
+// options as in ReadExtractManifest, over `defaults`, an asset's over the manifest's. Errors
+// name the file and the entry.
+StatusOr<std::vector<BatchAsset>> ReadBatchManifest(const std::string& path,
+                                                    const ExtractOptions& defaults);
 
 // ---- Assets of several shapes ---------------------------------------------------------------
 

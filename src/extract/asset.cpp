@@ -203,6 +203,11 @@ StatusOr<AssetReport> ExtractAssetInArena(const ExtractAssetOptions& o, int thre
 
 Status ValidateAssetOptions(const ExtractAssetOptions& o) {
   if (o.output_dir.empty()) return Status::Error("no output folder given (output_dir)");
+  if (o.options.shard_count > 0) {
+    return Status::Error(
+        "shard_count: assets of several shapes are not made in shards; shard each shape's "
+        "files as a map of its own (docs/FARM.md)");
+  }
   if (!o.manifest.empty() && !o.shapes.empty()) {
     return Status::Error("shapes selects shapes of base_path; a manifest names its own");
   }

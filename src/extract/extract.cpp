@@ -26,6 +26,8 @@
 #include "extract/parallel_errors.h"
 #include "extract/previous_map.h"
 #include "extract/process_faces.h"
+#include "extract/shard_parts.h"
+#include "extract/shard_plan.h"
 #include "extract/uv_maps.h"
 #include "extract/vector_faces.h"
 
@@ -54,6 +56,25 @@ Status CommitMap(PtexWriter& writer, const ExtractInputs& inputs,
   std::error_code ec;
   report.bytes_written = std::filesystem::file_size(report.output_path, ec);
   return Status::Ok();
+}
+
+// A shard's part: its faces' first pass (kept faces written now), every other face -- and any
+// of its own that missed entirely, which the merge fills from their neighbours -- 0 with a zero
+// key, and the shard's record.
+Status CommitPart(PtexWriter& writer, const ExtractInputs& inputs,
+                  std::span<const std::uint8_t> in_shard, const ShardInfo& info,
+                  const ProcessedFaces& faces, ExtractReport& report) {
+  if (!faces.kept.empty()) DISPEX_RETURN_IF_ERROR(WriteKeptFaces(writer, inputs, faces));
+  std::vector<Hash128> keys(in_shard.size());
+  for (std::size_t f = 0; f < in_shard.size(); ++f) {
+    const PtexFaceId face(static_cast<int>(f));
+    if (in_shard[f]) keys[f] = inputs.face_keys->keys[f];
+    if (!in_shard[f] || (faces.stats[f].all_missed && !inputs.surface.is_hole(face))) {
+      DISPEX_RETURN_IF_ERROR(WriteConstantFace(writer, inputs, face, 0.0f));
+    }
+  }
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData(kShardMetaKey, ShardInfoJson(info)));
+  return CommitMap(writer, inputs, keys, faces, report);
 }
 
 // What changed since the previous map, in words.
@@ -139,13 +160,14 @@ Status CheckOneShape(const ExtractOptions& options, const Mesh& base) {
                                    options.base_path, shapes->size(), names));
 }
 
-StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int threads) {
+StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int threads,
+                                       std::vector<ShardPart>* parts = nullptr) {
   Stopwatch total_clock;
   ExtractReport report = StartReport(options, threads);
   const std::uint64_t memory_limit = MemoryLimit(options);
   DISPEX_ASSIGN_OR_RETURN(ExtractInputs inputs, ReadInputs(options, memory_limit, report));
   DISPEX_RETURN_IF_ERROR(CheckOneShape(options, inputs.base));
-  return ExtractShape(options, std::move(inputs), std::move(report), total_clock);
+  return ExtractShape(options, std::move(inputs), std::move(report), total_clock, parts);
 }
 
 }  // namespace
@@ -166,11 +188,21 @@ ExtractReport StartReport(const ExtractOptions& options, int threads) {
 }
 
 StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInputs inputs,
-                                     ExtractReport report, const Stopwatch& total_clock) {
-  report.inputs_key = InputsKey(report).Hex();
+                                     ExtractReport report, const Stopwatch& total_clock,
+                                     std::vector<ShardPart>* parts) {
+  const bool shard = options.shard_count > 0;
+  const bool merge = parts != nullptr;
+  const std::string map_inputs_key = InputsKey(report).Hex();
+  report.inputs_key = shard
+                          ? PartInputsKey(map_inputs_key, options.shard_index, options.shard_count)
+                          : map_inputs_key;
   const auto num_faces = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
   PreviousMap previous;
-  if (options.incremental) {
+  if (merge) {
+    DISPEX_RETURN_IF_ERROR(CheckPartsMatchInputs(*parts, report));
+    report.parts_merged = static_cast<std::int64_t>(parts->size());
+    previous = PreviousMap::FromParts(std::move(*parts), num_faces);
+  } else if (options.incremental) {
     // Vector maps are made whole; an up-to-date map of either kind is left as it is.
     if (!options.vector) previous = PreviousMap::Open(options.output_path, num_faces);
     const std::string stored = options.vector      ? StoredInputsKey(options.output_path)
@@ -185,7 +217,7 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   }
   if (options.incremental && options.vector) {
     report.redo_reason = "a vector map is extracted whole when anything changed";
-  } else if (options.incremental) {
+  } else if (options.incremental && !merge) {
     previous.CheckFaceData();
     if (!previous.notice().empty()) report.warnings.push_back(previous.notice());
     report.redo_reason = RedoReason(previous, report);
@@ -197,9 +229,11 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   DISPEX_RETURN_IF_ERROR(ChooseMethod(options, inputs, report));
   const bool mapping = inputs.mapping != nullptr;
   // The automatic search distance is estimated with rays over the whole surface; a given one
-  // lets a re-run trace only the sculpt within reach of the faces it extracts.
-  const bool local = !mapping && options.incremental && previous.usable() &&
-                     options.search_distance.kind != SearchDistanceSpec::Kind::kAuto;
+  // lets an incremental run or a merge trace only the sculpt within reach of the faces it
+  // extracts. A shard traces against the whole sculpt: a BVH of part of it may answer a ray
+  // that meets two sculpt triangles at once with the other one (docs/FARM.md).
+  const bool local = !mapping && options.search_distance.kind != SearchDistanceSpec::Kind::kAuto &&
+                     previous.usable() && (options.incremental || merge);
   if (mapping) {
     SetTracerOptions(options, inputs);
   } else if (!local) {
@@ -211,14 +245,46 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   const std::vector<Hash128>& keys = face_keys.keys;
   inputs.face_keys = &face_keys;
   report.t_keys = keys_clock.seconds();
+  // A shard's faces: its first pass only, no stage that crosses faces (the merge runs those).
+  std::vector<std::uint8_t> in_shard;
+  if (shard) {
+    const ShardRange range = PlanShard(inputs.surface, settings.plan, face_keys,
+                                       options.shard_index, options.shard_count);
+    report.shard_begin = range.begin;
+    report.shard_end = range.end;
+    report.shard_cost_fraction = range.cost_fraction;
+    in_shard.assign(num_faces, 0);
+    std::fill(in_shard.begin() + range.begin, in_shard.begin() + range.end, 1);
+  }
   if (local) DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, face_keys, inputs, report));
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateMap(options, inputs));
 
   Stopwatch faces_clock;
-  DISPEX_ASSIGN_OR_RETURN(ProcessedFaces faces,
-                          ProcessFaces(inputs, settings, previous.usable() ? &previous : nullptr,
-                                       keys, options.progress, options.progress_counter, writer));
+  DISPEX_ASSIGN_OR_RETURN(
+      ProcessedFaces faces,
+      ProcessFaces(inputs, settings, previous.usable() ? &previous : nullptr, keys,
+                   options.progress, options.progress_counter, writer, in_shard));
   report.faces_copied = faces.faces_copied;
+  if (shard) {
+    report.faces_extracted = report.shard_end - report.shard_begin - faces.faces_copied;
+    for (auto f = report.shard_begin; f < report.shard_end; ++f) {
+      report.faces_extracted -= inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
+    }
+    report.t_sample_trace = faces_clock.seconds();
+    ShardInfo info;
+    info.index = options.shard_index;
+    info.count = options.shard_count;
+    info.begin = report.shard_begin;
+    info.end = report.shard_end;
+    info.map_inputs_key = map_inputs_key;
+    info.base_path = std::filesystem::absolute(options.base_path).lexically_normal().string();
+    info.sculpt_path = std::filesystem::absolute(options.sculpt_path).lexically_normal().string();
+    info.options = ExtractOptionsJson(options).dump();
+    DISPEX_RETURN_IF_ERROR(CommitPart(writer, inputs, in_shard, info, faces, report));
+    report.peak_rss_bytes = PeakResidentBytes();
+    report.t_total = total_clock.seconds();
+    return report;
+  }
   report.faces_extracted = static_cast<std::int64_t>(num_faces) - faces.faces_copied -
                            inputs.surface.stats().hole_ptex_faces;
   DISPEX_RETURN_IF_ERROR(FillMissedFaces(options, inputs, faces, writer, report));
@@ -252,6 +318,36 @@ StatusOr<ExtractReport> Extract(const ExtractOptions& given) {
   if (options.sculpt_mesh && options.sculpt_path.empty()) options.sculpt_path = "sculpt";
   return extract::RunInArena(
       options.threads, [&](int threads) { return extract::ExtractInArena(options, threads); });
+}
+
+StatusOr<ExtractReport> MergeShards(const MergeOptions& merge) {
+  if (merge.parts.empty()) return Status::Error("no parts given");
+  if (merge.output_path.empty()) return Status::Error("no output file given (output_path)");
+  std::vector<extract::ShardPart> parts;
+  for (const std::string& path : merge.parts) {
+    if (path == merge.output_path) {
+      return Status::Error(fmt::format("output {} is also a part; refusing to overwrite it", path));
+    }
+    DISPEX_ASSIGN_OR_RETURN(extract::ShardPart part, extract::OpenShardPart(path));
+    parts.push_back(std::move(part));
+  }
+  DISPEX_ASSIGN_OR_RETURN(parts, extract::CheckShardParts(std::move(parts)));
+  const extract::ShardInfo& info = parts.front().info;
+  const nlohmann::json stored = nlohmann::json::parse(info.options, nullptr, false);
+  StatusOr<ExtractOptions> read = extract::ExtractOptionsFromJson(stored);
+  if (!read.ok()) return read.status().WithPrefix(parts.front().path);
+  ExtractOptions options = std::move(*read);
+  options.base_path = info.base_path;
+  options.sculpt_path = info.sculpt_path;
+  options.output_path = merge.output_path;
+  options.threads = merge.threads;
+  options.progress = merge.progress;
+  options.max_memory = merge.max_memory;
+  Status valid = ValidateExtractOptions(options);
+  if (!valid.ok()) return valid.WithPrefix(parts.front().path);
+  return extract::RunInArena(options.threads, [&](int threads) {
+    return extract::ExtractInArena(options, threads, &parts);
+  });
 }
 
 }  // namespace dispex

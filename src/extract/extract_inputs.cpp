@@ -175,9 +175,22 @@ Status BuildPartTracer(Mesh part, std::vector<std::uint8_t> traced, ExtractInput
   Stopwatch clock;
   inputs.tracer.reset();
   inputs.traced_part = std::move(part);
+  inputs.traced = std::move(traced);
+  if (inputs.traced_part.num_faces() == 0) {
+    if (std::count(inputs.traced.begin(), inputs.traced.end(), 1) == 0) {
+      report.tracer = "none until a face needs one";  // every face copied
+      return Status::Ok();
+    }
+    // Faces with no sculpt within reach: their rays miss whatever the tracer holds.
+    inputs.traced.clear();
+    inputs.traced_part = Mesh{};
+    DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, inputs.tracer_options));
+    report.t_bvh += clock.seconds();
+    report.tracer = inputs.tracer->stats().backend;
+    return Status::Ok();
+  }
   DISPEX_ASSIGN_OR_RETURN(inputs.tracer,
                           MakeEmbreeTracer(inputs.traced_part, inputs.tracer_options));
-  inputs.traced = std::move(traced);
   report.t_bvh += clock.seconds();
   report.tracer = inputs.tracer->stats().backend + fmt::format(", {} of {} sculpt faces",
                                                                inputs.traced_part.num_faces(),

@@ -15,6 +15,8 @@ namespace dispex::extract {
 
 // Every option that affects the output (not threads, progress or paths).
 nlohmann::json ExtractOptionsJson(const ExtractOptions& options);
+// The options ExtractOptionsJson wrote (paths, threads and the like left at their defaults).
+StatusOr<ExtractOptions> ExtractOptionsFromJson(const nlohmann::json& json);
 // The JSON report of one map (ExtractReportJson, and each shape of AssetReportJson).
 nlohmann::json ExtractReportObject(const ExtractReport& report);
 // Resolved settings and statistics that do not depend on timing or thread count.

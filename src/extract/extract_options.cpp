@@ -2,6 +2,8 @@
 
 #include <bit>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "dispex/extract.h"
 
@@ -128,6 +130,18 @@ Status ValidateExtractOptions(const ExtractOptions& o) {
     if (o.incremental) {
       return Status::Error("uv_maps_dir: UV-space maps are not extracted incrementally");
     }
+    if (o.shard_count > 0) {
+      return Status::Error("uv_maps_dir: UV-space maps are not made in shards (docs/FARM.md)");
+    }
+  }
+  if (o.shard_count < 0 ||
+      (o.shard_count > 0 && (o.shard_index < 1 || o.shard_index > o.shard_count))) {
+    return Status::Error(fmt::format("shard {}/{}: the index must be 1..{} and the count > 0",
+                                     o.shard_index, o.shard_count, o.shard_count));
+  }
+  if (o.shard_count > 0 && o.vector) {
+    return Status::Error(
+        "shard_count: vector maps are not made in shards (only scalar maps; docs/FARM.md)");
   }
   SpectralOptions spectral;
   spectral.rule = o.resolution_rule;
@@ -136,6 +150,19 @@ Status ValidateExtractOptions(const ExtractOptions& o) {
   spectral.fixed_ulog2 = o.fixed_ulog2;
   spectral.fixed_vlog2 = o.fixed_vlog2;
   return ValidateSpectralOptions(spectral);
+}
+
+Status ParseShard(std::string_view text, int& index, int& count) {
+  const std::string s(text);
+  int i = 0, n = 0;
+  char slash = 0, extra = 0;
+  if (std::sscanf(s.c_str(), "%d%c%d%c", &i, &slash, &n, &extra) != 3 || slash != '/' || n < 1 ||
+      i < 1 || i > n) {
+    return Status::Error(fmt::format("'{}': expected I/N with 1 <= I <= N, e.g. 2/8", s));
+  }
+  index = i;
+  count = n;
+  return Status::Ok();
 }
 
 }  // namespace dispex

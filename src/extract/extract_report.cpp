@@ -24,6 +24,13 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
                         {"redo_reason", r.redo_reason},
                         {"tracer_faces", r.tracer_faces}};
   }
+  if (r.options.shard_count > 0) {
+    j["shard"] = {{"index", r.options.shard_index},        {"count", r.options.shard_count},
+                  {"faces", {r.shard_begin, r.shard_end}}, {"cost_fraction", r.shard_cost_fraction},
+                  {"faces_copied", r.faces_copied},        {"faces_extracted", r.faces_extracted},
+                  {"tracer_faces", r.tracer_faces}};
+  }
+  if (r.parts_merged > 0) j["parts_merged"] = r.parts_merged;
   j["options"] = extract::ExtractOptionsJson(r.options);
   j["threads"] = r.threads;
   j["statistics"] = extract::ExtractStatisticsJson(r);
@@ -146,10 +153,22 @@ std::string ExtractReportSummary(const ExtractReport& r) {
         "{:.2f}s\n",
         r.output_path, r.t_total);
   }
+  if (r.options.shard_count > 0) {
+    std::string copied =
+        r.faces_copied > 0 ? fmt::format(" ({} copied from the part there)", r.faces_copied) : "";
+    return fmt::format(
+        "dispex: shard {}/{}: Ptex faces {}..{} ({:.1f}% of the estimated cost), {} extracted{} "
+        "-> {}\n  time {:.2f}s (read {:.2f}+{:.2f}, bvh {:.2f}, sample+trace {:.2f})  peak "
+        "{:.0f} MB\n",
+        r.options.shard_index, r.options.shard_count, r.shard_begin, r.shard_end - 1,
+        100 * r.shard_cost_fraction, r.faces_extracted, copied, r.output_path, r.t_total,
+        r.t_read_base, r.t_read_sculpt, r.t_bvh, r.t_sample_trace, double(r.peak_rss_bytes) / 1e6);
+  }
   if (r.options.incremental) {
     out += fmt::format("dispex: incremental: {} faces copied, {} extracted ({})\n", r.faces_copied,
                        r.faces_extracted, r.redo_reason);
   }
+  if (r.parts_merged > 0) out += fmt::format("dispex: merged {} parts\n", r.parts_merged);
   out += fmt::format("dispex: {} ({} Ptex faces) <- {} ({} faces)\n", r.output_path, r.ptex_faces,
                      r.sculpt_path, r.sculpt_faces);
   if (!r.vector_space.empty()) {

@@ -13,6 +13,7 @@
 #include "core/system.h"
 #include "dispex/extract.h"
 #include "extract/extract_inputs.h"
+#include "extract/shard_parts.h"
 
 namespace dispex::extract {
 
@@ -23,9 +24,12 @@ std::uint64_t MemoryLimit(const ExtractOptions& options);
 ExtractReport StartReport(const ExtractOptions& options, int threads);
 
 // Everything after the inputs: the incremental check, BVH, settings, face keys, faces, edges,
-// totals and the map. `total_clock` started with the shape's work.
+// totals and the map. `total_clock` started with the shape's work. A shard
+// (options.shard_count) stops after its faces' first pass and writes a part; with `parts`
+// (CheckShardParts'), the faces' first pass is taken from them (a merge).
 StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInputs inputs,
-                                     ExtractReport report, const Stopwatch& total_clock);
+                                     ExtractReport report, const Stopwatch& total_clock,
+                                     std::vector<ShardPart>* parts = nullptr);
 
 // Runs work(threads) in an arena of `threads` threads (0: all cores), every parallel loop
 // (Embree's BVH build included) limited to them -- more than the machine's cores if asked: the

@@ -151,15 +151,21 @@ double Reach(const ExtractSettings& settings) {
 // largest half-extent of a sculpt face from it (every face whose bounding box meets the box has
 // its centroid there; faces in those cells that do not meet it only make the key change more
 // often than it must).
-// Also returns the largest half-extent of a sculpt face.
+// Also returns the largest half-extent of a sculpt face, and per box the number of sculpt faces
+// in those cells.
 std::vector<Hash128> SculptReachKeys(const Mesh& sculpt, const std::vector<Box>& boxes,
-                                     const std::vector<std::uint8_t>& skip, float& half_extent) {
+                                     const std::vector<std::uint8_t>& skip, float& half_extent,
+                                     std::vector<std::int64_t>& reach_faces) {
   const CellGrid grid(boxes, skip, /*per_side=*/2);
   struct Sums {
     std::vector<Hash128> cells;
+    std::vector<std::int64_t> counts;
     float half_extent = 0;
   };
-  tbb::combinable<Sums> sums([&] { return Sums{std::vector<Hash128>(grid.num_cells()), 0.0f}; });
+  tbb::combinable<Sums> sums([&] {
+    return Sums{std::vector<Hash128>(grid.num_cells()), std::vector<std::int64_t>(grid.num_cells()),
+                0.0f};
+  });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sculpt.num_faces(), 1 << 14),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       Sums& local = sums.local();
@@ -168,20 +174,29 @@ std::vector<Hash128> SculptReachKeys(const Mesh& sculpt, const std::vector<Box>&
                         Corners(sculpt, s, corners);
                         const FaceBounds b = Bounds(corners);
                         local.half_extent = std::max(local.half_extent, b.half_extent);
-                        local.cells[grid.CellOf(b.centre)] +=
-                            HashBytes(std::as_bytes(std::span(corners)));
+                        const std::size_t cell = grid.CellOf(b.centre);
+                        local.cells[cell] += HashBytes(std::as_bytes(std::span(corners)));
+                        ++local.counts[cell];
                       }
                     });
   std::vector<Hash128> cells(grid.num_cells());
+  std::vector<std::int64_t> counts(grid.num_cells());
   half_extent = 0;
   sums.combine_each([&](const Sums& part) {
-    for (std::size_t c = 0; c < cells.size(); ++c) cells[c] += part.cells[c];
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      cells[c] += part.cells[c];
+      counts[c] += part.counts[c];
+    }
     half_extent = std::max(half_extent, part.half_extent);
   });
   std::vector<Hash128> keys(boxes.size());
+  reach_faces.assign(boxes.size(), 0);
   tbb::parallel_for(std::size_t{0}, boxes.size(), [&](std::size_t f) {
     if (skip[f]) return;
-    grid.ForEachCell(boxes[f], half_extent, [&](std::size_t c) { keys[f] += cells[c]; });
+    grid.ForEachCell(boxes[f], half_extent, [&](std::size_t c) {
+      keys[f] += cells[c];
+      reach_faces[f] += counts[c];
+    });
   });
   return keys;
 }
@@ -228,8 +243,8 @@ FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& set
   out.reach_boxes = ReachBoxes(surface, patches, Reach(settings));
   std::vector<std::uint8_t> skip(num_faces);
   for (std::size_t f = 0; f < num_faces; ++f) skip[f] = surface.is_hole(PtexFaceId(int(f)));
-  const std::vector<Hash128> sculpt =
-      SculptReachKeys(inputs.sculpt, out.reach_boxes, skip, out.sculpt_half_extent);
+  const std::vector<Hash128> sculpt = SculptReachKeys(inputs.sculpt, out.reach_boxes, skip,
+                                                      out.sculpt_half_extent, out.reach_faces);
   Hasher global;
   global.Add(SettingsKey(settings)).Add(TracerScale(inputs.base));
   const Hash128 settings_key = global.Digest();
@@ -258,6 +273,10 @@ Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
   for (std::size_t f = 0; f < boxes.size(); ++f) {
     skip[f] = !faces[f] || surface.is_hole(PtexFaceId(static_cast<int>(f)));
   }
+  Mesh part;
+  part.source = sculpt.source;
+  part.face_offsets.push_back(0);
+  if (std::count(skip.begin(), skip.end(), 0) == 0) return part;  // no face: no sculpt
   // Finer than the keys' grid: the part of the sculpt to build a BVH of is found once. Every
   // face whose centre's cell a box, grown by the largest half-extent, reaches.
   const CellGrid grid(boxes, skip, /*per_side=*/6);
@@ -276,9 +295,6 @@ Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
                     });
   // The kept faces in their order, their vertices renumbered in ascending order.
   std::vector<std::int32_t> vertex(sculpt.num_vertices(), -1);
-  Mesh part;
-  part.source = sculpt.source;
-  part.face_offsets.push_back(0);
   for (std::size_t s = 0; s < sculpt.num_faces(); ++s) {
     if (!keep[s]) continue;
     for (std::int32_t v : sculpt.face(s)) vertex[static_cast<std::size_t>(v)] = 0;

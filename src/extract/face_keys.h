@@ -33,6 +33,8 @@ struct FaceKeys {
   std::vector<Hash128> keys;     // per Ptex face
   std::vector<Box> reach_boxes;  // per Ptex face: where its rays can go
   float sculpt_half_extent = 0;  // the largest half-size of a sculpt face's bounding box
+  // Per Ptex face: the sculpt faces in the grid cells its key sums (about those its rays reach).
+  std::vector<std::int64_t> reach_faces;
 };
 FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings);
 

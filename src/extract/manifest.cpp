@@ -9,13 +9,14 @@
 #include <sstream>
 
 #include "dispex/extract.h"
+#include "extract/manifest_fields.h"
 
 namespace dispex {
 
-namespace {
-
 namespace fs = std::filesystem;
 using nlohmann::json;
+
+namespace {
 
 StatusOr<int> IntValue(const json& v) {
   if (!v.is_number_integer()) return Status::Error(fmt::format("{} is not an integer", v.dump()));
@@ -110,6 +111,10 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
   return Status::Ok();
 }
 
+}  // namespace
+
+namespace extract {
+
 Status SetOptions(ExtractOptions& o, const json& options, const std::string& where) {
   if (!options.is_object()) return Status::Error(where + ": not an object");
   for (const auto& [name, value] : options.items()) {
@@ -128,7 +133,10 @@ StatusOr<std::string> PathIn(const json& entry, const char* key, const fs::path&
   return (p.is_absolute() ? p : folder / p).lexically_normal().string();
 }
 
-}  // namespace
+}  // namespace extract
+
+using extract::PathIn;
+using extract::SetOptions;
 
 Status SetExtractOption(ExtractOptions& options, const std::string& name,
                         const std::string& json_value) {

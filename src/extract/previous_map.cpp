@@ -14,7 +14,7 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces) {
   if (!std::filesystem::exists(path, ec)) return out;
   auto ignore = [&](const std::string& why) {
     out.notice_ = fmt::format("{}: {}; not re-used, every face is extracted", path, why);
-    out.file_.reset();
+    out.files_.clear();
     return std::move(out);
   };
   StatusOr<PtexFile> file = PtexFile::Open(path);
@@ -39,7 +39,30 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces) {
   if (!decoded_keys || !decoded_records) return ignore("has malformed face keys");
   out.keys_ = std::move(*decoded_keys);
   out.records_ = std::move(*decoded_records);
-  out.file_.emplace(std::move(*file));
+  out.files_.push_back(std::move(*file));
+  return out;
+}
+
+PreviousMap PreviousMap::FromParts(std::vector<ShardPart> parts, std::size_t num_faces) {
+  PreviousMap out;
+  out.keys_.resize(num_faces);
+  out.records_.resize(num_faces);
+  out.part_of_.assign(num_faces, 0);
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    ShardPart& part = parts[k];
+    // OpenShardPart checked that they decode.
+    const std::vector<Hash128> keys =
+        *DecodeFaceKeys(part.file.FindMetaData(kFaceKeysMetaKey)->bytes, num_faces);
+    const std::vector<FaceRecord> records =
+        *DecodeFaceRecords(part.file.FindMetaData(kFaceRecordsMetaKey)->bytes, num_faces);
+    for (auto f = static_cast<std::size_t>(part.info.begin);
+         f < static_cast<std::size_t>(part.info.end); ++f) {
+      out.keys_[f] = keys[f];
+      out.records_[f] = records[f];
+      out.part_of_[f] = static_cast<std::uint32_t>(k);
+    }
+    out.files_.push_back(std::move(part.file));
+  }
   return out;
 }
 
@@ -57,40 +80,40 @@ std::string StoredInputsKey(const std::string& path) {
 }
 
 void PreviousMap::CheckFaceData() {
-  if (!file_) return;
-  Status valid = file_->Validate();
+  if (files_.size() != 1) return;  // none, or parts (OpenShardPart checks them)
+  Status valid = files_[0].Validate();
   if (valid.ok()) return;
   notice_ = fmt::format("{}: corrupt face data ({}); not re-used, every face is extracted",
-                        file_->name(), valid.message());
-  file_.reset();
+                        files_[0].name(), valid.message());
+  files_.clear();
 }
 
 std::string PreviousMap::MetaString(const std::string& key) const {
-  if (!file_) return "";
-  const PtexMetaItem* item = file_->FindMetaData(key);
+  if (files_.empty()) return "";
+  const PtexMetaItem* item = files_[0].FindMetaData(key);
   return item ? item->AsString() : "";
 }
 
 bool PreviousMap::Reusable(std::size_t f, const Hash128& key) const {
-  if (!file_ || keys_[f] != key) return false;
+  if (files_.empty() || keys_[f] != key) return false;
   const FaceStats& s = records_[f].stats;
   if (s.all_missed || s.samples == 0) return true;  // written from the neighbours, or a hole
-  const PtexFaceInfo& info = file_->face_info(PtexFaceId(static_cast<int>(f)));
+  const PtexFaceInfo& info = file(f).face_info(PtexFaceId(static_cast<int>(f)));
   return info.ulog2 == s.ulog2 && info.vlog2 == s.vlog2;
 }
 
 Status PreviousMap::ReadTexels(std::size_t f, KeptFace& out) const {
   const PtexFaceId face(static_cast<int>(f));
-  const PtexFaceInfo& info = file_->face_info(face);
+  const PtexFaceInfo& info = file(f).face_info(face);
   out.ulog2 = info.ulog2;
   out.vlog2 = info.vlog2;
   out.kept = true;
   if (info.ulog2 == 0 && info.vlog2 == 0) {
     out.texels.resize(1);
-    file_->ConstantValue(face, out.texels.data());
+    file(f).ConstantValue(face, out.texels.data());
     return Status::Ok();
   }
-  return file_->ReadFace(face, 0, out.texels);
+  return file(f).ReadFace(face, 0, out.texels);
 }
 
 }  // namespace dispex::extract

@@ -3,7 +3,7 @@
 // texels.
 #pragma once
 
-#include <optional>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -11,6 +11,7 @@
 #include "dispex/ptex.h"
 #include "extract/face_records.h"
 #include "extract/process_faces.h"
+#include "extract/shard_parts.h"
 
 namespace dispex::extract {
 
@@ -25,8 +26,11 @@ class PreviousMap {
   // read, was not written by this version of dispex, or has another number of faces re-uses
   // nothing, and notice() says why in one line.
   static PreviousMap Open(const std::string& path, std::size_t num_faces);
+  // The parts of a sharded extraction (CheckShardParts' order) as one map: each face as the part
+  // of its shard holds it.
+  static PreviousMap FromParts(std::vector<ShardPart> parts, std::size_t num_faces);
 
-  bool usable() const { return file_.has_value(); }
+  bool usable() const { return !files_.empty(); }
   // Inflates every face's data (Open checks the structure only): corrupt data makes the map
   // unusable, with a notice, instead of failing the extraction when a face is copied.
   void CheckFaceData();
@@ -42,7 +46,10 @@ class PreviousMap {
   Status ReadTexels(std::size_t f, KeptFace& out) const;
 
  private:
-  std::optional<PtexFile> file_;
+  const PtexFile& file(std::size_t f) const { return files_[part_of_.empty() ? 0 : part_of_[f]]; }
+
+  std::vector<PtexFile> files_;
+  std::vector<std::uint32_t> part_of_;  // per face, its file; empty: one file
   std::vector<Hash128> keys_;
   std::vector<FaceRecord> records_;
   std::string notice_;

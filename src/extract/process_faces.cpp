@@ -85,7 +85,8 @@ Status WriteConstantFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFa
 
 StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
                                       const PreviousMap* previous, std::span<const Hash128> keys,
-                                      bool progress, ProgressCounter* counter, PtexWriter& writer) {
+                                      bool progress, ProgressCounter* counter, PtexWriter& writer,
+                                      std::span<const std::uint8_t> only) {
   const int num_faces = inputs.surface.num_ptex_faces();
   const bool keep = settings.watertight != WatertightEdges::kOff;
   ProcessedFaces out;
@@ -119,6 +120,7 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
   };
   auto process = [&](PtexFaceId face, FaceScratch& w) -> Status {
     const auto f = static_cast<std::size_t>(face.value);
+    if (!only.empty() && !only[f]) return Status::Ok();
     if (previous != nullptr && !inputs.surface.is_hole(face) && previous->Reusable(f, keys[f])) {
       return copy(face);
     }

@@ -48,11 +48,13 @@ class PreviousMap;
 // written to the map as soon as it is done, or, with watertight edges, kept for MatchEdges and
 // WriteKeptFaces. Through the mapping, faces with samples it leaves undecided wait until every
 // face has been through it; then one tracer is built for them (TraceFallback) and they are
-// processed again. On an error, the error of the lowest face id (whatever the scheduling), or
-// the cancellation.
+// processed again. With `only` (per Ptex face; empty: every face), the faces it does not flag
+// are left out (a shard's). On an error, the error of the lowest face id (whatever the
+// scheduling), or the cancellation.
 StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
                                       const PreviousMap* previous, std::span<const Hash128> keys,
-                                      bool progress, ProgressCounter* counter, PtexWriter& writer);
+                                      bool progress, ProgressCounter* counter, PtexWriter& writer,
+                                      std::span<const std::uint8_t> only = {});
 
 // Runs ProcessFace again for `faces` with their least resolutions (`least_log2`, per Ptex
 // face), replacing their kept texels and statistics; the rays cast count in the totals. Swaps

@@ -1,0 +1,137 @@
+// dispex batch MANIFEST.json: every asset of a batch manifest on this machine (docs/FARM.md);
+// with --asset and --shard, one shard of one asset (what the farm's jobs run).
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "command.h"
+#include "dispex/cancel.h"
+#include "dispex/extract.h"
+#include "dispex/files.h"
+#include "flag_names.h"
+#include "part_names.h"
+
+namespace dispex::cli {
+namespace {
+
+constexpr FlagName kBatchFlags[] = {
+    {"shard_count", "--shard"},
+    {"threads", "--threads"},
+};
+
+struct BatchArgs {
+  std::string manifest;
+  std::string asset;
+  std::string shard;
+  std::string parts_dir;
+  std::string report_path;
+  int threads = 0;
+  bool incremental = false;
+  bool quiet = false;
+};
+
+int RunBatch(BatchArgs& args) {
+  ExtractOptions defaults;
+  defaults.threads = args.threads;
+  defaults.incremental = args.incremental;
+  auto assets = ReadBatchManifest(args.manifest, defaults);
+  if (!assets.ok()) return ReportFailure(assets.status(), 2);
+  if (!args.asset.empty()) {
+    std::erase_if(*assets, [&](const BatchAsset& a) { return a.name != args.asset; });
+    if (assets->empty()) {
+      return ReportFailure(
+          Status::Error(fmt::format("--asset {}: no such asset in {}", args.asset, args.manifest)),
+          2);
+    }
+  }
+  if (!args.shard.empty()) {
+    if (args.asset.empty() || args.parts_dir.empty()) {
+      return ReportFailure(Status::Error("--shard needs --asset and --parts-dir"), 2);
+    }
+    ExtractOptions& o = assets->front().options;
+    Status parsed = ParseShard(args.shard, o.shard_index, o.shard_count);
+    if (!parsed.ok()) return ReportFailure(parsed.WithPrefix("--shard"), 2);
+    o.output_path = PartPath(args.parts_dir, args.asset, o.shard_index, o.shard_count);
+  } else if (!args.parts_dir.empty()) {
+    return ReportFailure(Status::Error("--parts-dir needs --shard"), 2);
+  }
+  InstallCancelSignalHandlers();
+  nlohmann::json report;
+  report["manifest"] = args.manifest;
+  report["assets"] = nlohmann::json::array();
+  int failed = 0;
+  const std::size_t n = assets->size();
+  for (std::size_t k = 0; k < n && !CancelRequested(); ++k) {
+    const BatchAsset& asset = (*assets)[k];
+    // The output folder is the asset's own: made when missing, as a farm's merge job makes it.
+    std::error_code ec;
+    std::filesystem::create_directories(
+        std::filesystem::path(asset.options.output_path).parent_path(), ec);
+    StatusOr<ExtractReport> r = Extract(asset.options);
+    nlohmann::json entry = {{"name", asset.name}, {"output", asset.options.output_path}};
+    if (r.ok()) {
+      entry["status"] = "ok";
+      entry["report"] = nlohmann::json::parse(ExtractReportJson(*r));
+      if (!args.quiet) {
+        std::fprintf(stderr, "dispex: [%zu/%zu] %s: %s, %.2fs, peak %.0f MB -> %s\n", k + 1, n,
+                     asset.name.c_str(), r->unchanged ? "up to date" : "ok", r->t_total,
+                     double(r->peak_rss_bytes) / 1e6, asset.options.output_path.c_str());
+      }
+    } else {
+      ++failed;
+      const std::string message = WithFlagNames(r.status().message(), kBatchFlags);
+      entry["status"] = "failed";
+      entry["error"] = message;
+      std::fprintf(stderr, "dispex: [%zu/%zu] %s: FAILED: %s\n", k + 1, n, asset.name.c_str(),
+                   message.c_str());
+    }
+    report["assets"].push_back(std::move(entry));
+  }
+  report["failed"] = failed;
+  if (!args.report_path.empty()) {
+    const std::string text = report.dump(2) + "\n";
+    Status written = WriteFileAtomically(args.report_path, text.data(), text.size());
+    if (!written.ok()) return ReportFailure(written.WithPrefix("--report"));
+  }
+  if (const int sig = CancelSignal()) return ReportFailure(Status::Error("cancelled"), 128 + sig);
+  if (failed > 0) {
+    std::fprintf(stderr, "dispex: %d of %zu assets failed\n", failed, n);
+    return 1;
+  }
+  if (!args.quiet && n > 1) std::fprintf(stderr, "dispex: all %zu assets done\n", n);
+  return 0;
+}
+
+void SetupBatch(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<BatchArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "batch",
+      "Extract every asset of a batch manifest (JSON: base, sculpt, output folder, options per "
+      "asset) on this machine; a failing asset does not stop the others");
+  cmd->add_option("manifest", args->manifest, "the batch manifest (docs/FARM.md)")->required();
+  cmd->add_option("--asset", args->asset, "only this asset");
+  cmd->add_option("--shard", args->shard,
+                  "I/N: with --asset, only the I-th of N shards, a part in --parts-dir (what "
+                  "`dispex farm` jobs run)");
+  cmd->add_option("--parts-dir", args->parts_dir,
+                  "with --shard: the part is DIR/<asset>.part-I-of-N.ptx");
+  cmd->add_option("--threads", args->threads, "worker threads (0: all cores)")
+      ->capture_default_str();
+  cmd->add_flag("--incremental", args->incremental,
+                "re-use each map (or part) already at its output path (docs/INCREMENTAL.md)");
+  cmd->add_option("--report", args->report_path,
+                  "write one JSON report: every asset's status, error or extraction report");
+  cmd->add_flag("-q,--quiet", args->quiet, "no progress lines (failures are still printed)");
+  cmd->callback([args, &exit_code] { exit_code = RunBatch(*args); });
+}
+
+}  // namespace
+
+DISPEX_REGISTER_COMMAND(35, SetupBatch);
+
+}  // namespace dispex::cli
