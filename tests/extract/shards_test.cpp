@@ -295,6 +295,10 @@ TEST(ShardOptions, BadShardsAndVectorMapsAreRefused) {
   o.vector = VectorSpace::kTangent;
   EXPECT_NE(ValidateExtractOptions(o).message().find("vector maps are not made in shards"),
             std::string::npos);
+  o.vector.reset();
+  o.uv_maps_dir = "uv";
+  EXPECT_EQ(ValidateExtractOptions(o).message(),
+            "uv_maps_dir: UV-space maps are not made in shards (docs/FARM.md)");
   int i = 0, n = 0;
   EXPECT_TRUE(ParseShard("2/8", i, n).ok());
   EXPECT_EQ(i, 2);
