@@ -2,9 +2,7 @@
 #include <fmt/format.h>
 
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "dispex/extract.h"
 #include "extract/manifest_fields.h"
@@ -46,13 +44,7 @@ Status OnlyKeys(const json& object, std::initializer_list<const char*> known,
 
 StatusOr<std::vector<BatchAsset>> ReadBatchManifest(const std::string& path,
                                                     const ExtractOptions& defaults) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::Error(fmt::format("{}: cannot be read", path));
-  std::stringstream text;
-  text << in.rdbuf();
-  const json manifest = json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
-  if (manifest.is_discarded()) return Status::Error(fmt::format("{}: not valid JSON", path));
-  if (!manifest.is_object()) return Status::Error(fmt::format("{}: not a JSON object", path));
+  DISPEX_ASSIGN_OR_RETURN(const json manifest, extract::ReadJsonObject(path));
   DISPEX_RETURN_IF_ERROR(OnlyKeys(manifest, {"options", "assets"}, path));
   const fs::path folder = fs::path(path).parent_path();
   ExtractOptions common = defaults;

@@ -133,6 +133,17 @@ StatusOr<std::string> PathIn(const json& entry, const char* key, const fs::path&
   return (p.is_absolute() ? p : folder / p).lexically_normal().string();
 }
 
+StatusOr<json> ReadJsonObject(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::Error(fmt::format("{}: cannot be read", path));
+  std::stringstream text;
+  text << in.rdbuf();
+  json value = json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
+  if (value.is_discarded()) return Status::Error(fmt::format("{}: not valid JSON", path));
+  if (!value.is_object()) return Status::Error(fmt::format("{}: not a JSON object", path));
+  return value;
+}
+
 }  // namespace extract
 
 using extract::PathIn;
@@ -147,13 +158,7 @@ Status SetExtractOption(ExtractOptions& options, const std::string& name,
 
 StatusOr<ExtractAssetOptions> ReadExtractManifest(const std::string& path,
                                                   const ExtractAssetOptions& defaults) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::Error(fmt::format("{}: cannot be read", path));
-  std::stringstream text;
-  text << in.rdbuf();
-  const json manifest = json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
-  if (manifest.is_discarded()) return Status::Error(fmt::format("{}: not valid JSON", path));
-  if (!manifest.is_object()) return Status::Error(fmt::format("{}: not a JSON object", path));
+  DISPEX_ASSIGN_OR_RETURN(const json manifest, extract::ReadJsonObject(path));
   const fs::path folder = fs::path(path).parent_path();
   ExtractAssetOptions out = defaults;
   out.manifest.clear();

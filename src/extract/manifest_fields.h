@@ -10,6 +10,10 @@
 
 namespace dispex::extract {
 
+// The JSON object in the file at `path`; errors name the file ("cannot be read", "not valid
+// JSON", "not a JSON object").
+StatusOr<nlohmann::json> ReadJsonObject(const std::string& path);
+
 // Sets each option of the JSON object `options` ({"tolerance": 0.001, ...}, values as the
 // command line takes them) over `o`; errors begin with `where`.
 Status SetOptions(ExtractOptions& o, const nlohmann::json& options, const std::string& where);
