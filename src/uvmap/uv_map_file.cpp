@@ -13,13 +13,15 @@
 #include <half.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <exception>
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <regex>
+#include <string>
+#include <string_view>
 
 #include "dispex/files.h"
 #include "dispex/uv_map.h"
@@ -53,11 +55,20 @@ const char* ChannelName(int channels, int c) {
   return channels == 1 ? "Y" : kRgb[c];
 }
 
+// The UDIM of a name ending in ".1DDD.exr" (the extension in any letter case), else 0.
 int UdimFromName(const std::string& path) {
-  static const std::regex kName(R"(.*\.(1\d\d\d)\.exr$)", std::regex::icase);
-  std::smatch m;
   const std::string name = std::filesystem::path(path).filename().string();
-  return std::regex_match(name, m, kName) ? std::stoi(m[1].str()) : 0;
+  constexpr std::size_t kSuffix = 9;  // ".1DDD.exr"
+  if (name.size() <= kSuffix) return 0;
+  const std::string_view end = std::string_view(name).substr(name.size() - kSuffix);
+  std::string extension(end.substr(5));
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  if (end[0] != '.' || end[1] != '1' || !digit(end[2]) || !digit(end[3]) || !digit(end[4]) ||
+      extension != ".exr") {
+    return 0;
+  }
+  return 1000 + (end[2] - '0') * 100 + (end[3] - '0') * 10 + (end[4] - '0');
 }
 
 }  // namespace
