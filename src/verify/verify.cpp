@@ -376,6 +376,23 @@ std::vector<Float3> SculptPoints(const Mesh& sculpt, std::size_t max_points) {
   return points;
 }
 
+// The sculpt's vertices (at most max_points of them) to `mesh`: the sculpt->map direction.
+StatusOr<ErrorStats> SculptToMesh(const Mesh& sculpt, const Mesh& mesh, std::size_t max_points) {
+  DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer, MakeEmbreeTracer(mesh));
+  std::vector<float> d = ClosestDistances(*tracer, SculptPoints(sculpt, max_points));
+  return Summarise(d);
+}
+
+// The largest allowed distance: max_error, max_error_rel times the diagonal, or the smaller.
+double DistanceLimit(const VerifyOptions& options, double diagonal) {
+  double limit = options.max_error;
+  if (options.max_error_rel > 0) {
+    const double rel = options.max_error_rel * diagonal;
+    limit = limit > 0 ? std::min(limit, rel) : rel;
+  }
+  return limit;
+}
+
 // VerifyOptions::displaced_path: a displaced mesh against the sculpt, both ways.
 StatusOr<VerifyReport> VerifyDisplacedMesh(const VerifyOptions& options) {
   Stopwatch clock;
@@ -393,18 +410,10 @@ StatusOr<VerifyReport> VerifyDisplacedMesh(const VerifyOptions& options) {
     std::vector<float> d = ClosestDistances(*sculpt_tracer, displaced.positions);
     r.map_to_sculpt = Summarise(d);
   }
-  {
-    DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer, MakeEmbreeTracer(displaced));
-    std::vector<float> d =
-        ClosestDistances(*tracer, SculptPoints(sculpt, options.max_sculpt_points));
-    r.sculpt_to_map = Summarise(d);
-  }
+  DISPEX_ASSIGN_OR_RETURN(r.sculpt_to_map,
+                          SculptToMesh(sculpt, displaced, options.max_sculpt_points));
   r.measured_distances = true;
-  double limit_abs = options.max_error;
-  if (options.max_error_rel > 0) {
-    const double rel = options.max_error_rel * r.diagonal;
-    limit_abs = limit_abs > 0 ? std::min(limit_abs, rel) : rel;
-  }
+  const double limit_abs = DistanceLimit(options, r.diagonal);
   const char* option = options.max_error_rel > 0 ? "max_error_rel" : "max_error";
   Threshold(r, "displaced->sculpt", r.map_to_sculpt, limit_abs, option);
   Threshold(r, "sculpt->displaced", r.sculpt_to_map, limit_abs, option);
@@ -780,20 +789,12 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
       }
       r.map_to_sculpt = Summarise(d);
     }
-    {
-      DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> map_tracer, MakeEmbreeTracer(displaced.mesh));
-      std::vector<float> d =
-          ClosestDistances(*map_tracer, SculptPoints(sculpt, options.max_sculpt_points));
-      r.sculpt_to_map = Summarise(d);
-    }
+    DISPEX_ASSIGN_OR_RETURN(r.sculpt_to_map,
+                            SculptToMesh(sculpt, displaced.mesh, options.max_sculpt_points));
     r.measured_distances = true;
   }
 
-  double limit_abs = options.max_error;
-  if (options.max_error_rel > 0) {
-    double rel = options.max_error_rel * r.diagonal;
-    limit_abs = limit_abs > 0 ? std::min(limit_abs, rel) : rel;
-  }
+  const double limit_abs = DistanceLimit(options, r.diagonal);
   const char* option = options.max_error_rel > 0 ? "max_error_rel" : "max_error";
   if (r.measured_truth && r.truth_over_bound > 0) {
     const auto& w = r.truth_worst;
