@@ -197,3 +197,24 @@ TEST(ConvertCli, AnOutputOfNeitherFormatIsRefused) {
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("/nonexistent/in.obj"), std::string::npos) << missing.err;
 }
+
+// make-sculpt writes the format its output's name asks for: the same sculpt as OBJ and as PLY.
+TEST(ConvertCli, MakeSculptWritesPlyByName) {
+  const std::string cage = Data("meshes/keenan_spot/spot_control_mesh.obj");
+  const std::string stem =
+      ::testing::TempDir() + "/dispex_make_sculpt_" + std::to_string(::getpid());
+  for (const char* ext : {".obj", ".ply"}) {
+    const CliRun run = Dispex("make-sculpt " + cage + " --levels 2 -q -o " + stem + ext);
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+  }
+  const nlohmann::json obj = nlohmann::json::parse(Dispex("info --json " + stem + ".obj").out);
+  const nlohmann::json ply = nlohmann::json::parse(Dispex("info --json " + stem + ".ply").out);
+  EXPECT_EQ(ply["format"], "PLY");
+  for (const char* key : {"vertices", "faces", "bounds", "median_edge_length"}) {
+    EXPECT_EQ(obj[key], ply[key]) << key;
+  }
+  for (const char* ext : {".obj", ".ply"}) {
+    std::remove((stem + ext).c_str());
+    std::remove((stem + ext + ".truth").c_str());
+  }
+}
