@@ -24,7 +24,7 @@ fail() {
   echo "FAIL: $*"
   if [ -n "${array:-}" ]; then
     scontrol show job 2>/dev/null | grep -E 'JobId|JobState|Dependency|Restarts'
-    tail -n 5 "$tmp"/work/logs/* 2>/dev/null
+    tail -n 5 "$tmp"/jobs/logs/* 2>/dev/null
   fi
   exit 1
 }
@@ -69,7 +69,7 @@ WRAP
 chmod +x slow-dispex
 
 ids=$("$dispex" farm slurm manifest.json --shards 3 --dispex "$tmp/slow-dispex" \
-  --work-dir "$tmp/work") || fail "dispex farm slurm: $ids"
+  --work-dir "$tmp/jobs") || fail "dispex farm slurm: $ids"
 echo "$ids"
 array=$(awk '$1 == "shards" {print $2}' <<<"$ids")
 merges=$(awk '$1 == "merge" {print $3}' <<<"$ids")
@@ -98,7 +98,7 @@ for merge in $merges; do
     case $(state "$merge") in
       COMPLETED) break ;;
       FAILED | CANCELLED | TIMEOUT | NODE_FAIL | OUT_OF_MEMORY)
-        cat "$tmp"/work/logs/* 2>/dev/null
+        cat "$tmp"/jobs/logs/* 2>/dev/null
         fail "merge job $merge: $(state "$merge")"
         ;;
     esac
@@ -118,6 +118,6 @@ for asset in spot blub; do
   cmp -s "maps/$asset.ptx" "${asset}_expected.ptx" ||
     fail "maps/$asset.ptx differs from a single-machine extraction"
 done
-ls "$tmp"/work/parts/*.ptx | wc -l | grep -qx 6 || fail "expected 6 parts"
+ls "$tmp"/jobs/parts/*.ptx | wc -l | grep -qx 6 || fail "expected 6 parts"
 echo "PASS: 2 assets x 3 shards on Slurm, shard ${array}_4 killed mid-run and requeued" \
   "(restarts $restarts); merged maps identical to single-machine extractions"
