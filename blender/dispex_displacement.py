@@ -1,7 +1,9 @@
 # dispex for Blender: "Extract Displacement" writes UV-space displacement maps (UDIM OpenEXR)
 # of the active object (the base cage) from the selected sculpt with the dispex command line,
 # and sets up the modifiers that displace the base with them: Subdivision Surface (limit
-# surface, UV Smooth: None) and Displace (UV, normal, mid level 0, strength 1).
+# surface, UV Smooth: None) and Displace (UV, normal, mid level 0, strength 1). With "Vector
+# (object space)" the maps hold the whole vector sculpt - limit surface (the sculpt must be the
+# base refined, as a Multires sculpt is) and Displace reads them "RGB to XYZ" in local space.
 #
 # Install: Edit > Preferences > Add-ons > Install..., pick this file, enable "dispex
 # Displacement"; set the path of the dispex program in the add-on's preferences unless it is on
@@ -55,7 +57,7 @@ def subdivision_levels(base, sculpt):
     return max(1, min(6, int(math.ceil(math.log(ratio, 4))) + 1))
 
 
-def apply_modifiers(base, pattern, levels):
+def apply_modifiers(base, pattern, levels, vector=False):
     for name in ("dispex Subdivision", "dispex Displace"):
         old = base.modifiers.get(name)
         if old is not None:
@@ -84,7 +86,7 @@ def apply_modifiers(base, pattern, levels):
     disp.texture = tex
     disp.texture_coords = "UV"
     disp.uv_layer = base.data.uv_layers.active.name
-    disp.direction = "NORMAL"
+    disp.direction = "RGB_TO_XYZ" if vector else "NORMAL"
     disp.space = "LOCAL"
     disp.mid_level = 0.0
     disp.strength = 1.0
@@ -103,6 +105,10 @@ class DispexSettings(bpy.types.PropertyGroup):
     resolution: bpy.props.IntProperty(name="Tile resolution", default=1024, min=16, max=16384)
     padding: bpy.props.IntProperty(name="Padding", default=16, min=0, max=256)
     half: bpy.props.BoolProperty(name="Half float", default=False)
+    vector: bpy.props.BoolProperty(
+        name="Vector (object space)", default=False,
+        description="Maps of the whole displacement vector in object space, read by Displace "
+                    "as RGB to XYZ; the sculpt must be the base refined (a Multires sculpt)")
     tolerance: bpy.props.FloatProperty(name="Tolerance (0: auto)", default=0.0, min=0.0,
                                        precision=6)
 
@@ -150,6 +156,8 @@ class DISPEX_OT_extract(bpy.types.Operator):
                "-o", os.path.join(out_dir, name + ".ptx"), "--uv-maps", out_dir,
                "--uv-resolution", str(settings.resolution), "--uv-padding", str(settings.padding),
                "--data-type", "half" if settings.half else "float"]
+        if settings.vector:
+            cmd += ["--vector", "object"]
         if settings.tolerance > 0:
             cmd += ["--tolerance", repr(settings.tolerance)]
         wm = context.window_manager
@@ -170,7 +178,7 @@ class DISPEX_OT_extract(bpy.types.Operator):
             self.report({"ERROR"}, (err.strip().splitlines() or ["dispex failed"])[-1])
             return {"CANCELLED"}
         apply_modifiers(base, os.path.join(out_dir, name + ".<UDIM>.exr"),
-                        subdivision_levels(base, sculpt))
+                        subdivision_levels(base, sculpt), settings.vector)
         self.report({"INFO"}, "dispex: maps in %s" % out_dir)
         return {"FINISHED"}
 
@@ -188,6 +196,7 @@ class DISPEX_PT_panel(bpy.types.Panel):
         col.prop(s, "resolution")
         col.prop(s, "padding")
         col.prop(s, "half")
+        col.prop(s, "vector")
         col.prop(s, "tolerance")
         col.label(text="Select the sculpt, then the base (active)")
         col.operator(DISPEX_OT_extract.bl_idname)

@@ -338,9 +338,10 @@ void SetupExtract(CLI::App& app, int& exit_code) {
                   "space: tangent (T, B, N), parametric (dP/du, dP/dv, N) or object (x, y, z); "
                   "the sculpt must be the base refined (see `dispex match`)");
   cmd->add_option("--uv-maps", o.uv_maps_dir,
-                  "also write UV-space maps: DIR/<map>.<UDIM>.exr (OpenEXR, one float channel) "
-                  "for every UDIM tile the base's UVs touch, extracted at each texel (UVs "
-                  "interpolated face-varying linearly; docs/UV_MAPS.md)");
+                  "also write UV-space maps: DIR/<map>.<UDIM>.exr (OpenEXR, one float channel, or "
+                  "R, G, B = x, y, z with --vector object) for every UDIM tile the base's UVs "
+                  "touch, extracted at each texel (UVs interpolated face-varying linearly; "
+                  "docs/UV_MAPS.md)");
   cmd->add_option("--uv-resolution", o.uv_resolution, "texels per side of each UDIM tile")
       ->capture_default_str();
   cmd->add_option("--uv-padding", o.uv_padding,

@@ -145,7 +145,8 @@ struct ExtractOptions {
   // limit surface (the cage's UVs interpolated face-varying linearly, include/dispex/
   // uv_charts.h) with the same rays, search distance and policy as the Ptex map; texels outside
   // every UV face (and those whose rays miss) are filled by dilation, uv_padding rings of
-  // texels. The base needs UVs on every face. Scalar maps only.
+  // texels. The base needs UVs on every face. A vector map (`vector`) must be object space: its
+  // tiles hold D's x, y, z, read at each texel through the sculpt's correspondence.
   std::string uv_maps_dir;
   int uv_resolution = 1024;  // 1..16384
   int uv_padding = 16;       // >= 0

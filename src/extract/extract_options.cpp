@@ -6,6 +6,7 @@
 #include <string>
 
 #include "dispex/extract.h"
+#include "dispex/vector_space.h"
 
 namespace dispex {
 
@@ -126,7 +127,12 @@ Status ValidateExtractOptions(const ExtractOptions& o) {
     if (o.uv_padding < 0) {
       return Status::Error(fmt::format("uv_padding = {}: must be >= 0", o.uv_padding));
     }
-    if (o.vector) return Status::Error("uv_maps_dir: UV-space maps are scalar maps only");
+    if (o.vector && *o.vector != VectorSpace::kObject) {
+      return Status::Error(fmt::format(
+          "uv_maps_dir: a {} space vector map's frame is its Ptex face's, which no UV-space "
+          "reader shares: UV-space vector maps are object space only",
+          VectorSpaceName(*o.vector)));
+    }
     if (o.incremental) {
       return Status::Error("uv_maps_dir: UV-space maps are not extracted incrementally");
     }

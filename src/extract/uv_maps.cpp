@@ -7,10 +7,12 @@
 #include <filesystem>
 #include <set>
 
+#include "core/check.h"
 #include "core/system.h"
 #include "dispex/cancel.h"
 #include "dispex/uv_charts.h"
 #include "dispex/uv_map.h"
+#include "dispex/vector_space.h"
 #include "dispex/version.h"
 #include "extract/face_pipeline.h"
 #include "extract/parallel_errors.h"
@@ -67,10 +69,13 @@ std::string FaceList(const std::vector<std::int32_t>& faces) {
 
 std::vector<std::pair<std::string, std::string>> TileAttributes(const ExtractOptions& options,
                                                                 const ExtractReport& report) {
-  return {
+  const bool vector = options.vector.has_value();
+  std::vector<std::pair<std::string, std::string>> attributes{
       {"dispex:version", DISPEX_VERSION_STRING},
-      {"dispex:space", "normal"},
-      {"dispex:channels", "Y: signed distance along the limit surface's unit normal"},
+      {"dispex:space", vector ? "object" : "normal"},
+      {"dispex:channels",
+       vector ? "R, G, B: x, y, z of sculpt - limit surface in the base mesh's object space"
+              : "Y: signed distance along the limit surface's unit normal"},
       {"dispex:midpoint", "0"},
       {"dispex:scale", "1"},
       {"dispex:units", "object units of the base mesh"},
@@ -82,11 +87,15 @@ std::vector<std::pair<std::string, std::string>> TileAttributes(const ExtractOpt
       {"dispex:sculpt", report.sculpt_path},
       {"dispex:base_fingerprint", report.base_fingerprint},
       {"dispex:sculpt_fingerprint", report.sculpt_fingerprint},
-      {"dispex:search_distance", fmt::format("{}", report.search_distance)},
       // The Ptex map's tolerance, which verify's truth bounds scale with (the texels
       // themselves are samples, not fitted to it).
       {"dispex:tolerance", fmt::format("{}", report.tolerance)},
   };
+  // A vector map's samples read the correspondence: no rays, no search distance.
+  if (!vector) {
+    attributes.emplace_back("dispex:search_distance", fmt::format("{}", report.search_distance));
+  }
+  return attributes;
 }
 
 // Tiles of `shape` in `dir` that this run did not write.
@@ -116,19 +125,25 @@ void RemoveStaleTiles(const std::string& dir, const std::string& shape,
 }  // namespace
 
 Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
-                   const ExtractSettings& settings, ExtractReport& report) {
+                   const ExtractSettings& settings, ExtractReport& report,
+                   const SculptCorrespondence* correspondence) {
   Stopwatch clock;
+  const bool vector = options.vector.has_value();
+  DISPEX_CHECK(!vector || (*options.vector == VectorSpace::kObject && correspondence != nullptr));
+  const int channels = vector ? 3 : 1;
   DISPEX_ASSIGN_OR_RETURN(PtexUvCharts charts, PtexUvCharts::Build(inputs.base, inputs.surface));
   DISPEX_ASSIGN_OR_RETURN(UvRaster raster,
                           RasterizeUvCharts(charts, inputs.surface, options.uv_resolution));
-  if (inputs.mapping != nullptr || inputs.tracer == nullptr || !inputs.traced.empty()) {
+  if (!vector &&
+      (inputs.mapping != nullptr || inputs.tracer == nullptr || !inputs.traced.empty())) {
     DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
   }
   const int num_faces = inputs.surface.num_ptex_faces();
   const FaceTexels by_face = GroupByFace(raster, num_faces);
   const int n = raster.resolution;
   const std::size_t tile_texels = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
-  std::vector<std::vector<float>> values(raster.tiles.size(), std::vector<float>(tile_texels, 0));
+  std::vector<std::vector<float>> values(raster.tiles.size(),
+                                         std::vector<float>(tile_texels * channels, 0));
   std::vector<std::vector<std::uint8_t>> filled(raster.tiles.size(),
                                                 std::vector<std::uint8_t>(tile_texels, 0));
   std::vector<std::int64_t> face_misses(static_cast<std::size_t>(num_faces), 0);
@@ -158,6 +173,19 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
         w.t.resize(count);
         w.flags.resize(count);
         DISPEX_RETURN_IF_ERROR(w.face.evaluator.EvaluatePoints(face, w.uv, w.positions, w.normals));
+        if (vector) {
+          for (std::size_t k = 0; k < count; ++k) {
+            const auto [tile, texel] = by_face.texels[begin + k];
+            const Float3 sculpt =
+                SculptPointAt(*correspondence, inputs.sculpt, face, w.uv[2 * k], w.uv[2 * k + 1]);
+            float* out = &values[tile][3 * static_cast<std::size_t>(texel)];
+            out[0] = static_cast<float>(double(sculpt.x) - w.positions[3 * k]);
+            out[1] = static_cast<float>(double(sculpt.y) - w.positions[3 * k + 1]);
+            out[2] = static_cast<float>(double(sculpt.z) - w.positions[3 * k + 2]);
+            filled[tile][texel] = 1;
+          }
+          return Status::Ok();
+        }
         const std::span<const Float3> origins(reinterpret_cast<const Float3*>(w.positions.data()),
                                               count);
         const std::span<const Float3> normals(reinterpret_cast<const Float3*>(w.normals.data()),
@@ -175,7 +203,7 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
         return Status::Ok();
       });
   DISPEX_RETURN_IF_ERROR(traced);
-  DISPEX_RETURN_IF_ERROR(inputs.tracer->status());
+  if (!vector) DISPEX_RETURN_IF_ERROR(inputs.tracer->status());
   for (std::int64_t m : face_misses) report.uv_texels_missed += m;
   report.uv_texels_inside = raster.inside;
   report.uv_overlap_texels = raster.overlap_texels;
@@ -214,8 +242,8 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
     UvMapTile tile;
     tile.udim = raster.tiles[t].udim;
     tile.resolution = n;
-    tile.channels = 1;
-    DilateTile(n, 1, options.uv_padding, values[t], filled[t]);
+    tile.channels = channels;
+    DilateTile(n, channels, options.uv_padding, values[t], filled[t]);
     tile.values = std::move(values[t]);
     tile.attributes = attributes;
     tile.attributes.emplace_back("dispex:udim", fmt::format("{}", tile.udim));

@@ -20,6 +20,7 @@
 #include "extract/extract_settings.h"
 #include "extract/parallel_errors.h"
 #include "extract/process_faces.h"
+#include "extract/uv_maps.h"
 
 namespace dispex::extract {
 
@@ -261,6 +262,9 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
   report.t_write = write_clock.seconds();
   std::error_code ec;
   report.bytes_written = std::filesystem::file_size(report.output_path, ec);
+  if (!options.uv_maps_dir.empty()) {
+    DISPEX_RETURN_IF_ERROR(WriteUvMaps(options, inputs, settings, report, &*correspondence));
+  }
   report.peak_rss_bytes = PeakResidentBytes();
   report.t_total = total_clock.seconds();
   return report;

@@ -84,7 +84,7 @@ struct MapReader {
   const PtexFile* ptex = nullptr;
   const UvMap* uv = nullptr;
   const PtexUvCharts* charts = nullptr;
-  std::optional<VectorSpace> space;  // Ptex vector maps only
+  std::optional<VectorSpace> space;  // vector maps only (UV-space ones: object)
 
   float Scalar(PtexFaceId face, float u, float v) const {
     if (ptex != nullptr) return ptex->Sample(face, u, v);
@@ -95,7 +95,12 @@ struct MapReader {
     return h;
   }
   Float3 Vector(PtexFaceId face, float u, float v, const SurfaceFrame& frame) const {
-    return MapVector(*ptex, *space, face, u, v, frame);
+    if (ptex != nullptr) return MapVector(*ptex, *space, face, u, v, frame);
+    double at[2];
+    charts->Evaluate(face, u, v, at);
+    float c[3] = {0, 0, 0};
+    uv->Sample(at[0], at[1], c);
+    return VectorFromChannels(*space, frame, c);
   }
   // Samples per side of a face's displaced grid: twice the Ptex face's resolution within
   // [8, 64]; for a UV map, twice the texels its UV footprint spans within [8, 64].
@@ -655,9 +660,20 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   std::optional<PtexUvCharts> charts;
   if (IsUvMapPath(options.map_path)) {
     DISPEX_ASSIGN_OR_RETURN(uv, UvMap::Open(options.map_path));
-    if (uv->channels() != 1) {
-      return Status::Error(options.map_path +
-                           ": a UV map of 3 channels: verify reads scalar UV maps only");
+    if (uv->channels() == 3) {
+      const std::string uv_space = uv->Attribute("dispex:space");
+      if (uv_space.empty()) {
+        r.warnings.push_back(
+            options.map_path +
+            ": 3 channels and no dispex:space: read as an object-space vector map");
+      } else if (uv_space != "object") {
+        return Status::Error(fmt::format(
+            "{}: 3 channels in dispex:space '{}': UV-space vector maps are read in object space",
+            options.map_path, uv_space));
+      }
+      reader.space = VectorSpace::kObject;
+      r.map_vector = true;
+      r.map_space = VectorSpace::kObject;
     }
     DISPEX_ASSIGN_OR_RETURN(charts, PtexUvCharts::Build(base, surface));
     reader.uv = &*uv;

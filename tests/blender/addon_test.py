@@ -3,7 +3,7 @@
 # "Extract Displacement" pressed (it finds dispex on PATH), and the base with the modifiers the
 # add-on set up is written as OBJ for `dispex verify --displaced`.
 #
-#   addon_test.py -- ADDON_DIR BASE.obj SCULPT.obj MAPS_DIR OUT.obj
+#   addon_test.py -- ADDON_DIR BASE.obj SCULPT.obj MAPS_DIR OUT.obj [vector]
 import os
 import sys
 
@@ -13,7 +13,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import displace  # noqa: E402  (build_object, write_evaluated)
 
 args = sys.argv[sys.argv.index("--") + 1:]
-addon_dir, base_path, sculpt_path, maps_dir, out = args
+addon_dir, base_path, sculpt_path, maps_dir, out = args[:5]
+vector = args[5:] == ["vector"]
 sys.path.insert(0, addon_dir)
 import dispex_displacement  # noqa: E402
 
@@ -28,6 +29,7 @@ base.select_set(True)
 view_layer.objects.active = base
 bpy.context.scene.dispex.output_dir = maps_dir
 bpy.context.scene.dispex.resolution = 256
+bpy.context.scene.dispex.vector = vector
 result = bpy.ops.dispex.extract_displacement()
 print("addon_test.py: operator", result)
 if result != {"FINISHED"}:
@@ -35,6 +37,9 @@ if result != {"FINISHED"}:
 names = [m.name for m in base.modifiers]
 if names != ["dispex Subdivision", "dispex Displace"]:
     sys.exit("addon_test.py: modifiers %s" % names)
+direction = base.modifiers["dispex Displace"].direction
+if direction != ("RGB_TO_XYZ" if vector else "NORMAL"):
+    sys.exit("addon_test.py: Displace direction %s" % direction)
 sculpt.hide_set(True)
 displace.write_evaluated(base, out, "the add-on's result")
 print("addon_test.py: wrote", out)

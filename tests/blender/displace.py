@@ -2,7 +2,8 @@
 # base cage with a dispex UV-space map the way a Blender user would, and writes the evaluated
 # mesh as OBJ for `dispex verify --displaced`.
 #
-#   displace.py -- BASE.obj MAP.<UDIM>.exr OUT.obj [--levels L] [--wrong KIND --work DIR]
+#   displace.py -- BASE.obj MAP.<UDIM>.exr OUT.obj [--levels L] [--direction normal|rgb]
+#                  [--wrong KIND --work DIR]
 #
 # The chain (docs/UV_MAPS.md): the cage built as it is in the OBJ (vertex and corner order
 # kept, UVs per corner), a Subdivision Surface modifier (Catmull-Clark, L levels, limit
@@ -10,10 +11,12 @@
 # corners kept sharp as OpenSubdiv's default edge-and-corner rule does), then a Displace
 # modifier reading the UDIM tiles as one tiled image through the UVs (direction: normal, mid
 # level 0, strength 1, texture clamping off so that negative values displace inward, bilinear
-# interpolation, no mipmaps, tiles extended at their borders).
+# interpolation, no mipmaps, tiles extended at their borders). `--direction rgb` reads an
+# object-space vector map: Displace "RGB to XYZ" in local space, the tiles' R, G, B being x, y, z.
 # --wrong makes the map wrong on purpose before it is read: zero (every texel 0), flip-v
 # (rows upside down), transpose (u and v swapped within each tile), swap-tiles (each tile
-# holding the next one's texels); `copy` re-saves it as it is
+# holding the next one's texels), swap-rg (a vector map's x and y exchanged); `copy` re-saves it
+# as it is
 # (the control: the same path of saving and loading, with the map right).
 import sys
 
@@ -22,11 +25,11 @@ import bpy
 
 def parse_args(argv):
     args = argv[argv.index("--") + 1:] if "--" in argv else []
-    opts = {"levels": 4, "wrong": "none", "work": None}
+    opts = {"levels": 4, "wrong": "none", "work": None, "direction": "normal"}
     pos = []
     i = 0
     while i < len(args):
-        if args[i] in ("--levels", "--wrong", "--work"):
+        if args[i] in ("--levels", "--wrong", "--work", "--direction"):
             opts[args[i][2:]] = args[i + 1]
             i += 2
         else:
@@ -108,11 +111,17 @@ def wrong_map(pattern, kind, work):
                     src = (n - 1 - j) * n + i
                 elif kind == "transpose":
                     src = i * n + j
+                elif kind == "swap-rg":
+                    src = j * n + i
                 else:
-                    sys.exit("displace.py: --wrong zero, flip-v, transpose, swap-tiles or copy")
+                    sys.exit("displace.py: --wrong zero, flip-v, transpose, swap-tiles, swap-rg "
+                             "or copy")
                 d = 4 * (j * n + i)
                 if src is None:
                     out[d:d + 4] = [0.0, 0.0, 0.0, 1.0]
+                elif kind == "swap-rg":
+                    r, g, b, a = px[4 * src:4 * src + 4]
+                    out[d:d + 4] = [g, r, b, a]
                 else:
                     out[d:d + 4] = px[4 * src:4 * src + 4]
         new = bpy.data.images.new("wrong%d" % udim, n, n, alpha=True, float_buffer=True)
@@ -158,7 +167,9 @@ def main():
     disp.texture = tex
     disp.texture_coords = "UV"
     disp.uv_layer = "UVMap"
-    disp.direction = "NORMAL"
+    if opts["direction"] not in ("normal", "rgb"):
+        sys.exit("displace.py: --direction normal or rgb")
+    disp.direction = "NORMAL" if opts["direction"] == "normal" else "RGB_TO_XYZ"
     disp.space = "LOCAL"
     disp.mid_level = 0.0
     disp.strength = 1.0
