@@ -35,6 +35,12 @@ std::string UvMapTilePath(const std::string& dir, const std::string& shape, int 
 // float32 or, with `half`, OpenEXR half. The same tile gives the same bytes.
 Status WriteUvMapTile(const std::string& path, const UvMapTile& tile, bool half);
 
+// Writes tiles[k] to paths[k] as a set: each to a temporary file beside its path, and only once
+// every one is complete are they renamed onto their paths, so an error while writing (or a
+// SIGINT / SIGTERM, with the handlers of dispex/cancel.h) leaves every tile as it was.
+Status WriteUvMapTiles(std::span<const std::string> paths, std::span<const UvMapTile> tiles,
+                       bool half);
+
 // Reads a tile written by WriteUvMapTile (or any square scanline OpenEXR file with a "Y"
 // channel, or "R", "G" and "B"); `udim` from the file name (…​.<UDIM>.exr), 0 when it has none.
 // Errors name the file and what is wrong.

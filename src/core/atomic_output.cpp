@@ -17,7 +17,7 @@ namespace {
 
 // Temporary paths of live outputs, kept in fixed storage so a signal handler can read them
 // without locks or allocation.
-constexpr int kMaxLiveOutputs = 16;
+constexpr int kMaxLiveOutputs = 256;  // a UV map's tiles are committed together
 constexpr std::size_t kMaxPath = 4096;
 struct LiveSlot {
   std::atomic<bool> used{false};
@@ -131,7 +131,7 @@ Status AtomicOutput::Write(const void* data, std::size_t size) {
   return Status::Ok();
 }
 
-Status AtomicOutput::Commit() {
+Status AtomicOutput::Close() {
   if (fd_ < 0) return Status::Error(target_ + ": output is closed");
   if (::fsync(fd_) != 0 && errno != EINVAL) {
     return Status::Error(target_ + ": flush failed: " + ErrnoText(errno));
@@ -139,6 +139,12 @@ Status AtomicOutput::Commit() {
   if (::close(std::exchange(fd_, -1)) != 0) {
     return Status::Error(target_ + ": close failed: " + ErrnoText(errno));
   }
+  return Status::Ok();
+}
+
+Status AtomicOutput::Commit() {
+  if (temp_.empty()) return Status::Error(target_ + ": output is closed");
+  if (fd_ >= 0) DISPEX_RETURN_IF_ERROR(Close());
   if (::rename(temp_.c_str(), target_.c_str()) != 0) {
     return Status::Error(target_ + ": cannot rename temporary file: " + ErrnoText(errno));
   }

@@ -28,7 +28,10 @@ class AtomicOutput {
   ~AtomicOutput();
 
   Status Write(const void* data, std::size_t size);
-  // Flushes, closes and renames the temporary file onto the target.
+  // Flushes and closes the temporary file, which stays until Commit() or Abandon(): a set of
+  // outputs is closed one by one, then committed together once every one was complete.
+  Status Close();
+  // Closes the temporary file (when still open) and renames it onto the target.
   Status Commit();
   // Closes and removes the temporary file (also done by the destructor).
   void Abandon();

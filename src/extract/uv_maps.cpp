@@ -236,10 +236,11 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
   }
   const std::string shape = fs::path(options.output_path).stem().string();
   const auto attributes = TileAttributes(options, report);
-  std::set<std::string> written;
+  std::vector<UvMapTile> tiles(raster.tiles.size());
+  std::vector<std::string> paths;
   for (std::size_t t = 0; t < raster.tiles.size(); ++t) {
     if (CancelRequested()) return Cancelled();
-    UvMapTile tile;
+    UvMapTile& tile = tiles[t];
     tile.udim = raster.tiles[t].udim;
     tile.resolution = n;
     tile.channels = channels;
@@ -247,11 +248,12 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
     tile.values = std::move(values[t]);
     tile.attributes = attributes;
     tile.attributes.emplace_back("dispex:udim", fmt::format("{}", tile.udim));
-    const std::string path = UvMapTilePath(options.uv_maps_dir, shape, tile.udim);
-    DISPEX_RETURN_IF_ERROR(WriteUvMapTile(path, tile, options.data_type == PtexDataType::kHalf));
-    written.insert(path);
-    report.uv_map_paths.push_back(path);
+    paths.push_back(UvMapTilePath(options.uv_maps_dir, shape, tile.udim));
   }
+  // All the tiles or none: a failure leaves the previous run's set as it was.
+  DISPEX_RETURN_IF_ERROR(WriteUvMapTiles(paths, tiles, options.data_type == PtexDataType::kHalf));
+  report.uv_map_paths = paths;
+  const std::set<std::string> written(paths.begin(), paths.end());
   RemoveStaleTiles(options.uv_maps_dir, shape, written, report);
   report.t_uv_maps = clock.seconds();
   return Status::Ok();

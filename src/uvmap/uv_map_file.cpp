@@ -23,6 +23,8 @@
 #include <string>
 #include <string_view>
 
+#include "core/atomic_output.h"
+#include "core/check.h"
 #include "dispex/files.h"
 #include "dispex/uv_map.h"
 
@@ -77,7 +79,10 @@ std::string UvMapTilePath(const std::string& dir, const std::string& shape, int 
   return (std::filesystem::path(dir) / fmt::format("{}.{}.exr", shape, udim)).string();
 }
 
-Status WriteUvMapTile(const std::string& path, const UvMapTile& tile, bool half) {
+namespace {
+
+// The OpenEXR file of `tile`, in memory.
+StatusOr<std::string> EncodeUvMapTile(const std::string& path, const UvMapTile& tile, bool half) {
   const int n = tile.resolution, channels = tile.channels;
   const std::size_t texels = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
   if (n < 1 || (channels != 1 && channels != 3) || tile.values.size() != texels * channels) {
@@ -117,10 +122,32 @@ Status WriteUvMapTile(const std::string& path, const UvMapTile& tile, bool half)
       file.setFrameBuffer(frame);
       file.writePixels(n);
     }
-    return WriteFileAtomically(path, stream.bytes().data(), stream.bytes().size());
+    return stream.bytes();
   } catch (const std::exception& e) {
     return Status::Error(fmt::format("{}: OpenEXR: {}", path, e.what()));
   }
+}
+
+}  // namespace
+
+Status WriteUvMapTile(const std::string& path, const UvMapTile& tile, bool half) {
+  return WriteUvMapTiles({&path, 1}, {&tile, 1}, half);
+}
+
+Status WriteUvMapTiles(std::span<const std::string> paths, std::span<const UvMapTile> tiles,
+                       bool half) {
+  DISPEX_CHECK_EQ(paths.size(), tiles.size());
+  std::vector<AtomicOutput> outputs;
+  outputs.reserve(tiles.size());
+  for (std::size_t t = 0; t < tiles.size(); ++t) {
+    DISPEX_ASSIGN_OR_RETURN(const std::string bytes, EncodeUvMapTile(paths[t], tiles[t], half));
+    DISPEX_ASSIGN_OR_RETURN(AtomicOutput out, AtomicOutput::Create(paths[t]));
+    DISPEX_RETURN_IF_ERROR(out.Write(bytes.data(), bytes.size()));
+    DISPEX_RETURN_IF_ERROR(out.Close());
+    outputs.push_back(std::move(out));
+  }
+  for (AtomicOutput& out : outputs) DISPEX_RETURN_IF_ERROR(out.Commit());
+  return Status::Ok();
 }
 
 StatusOr<UvMapTile> ReadUvMapTile(const std::string& path) {

@@ -10,7 +10,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "../extract/e2e_support.h"
 #include "dispex/extract.h"
@@ -318,6 +320,79 @@ TEST(UvExtract, ObjectSpaceVectorTexelsMatchTheExactDisplacement) {
   EXPECT_TRUE(verified->map_vector);
   EXPECT_EQ(verified->map_space, VectorSpace::kObject);
   EXPECT_TRUE(verified->passed) << verified->failure;
+}
+
+// An OBJ of `o` groups, each (name, the OBJ file it copies), the vertex and texture indices of
+// each group's faces (v or v/vt) offset past the groups before it.
+std::string Groups(const std::vector<std::pair<std::string, std::string>>& groups) {
+  std::string out;
+  std::size_t vertices = 0, uvs = 0;
+  for (const auto& [name, path] : groups) {
+    out += "o " + name + "\n";
+    std::ifstream in(path);
+    std::size_t group_vertices = 0, group_uvs = 0;
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("f ", 0) != 0) {
+        group_vertices += line.rfind("v ", 0) == 0;
+        group_uvs += line.rfind("vt ", 0) == 0;
+        if (line.rfind("v", 0) == 0) out += line + "\n";
+        continue;
+      }
+      std::istringstream corners(line.substr(2));
+      out += "f";
+      for (std::string c; corners >> c;) {
+        const auto slash = c.find('/');
+        out += fmt::format(" {}", std::stoul(c.substr(0, slash)) + vertices);
+        if (slash != std::string::npos) {
+          out += fmt::format("/{}", std::stoul(c.substr(slash + 1)) + uvs);
+        }
+      }
+      out += "\n";
+    }
+    vertices += group_vertices;
+    uvs += group_uvs;
+  }
+  return out;
+}
+
+// An asset of two shapes with `output_dir`: each shape's tiles are named by the shape and hold
+// its own displacement (one sculpt shape is the limit surface itself, the other sculpted).
+TEST(UvExtract, EachShapeOfAnAssetHasItsOwnTiles) {
+  TempDir dir;
+  const std::string cage = DataPath("uv_maps/udim_box.obj");
+  ASSERT_TRUE(
+      MakeSculpt(testing::SculptOptions(cage, dir / "bumpy.obj", 3, Pattern::kDetail, 0.02)).ok());
+  ASSERT_TRUE(
+      MakeSculpt(testing::SculptOptions(cage, dir / "flat.obj", 3, Pattern::kNone, 0.02)).ok());
+  std::ofstream(dir / "asset.obj") << Groups({{"bumpy", cage}, {"flat", cage}});
+  // The sculpt's shapes in the other order: they pair by name.
+  std::ofstream(dir / "asset_sculpt.obj")
+      << Groups({{"flat", dir / "flat.obj"}, {"bumpy", dir / "bumpy.obj"}});
+  ExtractAssetOptions asset;
+  asset.options.base_path = dir / "asset.obj";
+  asset.options.sculpt_path = dir / "asset_sculpt.obj";
+  asset.options.uv_maps_dir = dir / "uv";
+  asset.options.uv_resolution = 64;
+  // "flat" lies within its chords' sag of the limit surface: the automatic estimate is too short.
+  asset.options.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.02};
+  asset.output_dir = dir / "maps";
+  auto report = ExtractAsset(asset);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  for (const char* shape : {"bumpy", "flat"}) {
+    auto map = UvMap::Open(dir / fmt::format("uv/{}.<UDIM>.exr", shape));
+    ASSERT_TRUE(map.ok()) << map.status().message();
+    EXPECT_EQ(map->tiles().size(), 6u);
+    float largest = 0;
+    for (const UvMapTile& tile : map->tiles()) {
+      for (float value : tile.values) largest = std::max(largest, std::abs(value));
+    }
+    std::printf("%s: largest |texel| %.3g\n", shape, largest);
+    if (std::string(shape) == "flat") {
+      EXPECT_LT(largest, 0.004f);  // the chords' sag, level 3
+    } else {
+      EXPECT_GT(largest, 0.01f);
+    }
+  }
 }
 
 TEST(UvExtract, VectorMapsInAFaceFrameAreRefused) {

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "dispex/uv_map.h"
 
@@ -181,6 +182,32 @@ TEST_F(TileFiles, BadFilesNameTheFile) {
   wrong.values.pop_back();
   EXPECT_FALSE(WriteUvMapTile(Path("w.1001.exr"), wrong, false).ok());
   EXPECT_FALSE(fs::exists(Path("w.1001.exr")));
+}
+
+// A set of tiles is written whole or not at all: when its third tile cannot be written, the
+// first two keep the previous run's bytes and no temporary file is left.
+TEST_F(TileFiles, ATileSetIsCommittedTogether) {
+  const std::vector<std::string> paths = {Path("set.1001.exr"), Path("set.1002.exr"),
+                                          Path("set.1003.exr")};
+  std::vector<UvMapTile> old_tiles = {Ramp(1001, 4, 1), Ramp(1002, 4, 1), Ramp(1003, 4, 1)};
+  ASSERT_TRUE(WriteUvMapTiles(paths, old_tiles, false).ok());
+  const std::string old_first = Slurp(paths[0]), old_second = Slurp(paths[1]);
+  std::vector<UvMapTile> new_tiles = {Ramp(1001, 8, 3), Ramp(1002, 8, 3), Ramp(1003, 8, 3)};
+  ASSERT_TRUE(WriteUvMapTiles({paths.data(), 2}, {new_tiles.data(), 2}, false).ok());
+  EXPECT_NE(Slurp(paths[0]), old_first);  // the control: a set that can be written is
+  ASSERT_TRUE(WriteUvMapTiles({paths.data(), 2}, {old_tiles.data(), 2}, false).ok());
+  new_tiles[2].values.pop_back();
+  auto failed = WriteUvMapTiles(paths, new_tiles, false);
+  ASSERT_FALSE(failed.ok());
+  EXPECT_NE(failed.message().find("set.1003.exr"), std::string::npos) << failed.message();
+  EXPECT_EQ(Slurp(paths[0]), old_first);
+  EXPECT_EQ(Slurp(paths[1]), old_second);
+  std::size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(entry.path().string().find(".tmp."), std::string::npos) << entry.path();
+    ++files;
+  }
+  EXPECT_EQ(files, 3u);
 }
 
 }  // namespace
