@@ -37,7 +37,8 @@ Status WriteUvMapTile(const std::string& path, const UvMapTile& tile, bool half)
 
 // Writes tiles[k] to paths[k] as a set: each to a temporary file beside its path, and only once
 // every one is complete are they renamed onto their paths, so an error while writing (or a
-// SIGINT / SIGTERM, with the handlers of dispex/cancel.h) leaves every tile as it was.
+// SIGINT / SIGTERM, with the handlers of dispex/cancel.h) leaves every tile as it was. (The
+// signal handlers remove at most 256 temporaries; a set of more tiles leaves the rest.)
 Status WriteUvMapTiles(std::span<const std::string> paths, std::span<const UvMapTile> tiles,
                        bool half);
 

@@ -169,11 +169,8 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
           w.uv[2 * k + 1] = p.v;
         }
         w.positions.resize(3 * count);
-        w.normals.resize(3 * count);
-        w.t.resize(count);
-        w.flags.resize(count);
-        DISPEX_RETURN_IF_ERROR(w.face.evaluator.EvaluatePoints(face, w.uv, w.positions, w.normals));
-        if (vector) {
+        if (vector) {  // no rays: the limit points alone
+          DISPEX_RETURN_IF_ERROR(w.face.evaluator.EvaluatePoints(face, w.uv, w.positions, {}));
           for (std::size_t k = 0; k < count; ++k) {
             const auto [tile, texel] = by_face.texels[begin + k];
             const Float3 sculpt =
@@ -186,6 +183,10 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
           }
           return Status::Ok();
         }
+        w.normals.resize(3 * count);
+        w.t.resize(count);
+        w.flags.resize(count);
+        DISPEX_RETURN_IF_ERROR(w.face.evaluator.EvaluatePoints(face, w.uv, w.positions, w.normals));
         const std::span<const Float3> origins(reinterpret_cast<const Float3*>(w.positions.data()),
                                               count);
         const std::span<const Float3> normals(reinterpret_cast<const Float3*>(w.normals.data()),

@@ -88,19 +88,21 @@ struct MapReader {
 
   float Scalar(PtexFaceId face, float u, float v) const {
     if (ptex != nullptr) return ptex->Sample(face, u, v);
-    double at[2];
-    charts->Evaluate(face, u, v, at);
     float h = 0;
-    uv->Sample(at[0], at[1], {&h, 1});
+    ReadUv(face, u, v, {&h, 1});
     return h;
   }
   Float3 Vector(PtexFaceId face, float u, float v, const SurfaceFrame& frame) const {
     if (ptex != nullptr) return MapVector(*ptex, *space, face, u, v, frame);
+    float c[3] = {0, 0, 0};
+    ReadUv(face, u, v, c);
+    return VectorFromChannels(*space, frame, c);
+  }
+  // The UV map's channels at (u, v) of a Ptex face, through the cage's UVs.
+  void ReadUv(PtexFaceId face, float u, float v, std::span<float> out) const {
     double at[2];
     charts->Evaluate(face, u, v, at);
-    float c[3] = {0, 0, 0};
-    uv->Sample(at[0], at[1], c);
-    return VectorFromChannels(*space, frame, c);
+    uv->Sample(at[0], at[1], out);
   }
   // Samples per side of a face's displaced grid: twice the Ptex face's resolution within
   // [8, 64]; for a UV map, twice the texels its UV footprint spans within [8, 64].
