@@ -215,8 +215,9 @@ struct SpectralVectorFace {
 };
 
 // Per-thread analysis of vector faces, like SpectralAnalyzer (same plans, same determinism).
-// Supports every ResolutionRule (kNonzero: the largest of the channels' resolutions) and the
-// resolution floor; not the edge options (edge_tolerance, pin_edges), which fail.
+// Supports every ResolutionRule (kNonzero: the largest of the channels' resolutions), the
+// resolution floor and the edge options (pin_edges pins each channel; edge_tolerance bounds the
+// vector length of the edge read error).
 class SpectralVectorAnalyzer {
  public:
   SpectralVectorAnalyzer();

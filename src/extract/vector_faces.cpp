@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <optional>
 
 #include "core/progress.h"
 #include "core/vec3.h"
@@ -118,19 +119,31 @@ Status ProcessVectorFace(PtexFaceId face, VectorSpace space, const ExtractInputs
     const float zero[3] = {0, 0, 0};
     return writer.SetConstantFace(face, FaceInfo(inputs, face, 0, 0), zero);
   }
-  const int n = 1 << settings.plan.log2[static_cast<std::size_t>(face.value)];
-  ThreadCpuStopwatch limit_clock;
-  DISPEX_RETURN_IF_ERROR(SampleFace(face, n, space, inputs, correspondence, w, stats));
-  w.cpu_limit += limit_clock.seconds();
-  ThreadCpuStopwatch spectral_clock;
-  const float scale = space == VectorSpace::kParametric ? ParametricScale(w) : 1.0f;
-  ScaleTangentChannels(w.channels, scale);
-  auto analysed = w.analyzer.Analyze(w.channels, n, n, settings.spectral);
-  if (!analysed.ok()) {
-    return Status::Error(fmt::format("{}: Ptex face {}: {}", inputs.sculpt.source, face.value,
-                                     analysed.status().message()));
+  // With pinned edges (WatertightEdges::kAll), a face whose samples are too coarse to hold
+  // them (the vector changes too fast across the outermost half texel) is sampled again at
+  // twice the rate, up to the finest sampling allowed (ExtractSettings::max_samples_log2), as
+  // the scalar edge rounds do.
+  const int max_log2 = std::max<int>(settings.plan.log2[static_cast<std::size_t>(face.value)],
+                                     settings.max_samples_log2);
+  std::optional<SpectralVectorFace> analysed;
+  float scale = 1.0f;
+  for (int log2 = settings.plan.log2[static_cast<std::size_t>(face.value)];; ++log2) {
+    const int n = 1 << log2;
+    ThreadCpuStopwatch limit_clock;
+    DISPEX_RETURN_IF_ERROR(SampleFace(face, n, space, inputs, correspondence, w, stats));
+    w.cpu_limit += limit_clock.seconds();
+    ThreadCpuStopwatch spectral_clock;
+    scale = space == VectorSpace::kParametric ? ParametricScale(w) : 1.0f;
+    ScaleTangentChannels(w.channels, scale);
+    auto result = w.analyzer.Analyze(w.channels, n, n, settings.spectral);
+    if (!result.ok()) {
+      return Status::Error(fmt::format("{}: Ptex face {}: {}", inputs.sculpt.source, face.value,
+                                       result.status().message()));
+    }
+    analysed.emplace(std::move(*result));
+    w.cpu_spectral += spectral_clock.seconds();
+    if (!analysed->stats.edge_limited || log2 >= max_log2) break;
   }
-  w.cpu_spectral += spectral_clock.seconds();
   std::span<const float> texels = analysed->texels;
   if (scale != 1.0f) {
     w.texels.assign(texels.begin(), texels.end());

@@ -53,33 +53,49 @@ class EdgeValues {
   int nx_, ny_;
 };
 
-}  // namespace
-
-double MaxEdgeReadError(const float* texels, const BlockShape& res, const float* samples,
-                        const BlockShape& shape) {
+template <class Visit>
+void VisitEdgeReads(const float* texels, const BlockShape& res, const float* samples,
+                    const BlockShape& shape, Visit&& visit) {
   const int nx = shape.nx, ny = shape.ny, rx = res.nx, ry = res.ny;
   const EdgeValues edge(samples, shape);
-  double worst = 0;
+  std::size_t k = 0;
   for (int i = 0; i < nx; ++i) {  // bottom (v = 0) and top (v = 1) edges
     const double x = (i + 0.5) / nx;
-    const double bottom = ReadAlong(texels, 1, rx, x);
-    const double top = ReadAlong(texels + std::ptrdiff_t(ry - 1) * rx, 1, rx, x);
-    worst = std::max({worst, std::fabs(bottom - edge.Bottom(i)), std::fabs(top - edge.Top(i))});
+    visit(k++, ReadAlong(texels, 1, rx, x) - edge.Bottom(i));
+    visit(k++, ReadAlong(texels + std::ptrdiff_t(ry - 1) * rx, 1, rx, x) - edge.Top(i));
   }
   for (int j = 0; j < ny; ++j) {  // left (u = 0) and right (u = 1) edges
     const double y = (j + 0.5) / ny;
-    const double left = ReadAlong(texels, rx, ry, y);
-    const double right = ReadAlong(texels + (rx - 1), rx, ry, y);
-    worst = std::max({worst, std::fabs(left - edge.Left(j)), std::fabs(right - edge.Right(j))});
+    visit(k++, ReadAlong(texels, rx, ry, y) - edge.Left(j));
+    visit(k++, ReadAlong(texels + (rx - 1), rx, ry, y) - edge.Right(j));
   }
   // The corners: the corner texel, against the samples extrapolated both ways.
   for (int cj : {0, 1}) {
     for (int ci : {0, 1}) {
       const double texel = texels[std::ptrdiff_t(cj ? ry - 1 : 0) * rx + (ci ? rx - 1 : 0)];
-      worst = std::max(worst, std::fabs(texel - edge.Corner(ci, cj)));
+      visit(k++, texel - edge.Corner(ci, cj));
     }
   }
+}
+
+}  // namespace
+
+std::size_t EdgeReadCount(const BlockShape& shape) {
+  return 2 * static_cast<std::size_t>(shape.nx) + 2 * static_cast<std::size_t>(shape.ny) + 4;
+}
+
+double MaxEdgeReadError(const float* texels, const BlockShape& res, const float* samples,
+                        const BlockShape& shape) {
+  double worst = 0;
+  VisitEdgeReads(texels, res, samples, shape,
+                 [&](std::size_t, double error) { worst = std::max(worst, std::fabs(error)); });
   return worst;
+}
+
+void AddSquaredEdgeReadErrors(const float* texels, const BlockShape& res, const float* samples,
+                              const BlockShape& shape, double* squares) {
+  VisitEdgeReads(texels, res, samples, shape,
+                 [&](std::size_t k, double error) { squares[k] += error * error; });
 }
 
 void PinEdgeTexels(float* texels, const BlockShape& res, const float* samples,

@@ -5,6 +5,8 @@
 // the sample spacing).
 #pragma once
 
+#include <cstddef>
+
 #include "spectral/block_shape.h"
 
 namespace dispex::spectral {
@@ -13,6 +15,13 @@ namespace dispex::spectral {
 // edge value|, in double.
 double MaxEdgeReadError(const float* texels, const BlockShape& res, const float* samples,
                         const BlockShape& samples_shape);
+
+// The same reads for one channel of a vector: adds each position's squared error to
+// squares[k], k < EdgeReadCount(samples_shape), so that the channels' sums give the vector
+// error at each position.
+std::size_t EdgeReadCount(const BlockShape& samples_shape);
+void AddSquaredEdgeReadErrors(const float* texels, const BlockShape& res, const float* samples,
+                              const BlockShape& samples_shape, double* squares);
 
 // Makes the outermost texels hold the displacement on the face's edges rather than at their
 // own centres, half a texel inside: where 2 or more texels but fewer than the samples run

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <tuple>
+#include <vector>
 
 #include "dispex/spectral.h"
 #include "spectral/aligned_buffer.h"
@@ -15,6 +16,7 @@
 #include "spectral/block_shape.h"
 #include "spectral/dct2d.h"
 #include "spectral/dct_resample.h"
+#include "spectral/edge_readback.h"
 #include "spectral/nonzero_rule.h"
 #include "spectral/truncation_bounds.h"
 
@@ -26,6 +28,14 @@ using spectral::ShapeOfLog2;
 namespace {
 
 constexpr int kChannels = 3;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// A candidate resolution's errors: at the samples, and on the face's edges (0 when not
+// measured), both as vector lengths.
+struct Measured {
+  double error = 0;
+  double edge = 0;
+};
 
 }  // namespace
 
@@ -36,6 +46,19 @@ struct SpectralVectorAnalyzer::Impl {
   spectral::AlignedFloats padded;
   std::array<spectral::AlignedFloats, 3> interleaved;  // the current resolution, two candidates
   std::array<float, kChannels> mean{};
+  std::vector<double> edge_squares;
+  bool pin = false, measure_edges = false;
+
+  // The largest vector error of the per-face reader on the edges, for texels[c] at `res`.
+  double EdgeError(const BlockShape& shape, const BlockShape& res) {
+    if (!measure_edges) return 0;
+    edge_squares.assign(spectral::EdgeReadCount(shape), 0.0);
+    for (int c = 0; c < kChannels; ++c) {
+      spectral::AddSquaredEdgeReadErrors(texels[c].data(), res, samples[c].data(), shape,
+                                         edge_squares.data());
+    }
+    return std::sqrt(*std::max_element(edge_squares.begin(), edge_squares.end()));
+  }
 
   // Splits the channels; the first non-finite value fails, named by (i, j) and channel.
   Status Load(std::span<const float> in, const BlockShape& shape) {
@@ -86,14 +109,16 @@ struct SpectralVectorAnalyzer::Impl {
                                     [this](int kx, int ky) { return Bound(kx, ky); });
   }
 
-  // The channels resampled to `res`, interleaved into interleaved[slot]; returns the largest
-  // vector read-back error at the samples.
-  double ResampleAndMeasure(const BlockShape& shape, const BlockShape& res, int slot) {
+  // The channels resampled to `res` (their edge texels pinned when `pin`), interleaved into
+  // interleaved[slot]; returns the largest vector read-back error at the samples and on the
+  // edges.
+  Measured ResampleAndMeasure(const BlockShape& shape, const BlockShape& res, int slot) {
     float* out = interleaved[slot].Reserve(kChannels * res.count());
     for (int c = 0; c < kChannels; ++c) {
       float* t = texels[c].Reserve(res.count());
       spectral::ResampleBlock(dct, samples[c].data(), coefficients[c].data(), shape, res, mean[c],
                               padded, t);
+      if (pin) spectral::PinEdgeTexels(t, res, samples[c].data(), shape);
       for (std::size_t k = 0; k < res.count(); ++k) out[kChannels * k + c] = t[k];
       spectral::ReadBack(t, res, shape, read_back[c].Reserve(shape.count()));
     }
@@ -106,7 +131,7 @@ struct SpectralVectorAnalyzer::Impl {
       }
       worst = std::max(worst, d2);
     }
-    return std::sqrt(worst);
+    return Measured{std::sqrt(worst), EdgeError(shape, res)};
   }
 };
 
@@ -120,9 +145,6 @@ StatusOr<SpectralVectorFace> SpectralVectorAnalyzer::Analyze(std::span<const flo
                                                              int ny,
                                                              const SpectralOptions& options) {
   DISPEX_RETURN_IF_ERROR(ValidateSpectralOptions(options));
-  if (options.edge_tolerance > 0 || options.pin_edges) {
-    return Status::Error("vector faces take no edge tolerance and no pinned edges");
-  }
   DISPEX_ASSIGN_OR_RETURN(const BlockShape shape, spectral::MakeBlockShape(nx, ny));
   if (samples.size() != kChannels * shape.count()) {
     return Status::Error(
@@ -137,20 +159,36 @@ StatusOr<SpectralVectorFace> SpectralVectorAnalyzer::Analyze(std::span<const flo
   face.stats.texels_before = static_cast<std::int64_t>(shape.count());
   const double tolerance = options.tolerance;
   const bool verify = options.rule == ResolutionRule::kErrorBound && options.verify;
+  // As SpectralAnalyzer: with an edge tolerance a resolution is accepted when both errors are
+  // within theirs, and candidates compete on the larger of the two ratios.
+  const double edge_tolerance = verify ? options.edge_tolerance : 0.0;
+  m.measure_edges = edge_tolerance > 0;
+  m.pin = verify && options.pin_edges;
+  auto score = [&](const Measured& e) {
+    return m.measure_edges ? std::max(e.error / tolerance, e.edge / edge_tolerance) : e.error;
+  };
+  auto accepted = [&](const Measured& e) {
+    return e.error <= tolerance && (!m.measure_edges || e.edge <= edge_tolerance);
+  };
   const bool has_floor = options.min_ulog2 > 0 || options.min_vlog2 > 0;
   if (options.rule == ResolutionRule::kErrorBound && !has_floor) {
     const double deviation = m.MaxDeviationFromMean(shape);
     if (deviation <= tolerance) {
-      float* texel = m.interleaved[0].Reserve(kChannels);
-      std::copy(m.mean.begin(), m.mean.end(), texel);
-      face.constant = true;
-      face.constant_value = m.mean;
-      face.texels = std::span<const float>(texel, kChannels);
-      face.stats.texels_after = 1;
-      face.stats.bound = deviation;
-      face.stats.measured_error = deviation;
-      face.stats.constant = true;
-      return face;
+      for (int c = 0; c < kChannels; ++c) m.texels[c].Reserve(1)[0] = m.mean[c];
+      const Measured constant{deviation, m.EdgeError(shape, ShapeOfLog2(0, 0))};
+      if (accepted(constant)) {
+        float* texel = m.interleaved[0].Reserve(kChannels);
+        std::copy(m.mean.begin(), m.mean.end(), texel);
+        face.constant = true;
+        face.constant_value = m.mean;
+        face.texels = std::span<const float>(texel, kChannels);
+        face.stats.texels_after = 1;
+        face.stats.bound = deviation;
+        face.stats.measured_error = deviation;
+        face.stats.edge_error = constant.edge;
+        face.stats.constant = true;
+        return face;
+      }
     }
   }
 
@@ -186,28 +224,32 @@ StatusOr<SpectralVectorFace> SpectralVectorAnalyzer::Analyze(std::span<const flo
   }
 
   int slot = 0;
-  double error = m.ResampleAndMeasure(shape, ShapeOfLog2(kx, ky), slot);
-  while (verify && error > tolerance) {
-    // Double u or v, whichever lowers the error more (ties go to u); the full resolution
-    // holds the samples themselves, so the loop ends.
+  Measured measured = m.ResampleAndMeasure(shape, ShapeOfLog2(kx, ky), slot);
+  while (verify && !accepted(measured)) {
+    // Double u or v, whichever scores lower (ties go to u); the full resolution holds the
+    // samples themselves, so the loop ends.
     const bool can_u = kx < shape.lx;
     const bool can_v = ky < shape.ly;
-    if (!can_u && !can_v) break;
+    if (!can_u && !can_v) {
+      // Only the edge criterion can still fail, where the samples are too coarse for it.
+      face.stats.edge_limited = m.measure_edges;
+      break;
+    }
     const int slot_u = (slot + 1) % 3;
     const int slot_v = (slot + 2) % 3;
-    constexpr double kNone = std::numeric_limits<double>::infinity();
-    const double error_u =
-        can_u ? m.ResampleAndMeasure(shape, ShapeOfLog2(kx + 1, ky), slot_u) : kNone;
-    const double error_v =
-        can_v ? m.ResampleAndMeasure(shape, ShapeOfLog2(kx, ky + 1), slot_v) : kNone;
-    if (can_u && error_u <= error_v) {
+    const Measured none{kInfinity, kInfinity};
+    const Measured at_u =
+        can_u ? m.ResampleAndMeasure(shape, ShapeOfLog2(kx + 1, ky), slot_u) : none;
+    const Measured at_v =
+        can_v ? m.ResampleAndMeasure(shape, ShapeOfLog2(kx, ky + 1), slot_v) : none;
+    if (can_u && score(at_u) <= score(at_v)) {
       ++kx;
       slot = slot_u;
-      error = error_u;
+      measured = at_u;
     } else {
       ++ky;
       slot = slot_v;
-      error = error_v;
+      measured = at_v;
     }
     ++face.stats.step_ups;
   }
@@ -220,7 +262,8 @@ StatusOr<SpectralVectorFace> SpectralVectorAnalyzer::Analyze(std::span<const flo
   if (face.constant) std::copy_n(face.texels.begin(), kChannels, face.constant_value.begin());
   face.stats.texels_after = static_cast<std::int64_t>(res.count());
   face.stats.bound = m.Bound(kx, ky);
-  face.stats.measured_error = error;
+  face.stats.measured_error = measured.error;
+  face.stats.edge_error = measured.edge;
   face.stats.constant = face.constant;
   return face;
 }
