@@ -1,4 +1,4 @@
-// dispex preview MAP.ptx -o map.png [--mode grey|signed] [--range auto|A] [--labels]
+// dispex preview MAP.ptx -o map.png [--mode auto|grey|signed|vector] [--range auto|A] [--labels]
 #include <fmt/format.h>
 
 #include <charconv>
@@ -20,16 +20,20 @@ constexpr FlagName kPreviewFlags[] = {
 struct PreviewArgs {
   std::string map_path;
   std::string output_path;
-  std::string mode = "signed";
+  std::string mode = "auto";  // vector for vector maps, else signed (DefaultAtlasMode)
   std::string range = "auto";
   AtlasOptions options;
   bool quiet = false;
 };
 
 Status Resolve(PreviewArgs& a) {
-  auto mode = ParseAtlasMode(a.mode);
-  if (!mode.ok()) return mode.status().WithPrefix("--mode");
-  a.options.mode = *mode;
+  if (a.mode != "auto") {
+    auto mode = ParseAtlasMode(a.mode);
+    if (!mode.ok()) {
+      return Status::Error(fmt::format("--mode {}: expected auto, grey, signed or vector", a.mode));
+    }
+    a.options.mode = *mode;
+  }
   if (a.range != "auto") {
     double value = 0;
     auto [end, ec] = std::from_chars(a.range.data(), a.range.data() + a.range.size(), value);
@@ -51,6 +55,7 @@ int RunPreview(PreviewArgs& args) {
   if (!resolved.ok()) return ReportFailure(resolved, kPreviewFlags, 2);
   auto map = PtexFile::Open(args.map_path);
   if (!map.ok()) return ReportFailure(map.status());
+  if (args.mode == "auto") args.options.mode = DefaultAtlasMode(*map);
   AtlasLayout layout;
   auto image = RenderAtlas(*map, args.options, &layout);
   if (!image.ok()) return ReportFailure(image.status(), kPreviewFlags);
@@ -69,15 +74,18 @@ void SetupPreview(CLI::App& app, int& exit_code) {
   AtlasOptions& o = args->options;
   CLI::App* cmd = app.add_subcommand(
       "preview",
-      "Draw a Ptex map as a PNG atlas: one tile per face in face-id order, values in grey or "
-      "signed green/red, with a legend of the value range");
+      "Draw a Ptex map as a PNG atlas: one tile per face in face-id order, values in grey, "
+      "signed green/red, or a vector map's three channels as red, green, blue, with a legend of "
+      "the value range");
   cmd->add_option("map", args->map_path, "Ptex map (.ptx)")->required();
   cmd->add_option("-o,--output", args->output_path, "PNG to write")->required();
   cmd->add_option("--mode", args->mode,
-                  "grey (black = low, white = high) or signed (green +, red -, black 0)")
+                  "auto (vector for vector maps, else signed), grey (black = low, white = high), "
+                  "signed (green +, red -, black 0) or vector (channels --channel.. +2 as red, "
+                  "green, blue; 128 grey = 0)")
       ->capture_default_str();
   cmd->add_option("--range", args->range,
-                  "'auto' (signed: +-max|value|, grey: [min, max]) or A for [-A, A]")
+                  "'auto' (signed, vector: +-max|value|, grey: [min, max]) or A for [-A, A]")
       ->capture_default_str();
   cmd->add_flag("--labels", o.labels, "write each face id on its tile");
   cmd->add_option("--tile", o.min_tile,
@@ -92,7 +100,8 @@ void SetupPreview(CLI::App& app, int& exit_code) {
   cmd->add_option("--width", o.width, "atlas width in pixels (0: about square)")
       ->check(NonNegative())
       ->capture_default_str();
-  cmd->add_option("--channel", o.channel, "channel to draw")->capture_default_str();
+  cmd->add_option("--channel", o.channel, "channel to draw (vector: the first of three)")
+      ->capture_default_str();
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
       ->check(NonNegative())
       ->capture_default_str();

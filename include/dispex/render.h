@@ -62,16 +62,22 @@ StatusOr<std::array<int, 2>> ParseImageSize(std::string_view text);
 enum class AtlasMode : std::uint8_t {
   kGrey,    // black = low end of the range, white = high end
   kSigned,  // green positive, red negative, black zero; intensity proportional to |value|
+  // Three channels from `channel` on as red, green, blue (a vector map's x, y, z or T, B, N):
+  // each component as kGrey draws it over the range, so 128 grey is the zero vector.
+  kVector,
 };
-std::string_view AtlasModeName(AtlasMode mode);  // "grey", "signed"
+std::string_view AtlasModeName(AtlasMode mode);  // "grey", "signed", "vector"
+// The mode a map is best shown in: kVector for a vector map (one with dispex:vector_space and
+// three channels or more), kSigned otherwise.
+AtlasMode DefaultAtlasMode(const PtexFile& map);
 StatusOr<AtlasMode> ParseAtlasMode(std::string_view name);
 
 struct AtlasOptions {
   AtlasMode mode = AtlasMode::kSigned;
-  // 0: automatic. kSigned: [-m, m], m the largest |value| shown; kGrey: [min, max] of the
-  // values shown. A positive number A: [-A, A] in both modes.
+  // 0: automatic. kSigned and kVector: [-m, m], m the largest |value| shown (of any of the
+  // three components); kGrey: [min, max] of the values shown. A positive number A: [-A, A].
   double range = 0;
-  int channel = 0;
+  int channel = 0;  // the channel drawn; kVector: the first of three
   // Each tile is its face's ures x vres texels, each side scaled by the smallest integer factor
   // that makes it at least min_tile pixels (2..256), as far as max_tile allows. Faces whose
   // larger side exceeds max_tile pixels (16..4096) are shown reduced by a power of two (the
@@ -115,8 +121,8 @@ struct AtlasLayout {
 // tile), one-pixel separators, a legend strip below: the gradient bar with the minimum,
 // middle and maximum values written under it. Non-finite texels are drawn magenta and are
 // left out of the automatic range. Fails for a triangle-mesh Ptex file, a channel out of
-// range, options out of range, a face whose data is corrupt (naming the face), or an image
-// over 2^27 pixels. `layout`, when given, receives the positions.
+// range (kVector: channel + 2 past the last), options out of range, a face whose data is corrupt
+// (naming the face), or an image over 2^27 pixels. `layout`, when given, receives the positions.
 StatusOr<Image> RenderAtlas(const PtexFile& map, const AtlasOptions& options,
                             AtlasLayout* layout = nullptr);
 
@@ -125,8 +131,12 @@ StatusOr<Image> RenderAtlas(const PtexFile& map, const AtlasOptions& options,
 //            128 grey;
 //   kSigned: m = max(|lo|, |hi|), c = round(255 * min(1, |value| / m)): (0, c, 0) for value > 0,
 //            (c, 0, 0) for value < 0, black for 0 (and for m == 0);
+//   kVector: one component, as kGrey (AtlasVectorColour combines three);
 // magenta (255, 0, 255) for a value that is not finite.
 std::array<std::uint8_t, 3> AtlasColour(AtlasMode mode, double lo, double hi, float value);
+// kVector's pixel: the red, green and blue of AtlasColour(kGrey, lo, hi, .) of the three
+// components; magenta when any of them is not finite.
+std::array<std::uint8_t, 3> AtlasVectorColour(double lo, double hi, const float* components);
 
 // ---- Rendering the surface -----------------------------------------------------------------
 

@@ -1,5 +1,6 @@
 // dispex preview: a displacement map as a picture. Each Ptex face's texels become a tile (see
-// atlas_layout.cpp), coloured by value in grey or in signed green/red, with a legend strip
+// atlas_layout.cpp), coloured by value in grey, in signed green/red, or a vector's three
+// components as red, green and blue, with a legend strip
 // that gives the value range. Faces are read and drawn in parallel; each tile is written by
 // one task only, so the pixels do not depend on the thread count.
 #include <fmt/format.h>
@@ -14,6 +15,7 @@
 #include <string>
 
 #include "dispex/render.h"
+#include "dispex/vector_space.h"
 #include "render/atlas_layout.h"
 #include "render/bitmap_font.h"
 #include "render/image_ops.h"
@@ -33,26 +35,31 @@ Status CheckMapForAtlas(const PtexFile& map, const AtlasOptions& o) {
   if (map.header().mesh_type != PtexMeshType::kQuad) {
     return Status::Error(map.name() + ": triangle-mesh Ptex files are not supported");
   }
-  if (o.channel >= map.header().num_channels) {
+  const int last = o.channel + (o.mode == AtlasMode::kVector ? 2 : 0);
+  if (last >= map.header().num_channels) {
     return Status::Error(fmt::format("{}: channel {} out of range (the file has {})", map.name(),
-                                     o.channel, map.header().num_channels));
+                                     last, map.header().num_channels));
   }
   return Status::Ok();
 }
 
-// The face's texels of `channel` at the tile's reduction, v-major: stored reductions when the
-// file has the level, else the mean of each block of level-0 texels.
-Status ShownTexels(const PtexFile& map, PtexFaceId face, int channel, int reduction,
+// The face's texels of channels [first, first + count) at the tile's reduction, v-major and
+// interleaved: stored reductions when the file has the level, else the mean of each block of
+// level-0 texels.
+Status ShownTexels(const PtexFile& map, PtexFaceId face, int first, int count, int reduction,
                    std::vector<float>& scratch, std::vector<float>& out) {
   const PtexFaceInfo& info = map.face_info(face);
   const int nc = map.header().num_channels;
   const int su = render::Reduced(info.ures(), reduction);
   const int sv = render::Reduced(info.vres(), reduction);
-  out.assign(static_cast<std::size_t>(su) * static_cast<std::size_t>(sv), 0.0f);
+  const auto shown = static_cast<std::size_t>(su) * static_cast<std::size_t>(sv);
+  out.assign(shown * static_cast<std::size_t>(count), 0.0f);
   if (info.constant) {
     std::vector<float> value(static_cast<std::size_t>(nc));
     map.ConstantValue(face, value.data());
-    std::fill(out.begin(), out.end(), value[static_cast<std::size_t>(channel)]);
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      out[k] = value[static_cast<std::size_t>(first) + k % static_cast<std::size_t>(count)];
+    }
     return Status::Ok();
   }
   const bool stored = reduction > 0 && reduction < map.NumStoredLevels(face) &&
@@ -64,13 +71,15 @@ Status ShownTexels(const PtexFile& map, PtexFaceId face, int channel, int reduct
   const double inverse = 1.0 / (double(bu) * double(bv));
   for (int j = 0; j < sv; ++j) {
     for (int i = 0; i < su; ++i) {
-      double sum = 0;
-      for (int y = j * bv; y < (j + 1) * bv; ++y) {
-        for (int x = i * bu; x < (i + 1) * bu; ++x) {
-          sum += scratch[(static_cast<std::size_t>(y) * lu + x) * nc + channel];
+      for (int c = 0; c < count; ++c) {
+        double sum = 0;
+        for (int y = j * bv; y < (j + 1) * bv; ++y) {
+          for (int x = i * bu; x < (i + 1) * bu; ++x) {
+            sum += scratch[(static_cast<std::size_t>(y) * lu + x) * nc + first + c];
+          }
         }
+        out[(static_cast<std::size_t>(j) * su + i) * count + c] = static_cast<float>(sum * inverse);
       }
-      out[static_cast<std::size_t>(j) * su + i] = static_cast<float>(sum * inverse);
     }
   }
   return Status::Ok();
@@ -127,7 +136,7 @@ Status ValidateAtlasOptions(const AtlasOptions& o) {
 
 std::array<std::uint8_t, 3> AtlasColour(AtlasMode mode, double lo, double hi, float value) {
   if (!std::isfinite(value)) return {255, 0, 255};
-  if (mode == AtlasMode::kGrey) {
+  if (mode == AtlasMode::kGrey || mode == AtlasMode::kVector) {
     double t = hi > lo ? (double(value) - lo) / (hi - lo) : 0.5;
     t = std::clamp(t, 0.0, 1.0);
     const auto g = static_cast<std::uint8_t>(std::lround(255.0 * t));
@@ -140,12 +149,29 @@ std::array<std::uint8_t, 3> AtlasColour(AtlasMode mode, double lo, double hi, fl
   return value > 0 ? Rgb{0, c, 0} : Rgb{c, 0, 0};
 }
 
+AtlasMode DefaultAtlasMode(const PtexFile& map) {
+  const bool vector =
+      map.FindMetaData(kVectorSpaceMetaKey) != nullptr && map.header().num_channels >= 3;
+  return vector ? AtlasMode::kVector : AtlasMode::kSigned;
+}
+
+std::array<std::uint8_t, 3> AtlasVectorColour(double lo, double hi, const float* components) {
+  Rgb out;
+  for (int c = 0; c < 3; ++c) {
+    if (!std::isfinite(components[c])) return {255, 0, 255};
+    out[static_cast<std::size_t>(c)] = AtlasColour(AtlasMode::kGrey, lo, hi, components[c])[0];
+  }
+  return out;
+}
+
 StatusOr<Image> RenderAtlas(const PtexFile& map, const AtlasOptions& options,
                             AtlasLayout* layout_out) {
   DISPEX_RETURN_IF_ERROR(ValidateAtlasOptions(options));
   DISPEX_RETURN_IF_ERROR(CheckMapForAtlas(map, options));
   DISPEX_ASSIGN_OR_RETURN(AtlasLayout layout, render::LayOutAtlas(map, options));
   const int n = map.num_faces();
+  const bool vector = options.mode == AtlasMode::kVector;
+  const int count = vector ? 3 : 1;
 
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   // Texels shown per face (at most one per pixel of its tile, so bounded by the image).
@@ -158,7 +184,7 @@ StatusOr<Image> RenderAtlas(const PtexFile& map, const AtlasOptions& options,
     tbb::parallel_for(0, n, [&](int f) {
       std::vector<float>& scratch = scratches.local();
       const auto& tile = layout.tiles[static_cast<std::size_t>(f)];
-      Status st = ShownTexels(map, PtexFaceId(f), options.channel, tile.reduction, scratch,
+      Status st = ShownTexels(map, PtexFaceId(f), options.channel, count, tile.reduction, scratch,
                               shown[static_cast<std::size_t>(f)]);
       if (!st.ok()) {
         std::lock_guard lock(mutex);
@@ -185,7 +211,7 @@ StatusOr<Image> RenderAtlas(const PtexFile& map, const AtlasOptions& options,
       }
     }
     if (lo > hi) lo = hi = 0;  // nothing finite
-    if (options.mode == AtlasMode::kSigned) {
+    if (options.mode != AtlasMode::kGrey) {
       const double m = std::max(std::fabs(lo), std::fabs(hi));
       layout.range_min = -m;
       layout.range_max = m;
@@ -206,10 +232,11 @@ StatusOr<Image> RenderAtlas(const PtexFile& map, const AtlasOptions& options,
       for (int y = 0; y < tile.rect.height; ++y) {
         const int j = sv - 1 - y / tile.scale_y;
         for (int x = 0; x < tile.rect.width; ++x) {
-          const int i = x / tile.scale_x;
+          const std::size_t k = static_cast<std::size_t>(j) * su + x / tile.scale_x;
           image.set(tile.rect.x + x, tile.rect.y + y,
-                    AtlasColour(options.mode, layout.range_min, layout.range_max,
-                                texels[static_cast<std::size_t>(j) * su + i]));
+                    vector
+                        ? AtlasVectorColour(layout.range_min, layout.range_max, &texels[3 * k])
+                        : AtlasColour(options.mode, layout.range_min, layout.range_max, texels[k]));
         }
       }
       const std::string id = options.labels ? std::to_string(f) : std::string();

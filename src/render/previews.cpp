@@ -19,7 +19,9 @@ Status WritePreviews(const std::string& base_path, const std::string& map_path,
   DISPEX_ASSIGN_OR_RETURN(PtexFile map, PtexFile::Open(map_path));
   const std::string stem = fs::path(map_path).stem().string();
 
-  DISPEX_ASSIGN_OR_RETURN(Image atlas, RenderAtlas(map, AtlasOptions{}));
+  AtlasOptions atlas_options;
+  atlas_options.mode = DefaultAtlasMode(map);
+  DISPEX_ASSIGN_OR_RETURN(Image atlas, RenderAtlas(map, atlas_options));
   DISPEX_RETURN_IF_ERROR(WritePng((fs::path(dir) / (stem + "_atlas.png")).string(), atlas));
 
   SurfaceRenderOptions options;

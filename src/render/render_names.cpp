@@ -8,13 +8,22 @@
 namespace dispex {
 
 std::string_view AtlasModeName(AtlasMode mode) {
-  return mode == AtlasMode::kGrey ? "grey" : "signed";
+  switch (mode) {
+    case AtlasMode::kGrey:
+      return "grey";
+    case AtlasMode::kSigned:
+      return "signed";
+    case AtlasMode::kVector:
+      return "vector";
+  }
+  return "?";
 }
 
 StatusOr<AtlasMode> ParseAtlasMode(std::string_view name) {
   if (name == "grey" || name == "gray") return AtlasMode::kGrey;
   if (name == "signed") return AtlasMode::kSigned;
-  return Status::Error(fmt::format("unknown mode '{}' (expected grey or signed)", name));
+  if (name == "vector") return AtlasMode::kVector;
+  return Status::Error(fmt::format("unknown mode '{}' (expected grey, signed or vector)", name));
 }
 
 std::string_view ViewName(ViewPreset view) {

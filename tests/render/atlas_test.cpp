@@ -3,6 +3,7 @@
 // determinism.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include "dispex/render.h"
@@ -417,9 +418,59 @@ TEST(Atlas, TooLargeAnAtlasIsAnErrorBeforeAnyTexelIsRead) {
   EXPECT_EQ(layout.tiles[0].reduction, 4);
 }
 
+// A 3-channel map: each texel's channels as red, green, blue over [-m, m], m the largest
+// |component| (rejects drawing channel 0 only, channels out of order, or a range taken from
+// one channel). Texel (1, 0) of face 0 is (0, 0, 0): 128 grey. The default mode of a map
+// marked as a vector map is kVector, of a plain 3-channel map kSigned.
+TEST(Atlas, VectorModeDrawsThreeChannelsAsRgb) {
+  TempDir dir;
+  PtexWriterOptions options;
+  options.num_channels = 3;
+  auto writer = PtexWriter::Create(dir / "v.ptx", options, 2);
+  ASSERT_TRUE(writer.ok());
+  PtexFaceInfo info;
+  info.ulog2 = 1;
+  info.vlog2 = 0;
+  const std::vector<float> face0 = {-2, 1, 0, 0, 0, 0};  // texels (0, 0) and (1, 0)
+  ASSERT_TRUE(writer->SetFace(PtexFaceId(0), info, face0).ok());
+  const float constant[3] = {0.5f, -0.5f, 2.0f};
+  ASSERT_TRUE(writer->SetConstantFace(PtexFaceId(1), PtexFaceInfo{}, constant).ok());
+  ASSERT_TRUE(writer->AddMetaData("dispex:vector_space", "object").ok());
+  ASSERT_TRUE(writer->Finish().ok());
+  auto map = PtexFile::Open(dir / "v.ptx");
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  EXPECT_EQ(DefaultAtlasMode(*map), AtlasMode::kVector);
+  AtlasOptions o;
+  o.mode = AtlasMode::kVector;
+  o.min_tile = 4;
+  AtlasLayout layout;
+  auto image = RenderAtlas(*map, o, &layout);
+  ASSERT_TRUE(image.ok()) << image.status().message();
+  EXPECT_EQ(layout.range_min, -2);
+  EXPECT_EQ(layout.range_max, 2);
+  const AtlasLayout::Tile& t0 = layout.tiles[0];
+  // (x + 2) / 4 * 255: -2 -> 0, 1 -> 191, 0 -> 128 (127.5 rounds up).
+  EXPECT_EQ(image->at(t0.rect.x, t0.rect.y), (Rgb{0, 191, 128}));
+  EXPECT_EQ(image->at(t0.rect.x + t0.scale_x, t0.rect.y), (Rgb{128, 128, 128}));
+  ExpectUniformTile(*image, layout.tiles[1].rect, {159, 96, 255}, "constant (0.5, -0.5, 2)");
+  EXPECT_EQ(AtlasVectorColour(-1, 1, std::array<float, 3>{0, NAN, 0}.data()), kMagenta);
+  o.channel = 1;
+  EXPECT_FALSE(RenderAtlas(*map, o).ok()) << "channels 1..3 of a 3-channel map";
+
+  auto plain_writer = PtexWriter::Create(dir / "p.ptx", options, 1);
+  ASSERT_TRUE(plain_writer.ok());
+  ASSERT_TRUE(plain_writer->SetConstantFace(PtexFaceId(0), PtexFaceInfo{}, constant).ok());
+  ASSERT_TRUE(plain_writer->Finish().ok());
+  auto plain = PtexFile::Open(dir / "p.ptx");
+  ASSERT_TRUE(plain.ok());
+  EXPECT_EQ(DefaultAtlasMode(*plain), AtlasMode::kSigned);
+}
+
 TEST(Atlas, ParseAtlasMode) {
   EXPECT_EQ(*ParseAtlasMode("grey"), AtlasMode::kGrey);
   EXPECT_EQ(*ParseAtlasMode("signed"), AtlasMode::kSigned);
+  EXPECT_EQ(*ParseAtlasMode("vector"), AtlasMode::kVector);
+  EXPECT_EQ(AtlasModeName(AtlasMode::kVector), "vector");
   EXPECT_FALSE(ParseAtlasMode("colour").ok());
   EXPECT_EQ(AtlasModeName(AtlasMode::kSigned), "signed");
 }
