@@ -1,7 +1,7 @@
 // Per-face resolution of vector displacements: SpectralAnalyzer's steps (constant test,
-// truncation bound, DCT resampling, bilinear read-back with step-ups) run on the three
-// channels at one common resolution, every error measured as the Euclidean norm of the
-// vector's.
+// truncation bound, DCT resampling, pinned edges, bilinear read-back with step-ups, the edge
+// reading) run on the three channels at one common resolution, every error measured as the
+// Euclidean norm of the vector's.
 #include <fmt/format.h>
 
 #include <algorithm>
