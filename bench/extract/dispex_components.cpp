@@ -3,8 +3,12 @@
 // (packet8 and single rays: its -n ray cut at the +n hit, the vertex guard, exact t), a bare
 // rtcIntersect8 loop over the same two rays per sample with none of that (Embree alone), the
 // spectral analysis of the traced samples at the automatic tolerance, and the Ptex write of the
-// faces it chose. bench/run compares the extraction's phases, and its total with the sum of
-// these parts (read, first BVH, limit evaluation, packet8 rays, spectral, write).
+// faces it chose. When the sculpt is the base refined, also the path through the subdivision
+// correspondence: the match, the cell table with its fold marks, and the mapping kernel over
+// the same samples. bench/run compares the extraction's phases, and its total with the sum of
+// the parts of the path it took: read, first BVH, limit evaluation, packet8 rays, spectral,
+// write through rays; read, match, cell table, limit evaluation, mapping kernel, spectral,
+// write through the correspondence.
 //   dispex_components BASE SCULPT [--json FILE] [--threads N] [--repeat N]
 // --repeat N (default 3): each ray timing is taken N times and the fastest kept (the shared
 // machine's load moves single timings by tens of percent).
@@ -22,12 +26,14 @@
 #include <optional>
 
 #include "core/system.h"
+#include "dispex/correspondence.h"
 #include "dispex/extract.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
 #include "dispex/spectral.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
+#include "extract/mapping_trace.h"
 #include "extract/oversampling.h"
 #include "trace/flush_denormals.h"
 
@@ -126,6 +132,49 @@ int main(int argc, char** argv) {
   }
   auto estimate =
       Must(EstimateSearchDistance(*tracer, sparse, sparse_n, ComputeBounds(base).diagonal()));
+  // Through the correspondence (extract --method mapping), on the same samples and distance.
+  if (auto correspondence = MatchRefinedSculpt(surface, sculpt); correspondence.ok()) {
+    clock.Reset();
+    correspondence = MatchRefinedSculpt(surface, sculpt);  // timed on warm memory, as a run is
+    const double match = clock.seconds();
+    const std::vector<PtexFaceInfo> table = PtexFaceTable(surface);
+    clock.Reset();
+    extract::SculptMapping mapping =
+        Must(extract::SculptMapping::Build(*correspondence, sculpt, table));
+    MustOk(mapping.MarkFolds(surface, sculpt, table));
+    const double cells = clock.seconds();
+    correspondence = SculptCorrespondence{};
+    out["mapping_match"] = {{"what", "the correspondence (MatchRefinedSculpt)"},
+                            {"seconds", match}};
+    out["mapping_table"] = {{"what", "its cell table and fold marks"}, {"seconds", cells}};
+    struct Scratch {
+      extract::MappingScratch mapping;
+      extract::MappingCounters counters;
+      std::vector<float> t;
+      std::vector<std::uint8_t> flags, undecided;
+    };
+    const NormalQuery query{static_cast<float>(estimate.distance)};
+    double seconds = 1e30;
+    for (int r = 0; r < repeat; ++r) {
+      tbb::enumerable_thread_specific<Scratch> scratches;
+      clock.Reset();
+      tbb::parallel_for(0, n, [&](int f) {
+        const std::size_t b = start[f], e = start[f + 1];
+        if (b == e || surface.is_hole(PtexFaceId(f))) return;
+        Scratch& w = scratches.local();
+        w.t.resize(e - b);
+        w.flags.resize(e - b);
+        w.undecided.resize(e - b);
+        extract::TraceMapped(mapping, sculpt, PtexFaceId(f), 1 << plan.log2[f], {},
+                             {points.data() + b, e - b}, {normals.data() + b, e - b}, query,
+                             NormalHits{w.t, {}, w.flags}, w.undecided, w.mapping, w.counters);
+      });
+      seconds = std::min(seconds, clock.seconds());
+    }
+    out["mapping_kernel"] = {{"what", "the mapping kernel alone on the samples (no fallback BVH)"},
+                             {"seconds", seconds},
+                             {"samples", start[n]}};
+  }
   std::vector<float> distances;  // packet8's, for the spectral stage
   for (RayMode mode : {RayMode::kPacket8, RayMode::kSingle}) {
     TracerOptions o;
