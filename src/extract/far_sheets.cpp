@@ -35,6 +35,30 @@ bool WindowBox(std::size_t k, std::span<const Float3> origins, std::span<const F
   return true;
 }
 
+// Whether sample k's window, the segment o + t n for |t| <= w, meets `box` widened by its
+// rounding margin (in double: a slab test, far tighter than the window's box where n is
+// oblique to the axes).
+bool SegmentMeets(const Float3& o, const Float3& d, double w, const BlockBox& box) {
+  const double c[3] = {o.x, o.y, o.z}, n[3] = {d.x, d.y, d.z};
+  double t0 = -w, t1 = w;
+  for (int a = 0; a < 3; ++a) {
+    const double e = (std::max(std::fabs(double(box.lower[a])), std::fabs(double(box.upper[a]))) +
+                      std::fabs(c[a]) + w) *
+                         0x1p-20 +
+                     0x1p-126;
+    const double lo = double(box.lower[a]) - e, hi = double(box.upper[a]) + e;
+    if (n[a] == 0) {
+      if (c[a] < lo || c[a] > hi) return false;
+      continue;
+    }
+    const double ta = (lo - c[a]) / n[a], tb = (hi - c[a]) / n[a];
+    t0 = std::max(t0, std::min(ta, tb));
+    t1 = std::min(t1, std::max(ta, tb));
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
 void Grow(BlockBox& into, const BlockBox& box) {
   for (int a = 0; a < 3; ++a) {
     into.lower[a] = std::min(into.lower[a], box.lower[a]);
@@ -115,8 +139,12 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, int face, int n,
     const std::size_t at = block_of(k);
     if (w.candidate_starts[at] == w.candidate_starts[at + 1]) continue;
     if (!WindowBox(k, origins, normals, query, out, undecided, box)) continue;
+    const bool hit = out.flags[k] & HitFlags::kHit;
+    const double window = hit && query.policy == HitPolicy::kNearest ? std::fabs(double(out.t[k]))
+                                                                     : double(query.distance);
     for (std::int32_t c = w.candidate_starts[at]; c < w.candidate_starts[at + 1]; ++c) {
-      if (blocks.box(w.candidate_ids[static_cast<std::size_t>(c)]).Meets(box)) {
+      const BlockBox& candidate = blocks.box(w.candidate_ids[static_cast<std::size_t>(c)]);
+      if (candidate.Meets(box) && SegmentMeets(origins[k], normals[k], window, candidate)) {
         undecided[k] = 1;
         ++sent;
         break;

@@ -209,10 +209,6 @@ TexelComparison CompareTexels(const std::string& a_path, const std::string& b_pa
       const double ulps = std::fabs(double(ta[k]) - double(tb[k])) / ulp;
       c.max_ulps = std::max(c.max_ulps, ulps);
       c.beyond += !(ulps <= kUlps);
-      if (!(ulps <= kUlps) && std::getenv("DEBUG_TEXELS")) {
-        std::fprintf(stderr, "face %d texel %zu of %zu: %.9g vs %.9g\n", f, k, ta.size(),
-                     double(ta[k]), double(tb[k]));
-      }
     }
   }
   return c;
@@ -494,10 +490,12 @@ ExtractOptions PerSample(ExtractOptions o, int levels) {
 }
 
 // Spot at level 3 with the detail pattern folds (MakeSculpt counts quads turned over): the faces
-// around the folds go to the BVH whole, and the samples farther away that a folded sheet
-// reaches over go to it through the far-sheet check. Rejects a fold check that never fires,
-// and any texel (one per sample) beyond rounding of the ray map's: before the far-sheet check
-// 28 of 311,296 did, samples whose nearer hit lies on a fold more than two faces away.
+// around the folds go to the BVH whole, and samples farther away whose windows a folded sheet
+// could reach go to it through the far-sheet check. One long search distance for both methods
+// (the automatic one is estimated from the samples each method decides at once, which differ
+// here: 0.0469 against 0.0547, and that alone made the default maps differ in a few texels).
+// Rejects a fold check that never fires, and any texel (one per sample) beyond rounding of the
+// ray map's.
 TEST(MappingFallback, FoldsGoToTheBvh) {
   TempDir dir;
   const std::string cage = DataPath("meshes/keenan_spot/spot_quadrangulated.obj");
@@ -507,11 +505,9 @@ TEST(MappingFallback, FoldsGoToTheBvh) {
   ASSERT_GT(made->folded_faces, 0u);
   auto base = ReadMesh(cage);
   ASSERT_TRUE(base.ok());
-  // One search distance for both (the automatic one is estimated from the samples each
-  // method decides at once, which differ here).
   auto given = [&](ExtractOptions o) {
     o = PerSample(o, 3);
-    o.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.02};
+    o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0.2};
     return o;
   };
   auto mapping =
