@@ -38,7 +38,7 @@ T Must(StatusOr<T> value) {
 
 struct Totals {
   double cpu_mapping = 0, cpu_rays = 0;
-  std::uint64_t samples = 0, undecided = 0, both = 0, differ = 0, quads = 0;
+  std::uint64_t samples = 0, undecided = 0, both = 0, differ = 0, quads = 0, far = 0;
   double max_ulps = 0;
 };
 
@@ -83,6 +83,9 @@ int main(int argc, char** argv) {
     return 1;
   }
   const double t_folds = clock.seconds();
+  clock.Reset();
+  mapping.BuildBlocks(sculpt);
+  const double t_blocks = clock.seconds();
   const int levels = correspondence.levels;
   correspondence = SculptCorrespondence{};
   std::unique_ptr<Tracer> tracer;
@@ -160,6 +163,7 @@ int main(int argc, char** argv) {
       all.samples += w.totals.samples;
       all.undecided += w.counters.queries - w.counters.decided;
       all.quads += w.counters.quads;
+      all.far += w.counters.far_sheets;
       all.both += w.totals.both;
       all.differ += w.totals.differ;
       all.max_ulps = std::max(all.max_ulps, w.totals.max_ulps);
@@ -176,12 +180,14 @@ int main(int argc, char** argv) {
   const double s = double(all.samples);
   fmt::print(
       "read {:.2f}s  match {:.2f}s  cell table {:.2f}s ({:.0f} MB)  folds {:.2f}s ({} faces at "
-      "risk)  bvh {:.2f}s  loop {:.2f}s\n",
+      "risk)  blocks {:.2f}s  bvh {:.2f}s  loop {:.2f}s\n",
       t_read, t_match, t_table, double(mapping.bytes()) / 1e6, t_folds, mapping.fold_risk_faces(),
-      t_bvh, t_loop);
+      t_blocks, t_bvh, t_loop);
   fmt::print("{} samples (level {}), search distance {:.4g}\n", all.samples, levels, distance);
-  fmt::print("mapping: {:.2f} CPU s, {:.1f} ns/sample, {:.2f} quads/sample, {} undecided\n",
-             all.cpu_mapping, 1e9 * all.cpu_mapping / s, double(all.quads) / s, all.undecided);
+  fmt::print(
+      "mapping: {:.2f} CPU s, {:.1f} ns/sample, {:.2f} quads/sample, {} undecided ({} by far "
+      "sheets)\n",
+      all.cpu_mapping, 1e9 * all.cpu_mapping / s, double(all.quads) / s, all.undecided, all.far);
   if (tracer) {
     fmt::print(
         "rays:    {:.2f} CPU s, {:.1f} ns/sample; {} both hit, {} differ, max {:.3g} ulps "

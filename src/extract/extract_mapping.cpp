@@ -40,6 +40,7 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   DISPEX_ASSIGN_OR_RETURN(SculptMapping mapping,
                           SculptMapping::Build(*correspondence, inputs.sculpt, inputs.faces));
   DISPEX_RETURN_IF_ERROR(mapping.MarkFolds(inputs.surface, inputs.sculpt, inputs.faces));
+  mapping.BuildBlocks(inputs.sculpt);
   inputs.mapping = std::make_unique<SculptMapping>(std::move(mapping));
   report.t_match = clock.seconds();
   report.method = ExtractMethod::kMapping;

@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <climits>
 #include <cmath>
 #include <limits>
@@ -13,6 +14,7 @@
 
 #include "core/vec3.h"
 #include "dispex/ptex_sampler.h"
+#include "extract/far_sheets.h"
 #include "extract/parallel_errors.h"
 
 namespace dispex::extract {
@@ -209,7 +211,8 @@ StatusOr<SculptMapping> SculptMapping::Build(const SculptCorrespondence& corresp
 std::size_t SculptMapping::bytes() const {
   return grid_sizes_.capacity() * sizeof(std::int32_t) +
          cell_offsets_.capacity() * sizeof(std::int64_t) +
-         cells_.capacity() * sizeof(std::uint32_t) + crossings_.capacity() * sizeof(Crossing);
+         cells_.capacity() * sizeof(std::uint32_t) + crossings_.capacity() * sizeof(Crossing) +
+         blocks_.bytes();
 }
 
 Status SculptMapping::MarkFolds(const LimitSurface& surface, const Mesh& sculpt,
@@ -279,6 +282,7 @@ MappingCounters& MappingCounters::operator+=(const MappingCounters& other) {
   queries += other.queries;
   decided += other.decided;
   quads += other.quads;
+  far_sheets += other.far_sheets;
   return *this;
 }
 
@@ -474,6 +478,72 @@ void LayOut(const SculptMapping& mapping, int face, MappingScratch& w) {
   }
   w.lattice_face = -1;
 }
+
+}  // namespace
+
+void LayOutNearBlocks(const SculptMapping& mapping, int face, MappingScratch& w) {
+  const SculptBlocks& blocks = mapping.blocks();
+  const int b = blocks.block_size(face), per = blocks.blocks_per_side(face);
+  w.near_face = face;
+  w.near_starts.assign(1, 0);
+  w.near_ids.clear();
+  int corner_state[4];  // 0: none or regular, 1: a fan
+  std::vector<std::pair<int, int>>& around = w.around;
+  for (int c = 0; c < 4; ++c)
+    corner_state[c] = WalkCorner(mapping, face, c, around) == CornerKind::kFan;
+  auto add = [&](std::int64_t id) {
+    const auto begin = w.near_ids.begin() + w.near_starts.back();
+    if (std::find(begin, w.near_ids.end(), id) == w.near_ids.end()) w.near_ids.push_back(id);
+  };
+  // The block of the cell at (a, c) of the face's lattice: face and block indices, or face -1.
+  auto block_of = [&](int a, int c) {
+    const Located at = Locate(mapping, face, {2 * a + 1, 2 * c + 1}, Iso{}, 0);
+    if (at.kind != kCell) return std::array<int, 3>{-1, 0, 0};
+    const int bg = blocks.block_size(at.face);
+    return std::array<int, 3>{at.face, (at.p.x - 1) / 2 / bg, (at.p.y - 1) / 2 / bg};
+  };
+  for (int bj = -1; bj <= per; ++bj) {
+    for (int bi = -1; bi <= per; ++bi) {
+      const bool out_i = bi < 0 || bi >= per, out_j = bj < 0 || bj >= per;
+      if (!out_i && !out_j) {
+        add(blocks.id(face, bi, bj));
+      } else if (out_i && out_j && corner_state[bj < 0 ? (bi < 0 ? 0 : 1) : (bi < 0 ? 3 : 2)]) {
+        // The diagonal slot at an extraordinary corner: the corner block of each face there.
+        const int c = bj < 0 ? (bi < 0 ? 0 : 1) : (bi < 0 ? 3 : 2);
+        WalkCorner(mapping, face, c, around);
+        for (const auto& [h, ch] : around) {
+          const int ph = blocks.blocks_per_side(h);
+          add(blocks.id(h, ch == 0 || ch == 3 ? 0 : ph - 1, ch == 0 || ch == 1 ? 0 : ph - 1));
+        }
+      } else {
+        // The slot's corner cells; where all four land in one face, the blocks between them
+        // (the crossings are isometries of the lattices), else cell by cell.
+        const int a0 = bi * b, a1 = a0 + b - 1, c0 = bj * b, c1 = c0 + b - 1;
+        const std::array<int, 3> k[4] = {block_of(a0, c0), block_of(a1, c0), block_of(a1, c1),
+                                         block_of(a0, c1)};
+        if (k[0][0] >= 0 && k[0][0] == k[1][0] && k[0][0] == k[2][0] && k[0][0] == k[3][0]) {
+          const int i0 = std::min({k[0][1], k[1][1], k[2][1], k[3][1]});
+          const int i1 = std::max({k[0][1], k[1][1], k[2][1], k[3][1]});
+          const int j0 = std::min({k[0][2], k[1][2], k[2][2], k[3][2]});
+          const int j1 = std::max({k[0][2], k[1][2], k[2][2], k[3][2]});
+          for (int j = j0; j <= j1; ++j) {
+            for (int i = i0; i <= i1; ++i) add(blocks.id(k[0][0], i, j));
+          }
+        } else {
+          for (int c = c0; c <= c1; ++c) {
+            for (int a = a0; a <= a1; ++a) {
+              const std::array<int, 3> at = block_of(a, c);
+              if (at[0] >= 0) add(blocks.id(at[0], at[1], at[2]));
+            }
+          }
+        }
+      }
+      w.near_starts.push_back(static_cast<std::int32_t>(w.near_ids.size()));
+    }
+  }
+}
+
+namespace {
 
 // ---- Lines against quads -------------------------------------------------------------------
 
@@ -860,18 +930,14 @@ void TraceBlock(const MappingScratch& w, const Mesh& sculpt, int ci, int cj, con
 
 }  // namespace
 
-void TraceMapped(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId face, int n,
-                 std::span<const std::int32_t> samples, std::span<const Float3> origins,
-                 std::span<const Float3> normals, const NormalQuery& query, const NormalHits& out,
-                 std::span<std::uint8_t> undecided, MappingScratch& w, MappingCounters& counters) {
-  const std::size_t count = samples.empty() ? static_cast<std::size_t>(n) * n : samples.size();
-  counters.queries += count;
-  if (mapping.fold_risk(face.value)) {
-    for (std::size_t s = 0; s < count; ++s) {
-      undecided[samples.empty() ? s : static_cast<std::size_t>(samples[s])] = 1;
-    }
-    return;
-  }
+namespace {
+
+// TraceMapped's rings, for a face not at risk of folds.
+void TraceRingsOfFace(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId face, int n,
+                      std::span<const std::int32_t> samples, std::span<const Float3> origins,
+                      std::span<const Float3> normals, const NormalQuery& query,
+                      const NormalHits& out, std::span<std::uint8_t> undecided, MappingScratch& w,
+                      MappingCounters& counters) {
   if (w.face != face.value) LayOut(mapping, face.value, w);
   const int m = w.m;
   if (samples.empty() && w.lattice_face != face.value) {
@@ -970,6 +1036,28 @@ void TraceMapped(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId fa
       flush(ci, cj);
     }
   }
+}
+
+}  // namespace
+
+void TraceMapped(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId face, int n,
+                 std::span<const std::int32_t> samples, std::span<const Float3> origins,
+                 std::span<const Float3> normals, const NormalQuery& query, const NormalHits& out,
+                 std::span<std::uint8_t> undecided, MappingScratch& w, MappingCounters& counters) {
+  const std::size_t count = samples.empty() ? static_cast<std::size_t>(n) * n : samples.size();
+  counters.queries += count;
+  if (mapping.fold_risk(face.value)) {
+    for (std::size_t s = 0; s < count; ++s) {
+      undecided[samples.empty() ? s : static_cast<std::size_t>(samples[s])] = 1;
+    }
+    return;
+  }
+  TraceRingsOfFace(mapping, sculpt, face, n, samples, origins, normals, query, out, undecided, w,
+                   counters);
+  const std::uint64_t far =
+      CheckFarSheets(mapping, face.value, n, samples, origins, normals, query, out, undecided, w);
+  counters.decided -= far;
+  counters.far_sheets += far;
 }
 
 }  // namespace dispex::extract

@@ -27,10 +27,11 @@
 // only in the outermost ring, no crossing at all, a ring reaching where the neighbourhood
 // cannot be laid out, a degenerate triangle, quads tested that face the line both ways (the
 // sheet folds or stands edge-on there) -- are left undecided for a BVH to answer, and so are
-// all samples of faces near a quad turned over against the limit normal (MarkFolds). The rule
-// assumes the sculpt is one sheet near the sample: another part of the sculpt that comes nearer
-// along the normal than the local sheet (a thin part's other side within the search distance,
-// a fold farther than two faces) is seen only where it lies in the rings tested.
+// all samples of faces near a quad turned over against the limit normal (MarkFolds). Then the
+// decided samples whose ray window could meet any part of the sculpt outside the blocks of
+// cells near them -- the other side of a thin part, a fold farther than two faces, another
+// part that comes close -- are left undecided too (CheckFarSheets, far_sheets.h: boxes of
+// 4 x 4-cell blocks against the boxes of the windows up to the hit kept).
 //
 // Speed. The samples of one cell go through rings 0 and 1 together (4 lanes): the cell's 4 x 4
 // lattice of corners projected in float, each edge's value once, and a triangle classified as
@@ -50,6 +51,7 @@
 #include "dispex/status.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
+#include "extract/sculpt_blocks.h"
 
 namespace dispex::extract {
 
@@ -67,6 +69,7 @@ class SculptMapping {
                                        const Mesh& sculpt, std::span<const PtexFaceInfo> faces);
 
   int levels() const { return levels_; }
+  int num_ptex_faces() const { return static_cast<int>(grid_sizes_.size()); }
   int grid_size(int face) const { return grid_sizes_[static_cast<std::size_t>(face)]; }
   // The sculpt face of cell (i, j) of Ptex face `face` and which of its corners sits at the
   // cell's (i, j) corner (SculptCorrespondence::face_rotation).
@@ -90,6 +93,11 @@ class SculptMapping {
                    std::span<const PtexFaceInfo> faces);
   std::size_t fold_risk_faces() const;
 
+  // The boxes of blocks of cells (SculptBlocks) that decided samples are checked against for
+  // sculpt outside the blocks near them (far_sheets.h); built by BuildBlocks.
+  void BuildBlocks(const Mesh& sculpt) { blocks_ = SculptBlocks::Build(*this, sculpt); }
+  const SculptBlocks& blocks() const { return blocks_; }
+
   // Edge `edge` of Ptex face `face` into its neighbour's grid: points p of the face's grid in
   // half-cell units (vertex (i, j) at (2i, 2j)) are R p + (tx, ty) there, R a rotation by q
   // quarter turns.
@@ -110,13 +118,15 @@ class SculptMapping {
   std::vector<std::uint32_t> cells_;
   std::vector<Crossing> crossings_;      // 4 per Ptex face
   std::vector<std::uint8_t> fold_risk_;  // per Ptex face, once MarkFolds ran
+  SculptBlocks blocks_;
 };
 
 // What TraceMapped did, added up per thread.
 struct MappingCounters {
-  std::uint64_t queries = 0;  // samples given
-  std::uint64_t decided = 0;  // of those, answered (hit or miss)
-  std::uint64_t quads = 0;    // sculpt quads tested
+  std::uint64_t queries = 0;     // samples given
+  std::uint64_t decided = 0;     // of those, answered (hit or miss)
+  std::uint64_t quads = 0;       // sculpt quads tested
+  std::uint64_t far_sheets = 0;  // of the decided, left undecided by CheckFarSheets
   MappingCounters& operator+=(const MappingCounters& other);
 };
 
@@ -145,7 +155,23 @@ struct MappingScratch {
   double centre[3] = {0, 0, 0};
   float extent = 0;
   std::vector<int> first_sample;  // per cell row: its first sample row
+  // The blocks near each block of the face (far_sheets.h), laid out for `near_face`: per slot
+  // of its (M + 2)^2 block grid with a margin of one block (M blocks per side), the ids of the
+  // sculpt blocks there at near_ids[near_starts[s] .. near_starts[s + 1]).
+  int near_face = -1;
+  std::vector<std::int32_t> near_starts;
+  std::vector<std::int64_t> near_ids;
+  // The check's buffers: per block of the face its samples' box and its candidates.
+  std::vector<BlockBox> sample_boxes;
+  std::vector<std::uint8_t> sample_box_used;
+  std::vector<std::int32_t> candidate_starts;
+  std::vector<std::int64_t> candidate_ids;
 };
+
+// Lays out scratch.near_* for `face` (after LayOut's corners): each block slot's sculpt
+// blocks, found cell by cell across Ptex face edges as the rings cross them, and at an
+// extraordinary corner the corner blocks of every face around it.
+void LayOutNearBlocks(const SculptMapping& mapping, int face, MappingScratch& scratch);
 
 // The normal queries of samples `samples` (grid indices j * n + i of face `face`'s n x n
 // grid of texel centres ((i + 0.5) / n, (j + 0.5) / n); all n * n when empty) of `origins` and
@@ -153,7 +179,8 @@ struct MappingScratch {
 // Decided samples get out.t / out.flags (and out.prim when not empty) at their grid index as
 // Tracer::TraceNormals sets them and undecided[k] = 0; the others undecided[k] = 1, out
 // untouched. `sculpt` is the matched mesh. Every sample of a face at risk of folds
-// (SculptMapping::fold_risk) is undecided.
+// (SculptMapping::fold_risk) is undecided, and so is every sample whose window could meet a
+// sculpt block not near it (CheckFarSheets, when BuildBlocks ran).
 void TraceMapped(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId face, int n,
                  std::span<const std::int32_t> samples, std::span<const Float3> origins,
                  std::span<const Float3> normals, const NormalQuery& query, const NormalHits& out,

@@ -1,0 +1,157 @@
+#include "extract/far_sheets.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dispex::extract {
+
+namespace {
+
+// The box of sample k's window, or false when it has none to check (a sample not decided, or
+// one with no valid line: a miss by rule).
+bool WindowBox(std::size_t k, std::span<const Float3> origins, std::span<const Float3> normals,
+               const NormalQuery& query, const NormalHits& out,
+               std::span<const std::uint8_t> undecided, BlockBox& box) {
+  if (undecided[k]) return false;
+  const Float3& o = origins[k];
+  const Float3& d = normals[k];
+  const float c[3] = {o.x, o.y, o.z}, n[3] = {d.x, d.y, d.z};
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(c[a]) || !std::isfinite(n[a])) return false;
+  }
+  if (n[0] == 0 && n[1] == 0 && n[2] == 0) return false;
+  const bool hit = out.flags[k] & HitFlags::kHit;
+  const float w = hit && query.policy == HitPolicy::kNearest ? std::fabs(out.t[k]) : query.distance;
+  if (!std::isfinite(w)) return false;
+  const float scale = std::max({std::fabs(c[0]), std::fabs(c[1]), std::fabs(c[2])}) + w;
+  // Each bound is within a few roundings of the exact o -+ w |n|; 2^-20 of the magnitudes
+  // covers them, and the smallest normal float covers underflow.
+  const float e = scale * 0x1p-20f + 0x1p-126f;
+  for (int a = 0; a < 3; ++a) {
+    const float r = w * std::fabs(n[a]);
+    box.lower[a] = c[a] - r - e;
+    box.upper[a] = c[a] + r + e;
+  }
+  return true;
+}
+
+// Whether sample k's window, the segment o + t n for |t| <= w, meets `box` widened by its
+// rounding margin (in double: a slab test, far tighter than the window's box where n is
+// oblique to the axes).
+bool SegmentMeets(const Float3& o, const Float3& d, double w, const BlockBox& box) {
+  const double c[3] = {o.x, o.y, o.z}, n[3] = {d.x, d.y, d.z};
+  double t0 = -w, t1 = w;
+  for (int a = 0; a < 3; ++a) {
+    const double e = (std::max(std::fabs(double(box.lower[a])), std::fabs(double(box.upper[a]))) +
+                      std::fabs(c[a]) + w) *
+                         0x1p-20 +
+                     0x1p-126;
+    const double lo = double(box.lower[a]) - e, hi = double(box.upper[a]) + e;
+    if (n[a] == 0) {
+      if (c[a] < lo || c[a] > hi) return false;
+      continue;
+    }
+    const double ta = (lo - c[a]) / n[a], tb = (hi - c[a]) / n[a];
+    t0 = std::max(t0, std::min(ta, tb));
+    t1 = std::min(t1, std::max(ta, tb));
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+void Grow(BlockBox& into, const BlockBox& box) {
+  for (int a = 0; a < 3; ++a) {
+    into.lower[a] = std::min(into.lower[a], box.lower[a]);
+    into.upper[a] = std::max(into.upper[a], box.upper[a]);
+  }
+}
+
+}  // namespace
+
+std::uint64_t CheckFarSheets(const SculptMapping& mapping, int face, int n,
+                             std::span<const std::int32_t> samples, std::span<const Float3> origins,
+                             std::span<const Float3> normals, const NormalQuery& query,
+                             const NormalHits& out, std::span<std::uint8_t> undecided,
+                             MappingScratch& w) {
+  const SculptBlocks& blocks = mapping.blocks();
+  if (blocks.empty()) return 0;
+  const int m = mapping.grid_size(face), b = blocks.block_size(face);
+  const int per = blocks.blocks_per_side(face);
+  if (per == 0) return 0;
+  if (w.near_face != face) LayOutNearBlocks(mapping, face, w);
+  const std::size_t count = samples.empty() ? static_cast<std::size_t>(n) * n : samples.size();
+  auto index = [&](std::size_t s) {
+    return samples.empty() ? s : static_cast<std::size_t>(samples[s]);
+  };
+  auto cell_of = [&](int i) {
+    return static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));
+  };
+  auto block_of = [&](std::size_t k) {
+    const int i = static_cast<int>(k % static_cast<std::size_t>(n));
+    const int j = static_cast<int>(k / static_cast<std::size_t>(n));
+    return static_cast<std::size_t>(cell_of(j) / b) * static_cast<std::size_t>(per) +
+           static_cast<std::size_t>(cell_of(i) / b);
+  };
+  // Per block of samples, the box of their windows.
+  const auto num_blocks = static_cast<std::size_t>(per) * static_cast<std::size_t>(per);
+  w.sample_boxes.resize(num_blocks);
+  w.sample_box_used.assign(num_blocks, 0);
+  BlockBox box;
+  for (std::size_t s = 0; s < count; ++s) {
+    const std::size_t k = index(s);
+    if (!WindowBox(k, origins, normals, query, out, undecided, box)) continue;
+    const std::size_t at = block_of(k);
+    if (w.sample_box_used[at]) {
+      Grow(w.sample_boxes[at], box);
+    } else {
+      w.sample_boxes[at] = box;
+      w.sample_box_used[at] = 1;
+    }
+  }
+  // Its candidates: the sculpt blocks the box meets that are not near.
+  const int width = per + 2;
+  w.candidate_starts.assign(1, 0);
+  w.candidate_ids.clear();
+  for (int bj = 0; bj < per; ++bj) {
+    for (int bi = 0; bi < per; ++bi) {
+      const std::size_t at = static_cast<std::size_t>(bj) * per + bi;
+      if (w.sample_box_used[at]) {
+        blocks.ForEachMeeting(w.sample_boxes[at], [&](std::int64_t id) {
+          for (int dj = 0; dj <= 2; ++dj) {
+            for (int di = 0; di <= 2; ++di) {
+              const auto slot = static_cast<std::size_t>((bj + dj) * width + bi + di);
+              const auto begin = w.near_ids.begin() + w.near_starts[slot];
+              const auto end = w.near_ids.begin() + w.near_starts[slot + 1];
+              if (std::find(begin, end, id) != end) return;
+            }
+          }
+          w.candidate_ids.push_back(id);
+        });
+      }
+      w.candidate_starts.push_back(static_cast<std::int32_t>(w.candidate_ids.size()));
+    }
+  }
+  if (w.candidate_ids.empty()) return 0;
+  // The samples of blocks with candidates, one by one.
+  std::uint64_t sent = 0;
+  for (std::size_t s = 0; s < count; ++s) {
+    const std::size_t k = index(s);
+    const std::size_t at = block_of(k);
+    if (w.candidate_starts[at] == w.candidate_starts[at + 1]) continue;
+    if (!WindowBox(k, origins, normals, query, out, undecided, box)) continue;
+    const bool hit = out.flags[k] & HitFlags::kHit;
+    const double window = hit && query.policy == HitPolicy::kNearest ? std::fabs(double(out.t[k]))
+                                                                     : double(query.distance);
+    for (std::int32_t c = w.candidate_starts[at]; c < w.candidate_starts[at + 1]; ++c) {
+      const BlockBox& candidate = blocks.box(w.candidate_ids[static_cast<std::size_t>(c)]);
+      if (candidate.Meets(box) && SegmentMeets(origins[k], normals[k], window, candidate)) {
+        undecided[k] = 1;
+        ++sent;
+        break;
+      }
+    }
+  }
+  return sent;
+}
+
+}  // namespace dispex::extract
