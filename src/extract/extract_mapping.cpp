@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/system.h"
@@ -104,6 +105,40 @@ StatusOr<SearchDistanceEstimate> EstimateSearchDistanceMapped(const ExtractInput
   return SearchDistanceFromHits(std::move(hits), count, base_diagonal, options);
 }
 
+namespace {
+
+// SculptWithinReach through the mapping's blocks of cells: the quads of every block whose box
+// meets the reach box of a flagged face. A quad's box lies in its block's, so this holds every
+// quad whose box meets a reach box; it reads only the blocks found, not every sculpt face.
+Mesh SculptNearFaces(const ExtractInputs& inputs, std::span<const std::uint8_t> flagged) {
+  const SculptMapping& mapping = *inputs.mapping;
+  const SculptBlocks& blocks = mapping.blocks();
+  std::vector<std::uint8_t> keep(inputs.sculpt.num_faces(), 0);
+  std::vector<std::uint8_t> seen(static_cast<std::size_t>(blocks.num_blocks()), 0);
+  for (std::size_t f = 0; f < flagged.size(); ++f) {
+    if (!flagged[f] || inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
+    const Box& reach = inputs.face_keys->reach_boxes[f];
+    BlockBox query;
+    for (int a = 0; a < 3; ++a) {
+      query.lower[a] = reach.lower[static_cast<std::size_t>(a)];
+      query.upper[a] = reach.upper[static_cast<std::size_t>(a)];
+    }
+    blocks.ForEachMeeting(query, [&](std::int64_t id) {
+      if (std::exchange(seen[static_cast<std::size_t>(id)], 1)) return;
+      const auto [face, bi, bj] = blocks.block(id);
+      const int b = blocks.block_size(face);
+      for (int j = bj * b; j < (bj + 1) * b; ++j) {
+        for (int i = bi * b; i < (bi + 1) * b; ++i) {
+          keep[static_cast<std::size_t>(SculptMapping::FaceOf(mapping.cell(face, i, j)))] = 1;
+        }
+      }
+    });
+  }
+  return SculptPart(inputs.sculpt, keep);
+}
+
+}  // namespace
+
 Status TraceFallback(ExtractInputs& inputs, std::span<const int> faces) {
   if (inputs.tracer) {
     if (inputs.traced.empty()) return Status::Ok();
@@ -120,7 +155,9 @@ Status TraceFallback(ExtractInputs& inputs, std::span<const int> faces) {
   inputs.tracer.reset();
   inputs.traced_part = Mesh{};
   if (inputs.face_keys != nullptr && 2 * count <= n) {
-    inputs.traced_part = SculptWithinReach(inputs, *inputs.face_keys, traced);
+    inputs.traced_part = inputs.mapping->blocks().empty()
+                             ? SculptWithinReach(inputs, *inputs.face_keys, traced)
+                             : SculptNearFaces(inputs, traced);
   }
   if (inputs.traced_part.num_faces() == 0) {
     inputs.traced.clear();

@@ -293,7 +293,13 @@ Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
                         keep[s] = marked[grid.CellOf(Bounds(corners).centre)];
                       }
                     });
-  // The kept faces in their order, their vertices renumbered in ascending order.
+  return SculptPart(sculpt, keep);
+}
+
+Mesh SculptPart(const Mesh& sculpt, std::span<const std::uint8_t> keep) {
+  Mesh part;
+  part.source = sculpt.source;
+  part.face_offsets.push_back(0);
   std::vector<std::int32_t> vertex(sculpt.num_vertices(), -1);
   for (std::size_t s = 0; s < sculpt.num_faces(); ++s) {
     if (!keep[s]) continue;

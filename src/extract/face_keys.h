@@ -44,4 +44,8 @@ FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& set
 Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
                        std::span<const std::uint8_t> faces);
 
+// The sculpt faces flagged in `keep` (one flag per sculpt face), in their order, their vertices
+// renumbered in ascending order.
+Mesh SculptPart(const Mesh& sculpt, std::span<const std::uint8_t> keep);
+
 }  // namespace dispex::extract

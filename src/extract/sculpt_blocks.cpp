@@ -112,6 +112,16 @@ SculptBlocks SculptBlocks::Build(const SculptMapping& mapping, const Mesh& sculp
   return out;
 }
 
+SculptBlocks::Place SculptBlocks::block(std::int64_t id) const {
+  // offsets_ is ascending, one entry per Ptex face plus the end: the face is the last whose
+  // first block is at or before `id` (faces without blocks share their successor's offset).
+  const auto it = std::upper_bound(offsets_.begin(), offsets_.end(), id) - 1;
+  const int face = static_cast<int>(it - offsets_.begin());
+  const std::int64_t k = id - *it;
+  const int per = per_side_[static_cast<std::size_t>(face)];
+  return Place{face, static_cast<int>(k % per), static_cast<int>(k / per)};
+}
+
 int SculptBlocks::Cell(int axis, float v) const {
   const float x = std::floor((v - origin_[axis]) / cell_);
   if (!(x >= 0)) return 0;  // below the grid, or NaN

@@ -39,6 +39,12 @@ class SculptBlocks {
     return offsets_[static_cast<std::size_t>(face)] + std::int64_t{bj} * blocks_per_side(face) + bi;
   }
   const BlockBox& box(std::int64_t id) const { return boxes_[static_cast<std::size_t>(id)]; }
+  std::int64_t num_blocks() const { return static_cast<std::int64_t>(boxes_.size()); }
+  // The Ptex face and block coordinates (bi, bj) of block `id`.
+  struct Place {
+    int face = 0, bi = 0, bj = 0;
+  };
+  Place block(std::int64_t id) const;
   std::size_t bytes() const;
 
   // Calls fn(id) once for each block whose box meets `query`, in an order fixed by the boxes.
