@@ -48,6 +48,68 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   return CancelRequested() ? Cancelled() : Status::Ok();
 }
 
+namespace {
+
+// The quads of every block of cells (the mapping's SculptBlocks) whose box meets one of
+// `boxes`, as a mesh (SculptPart). A quad's box lies in its block's, so this holds every quad
+// whose box meets one of them; it reads only the blocks found, not every sculpt face.
+Mesh SculptInBlocksMeeting(const ExtractInputs& inputs, std::span<const BlockBox> boxes) {
+  const SculptMapping& mapping = *inputs.mapping;
+  const SculptBlocks& blocks = mapping.blocks();
+  std::vector<std::uint8_t> keep(inputs.sculpt.num_faces(), 0);
+  std::vector<std::uint8_t> seen(static_cast<std::size_t>(blocks.num_blocks()), 0);
+  for (const BlockBox& query : boxes) {
+    blocks.ForEachMeeting(query, [&](std::int64_t id) {
+      if (std::exchange(seen[static_cast<std::size_t>(id)], 1)) return;
+      const auto [face, bi, bj] = blocks.block(id);
+      const int b = blocks.block_size(face);
+      for (int j = bj * b; j < (bj + 1) * b; ++j) {
+        for (int i = bi * b; i < (bi + 1) * b; ++i) {
+          keep[static_cast<std::size_t>(SculptMapping::FaceOf(mapping.cell(face, i, j)))] = 1;
+        }
+      }
+    });
+  }
+  return SculptPart(inputs.sculpt, keep);
+}
+
+// The sculpt the normal queries from `origins` along +- `directions`, `distance` long, can
+// reach: each segment's box, grown by 2^-16 of the coordinates' magnitude and of the distance
+// (well beyond the margin Embree's window gets, trace/batch_kernels.h).
+Mesh SculptNearSegments(const ExtractInputs& inputs, std::span<const Float3> origins,
+                        std::span<const Float3> directions, float distance) {
+  std::vector<BlockBox> boxes(origins.size());
+  for (std::size_t k = 0; k < origins.size(); ++k) {
+    const float o[3] = {origins[k].x, origins[k].y, origins[k].z};
+    const float d[3] = {directions[k].x, directions[k].y, directions[k].z};
+    for (int a = 0; a < 3; ++a) {
+      const float reach = std::fabs(d[a]) * distance;
+      const float margin = (std::fabs(o[a]) + distance + inputs.tracer_options.scale) * 0x1p-16f;
+      boxes[k].lower[a] = o[a] - reach - margin;
+      boxes[k].upper[a] = o[a] + reach + margin;
+    }
+  }
+  return SculptInBlocksMeeting(inputs, boxes);
+}
+
+// SculptWithinReach through the blocks: the quads of every block whose box meets the reach
+// box of a flagged face.
+Mesh SculptNearFaces(const ExtractInputs& inputs, std::span<const std::uint8_t> flagged) {
+  std::vector<BlockBox> boxes;
+  for (std::size_t f = 0; f < flagged.size(); ++f) {
+    if (!flagged[f] || inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
+    const Box& reach = inputs.face_keys->reach_boxes[f];
+    BlockBox& box = boxes.emplace_back();
+    for (int a = 0; a < 3; ++a) {
+      box.lower[a] = reach.lower[static_cast<std::size_t>(a)];
+      box.upper[a] = reach.upper[static_cast<std::size_t>(a)];
+    }
+  }
+  return SculptInBlocksMeeting(inputs, boxes);
+}
+
+}  // namespace
+
 StatusOr<SearchDistanceEstimate> EstimateSearchDistanceMapped(const ExtractInputs& inputs,
                                                               const CoarseSampling& coarse,
                                                               double base_diagonal) {
@@ -97,47 +159,37 @@ StatusOr<SearchDistanceEstimate> EstimateSearchDistanceMapped(const ExtractInput
     }
   });
   if (error.failed()) return error.status();
+  // The samples the mapping left undecided (near folds, or where another sheet may be nearer)
+  // go to a BVH of the sculpt their rays can reach, as the ray path answers every sample.
+  std::vector<std::size_t> rest;
+  for (std::size_t k = 0; k < decided.size(); ++k) {
+    if (!decided[k]) rest.push_back(k);
+  }
+  if (!rest.empty()) {
+    std::vector<Float3> origins, directions;
+    for (std::size_t k : rest) {
+      origins.push_back(coarse.points[k]);
+      directions.push_back(coarse.normals[k]);
+    }
+    const Mesh part = SculptNearSegments(inputs, origins, directions, query.distance);
+    DISPEX_ASSIGN_OR_RETURN(
+        std::unique_ptr<Tracer> tracer,
+        MakeEmbreeTracer(part.num_faces() > 0 ? part : inputs.sculpt, inputs.tracer_options));
+    std::vector<float> t(rest.size());
+    std::vector<std::uint8_t> flags(rest.size());
+    TraceCounters counters;
+    tracer->TraceNormals(origins, directions, query, NormalHits{t, {}, flags}, counters);
+    DISPEX_RETURN_IF_ERROR(tracer->status());
+    for (std::size_t r = 0; r < rest.size(); ++r) {
+      if (flags[r] & HitFlags::kHit) abs_t[rest[r]] = std::fabs(double(t[r]));
+    }
+  }
   std::vector<double> hits;
   for (double a : abs_t) {
     if (a >= 0) hits.push_back(a);
   }
-  const auto count = static_cast<std::size_t>(std::count(decided.begin(), decided.end(), 1));
-  return SearchDistanceFromHits(std::move(hits), count, base_diagonal, options);
+  return SearchDistanceFromHits(std::move(hits), abs_t.size(), base_diagonal, options);
 }
-
-namespace {
-
-// SculptWithinReach through the mapping's blocks of cells: the quads of every block whose box
-// meets the reach box of a flagged face. A quad's box lies in its block's, so this holds every
-// quad whose box meets a reach box; it reads only the blocks found, not every sculpt face.
-Mesh SculptNearFaces(const ExtractInputs& inputs, std::span<const std::uint8_t> flagged) {
-  const SculptMapping& mapping = *inputs.mapping;
-  const SculptBlocks& blocks = mapping.blocks();
-  std::vector<std::uint8_t> keep(inputs.sculpt.num_faces(), 0);
-  std::vector<std::uint8_t> seen(static_cast<std::size_t>(blocks.num_blocks()), 0);
-  for (std::size_t f = 0; f < flagged.size(); ++f) {
-    if (!flagged[f] || inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
-    const Box& reach = inputs.face_keys->reach_boxes[f];
-    BlockBox query;
-    for (int a = 0; a < 3; ++a) {
-      query.lower[a] = reach.lower[static_cast<std::size_t>(a)];
-      query.upper[a] = reach.upper[static_cast<std::size_t>(a)];
-    }
-    blocks.ForEachMeeting(query, [&](std::int64_t id) {
-      if (std::exchange(seen[static_cast<std::size_t>(id)], 1)) return;
-      const auto [face, bi, bj] = blocks.block(id);
-      const int b = blocks.block_size(face);
-      for (int j = bj * b; j < (bj + 1) * b; ++j) {
-        for (int i = bi * b; i < (bi + 1) * b; ++i) {
-          keep[static_cast<std::size_t>(SculptMapping::FaceOf(mapping.cell(face, i, j)))] = 1;
-        }
-      }
-    });
-  }
-  return SculptPart(inputs.sculpt, keep);
-}
-
-}  // namespace
 
 Status TraceFallback(ExtractInputs& inputs, std::span<const int> faces) {
   if (inputs.tracer) {

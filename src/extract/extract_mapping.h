@@ -22,9 +22,9 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
 
 // The automatic search distance through the mapping: EstimateSearchDistance's rule (1.5 x the
 // 99.9th percentile of |t| of rays 0.15 x the base diagonal long, nearest policy) over the
-// same coarse samples, each answered through the mapping. Samples it cannot decide are left
-// out (not traced by a BVH); `samples` of the estimate counts the decided ones. Errors as
-// EstimateSearchDistance's.
+// same coarse samples, each answered through the mapping, and those it cannot decide by a BVH
+// of the sculpt their rays can reach (found through the blocks of cells): the ray path's
+// estimate. Errors as EstimateSearchDistance's.
 StatusOr<SearchDistanceEstimate> EstimateSearchDistanceMapped(const ExtractInputs& inputs,
                                                               const CoarseSampling& coarse,
                                                               double base_diagonal);
