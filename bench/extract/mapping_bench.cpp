@@ -3,7 +3,9 @@
 // Ptex face's grid of 2^(L+1) samples per side (2^L on sub-faces) is evaluated, then traced
 // both ways; only the tracing is timed (each thread's CPU clock, summed), and the answers are
 // compared.
-//   mapping_bench BASE SCULPT [--threads N] [--no-rays] [--search-distance D] [--repeat N]
+//   mapping_bench BASE SCULPT [--threads N] [--no-rays] [--no-far-sheets] [--search-distance D]
+//                 [--repeat N]
+// --no-far-sheets: without the far-sheet check (no blocks built), to measure what it costs.
 // --repeat N: the loop N times, the least CPU time of each kernel kept.
 #include <fmt/format.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -47,18 +49,19 @@ struct Totals {
 int main(int argc, char** argv) {
   if (argc < 3) {
     fmt::print(stderr,
-               "usage: mapping_bench BASE SCULPT [--threads N] [--no-rays] "
-               "[--search-distance D]\n");
+               "usage: mapping_bench BASE SCULPT [--threads N] [--no-rays] [--no-far-sheets] "
+               "[--search-distance D] [--repeat N]\n");
     return 2;
   }
   int threads = 0, repeat = 1;
-  bool rays = true;
+  bool rays = true, far_sheets = true;
   double distance = 0;
   for (int i = 3; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--threads" && i + 1 < argc) threads = std::atoi(argv[++i]);
     if (a == "--search-distance" && i + 1 < argc) distance = std::atof(argv[++i]);
     if (a == "--no-rays") rays = false;
+    if (a == "--no-far-sheets") far_sheets = false;
     if (a == "--repeat" && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
   }
   std::optional<tbb::global_control> limit;
@@ -84,7 +87,7 @@ int main(int argc, char** argv) {
   }
   const double t_folds = clock.seconds();
   clock.Reset();
-  mapping.BuildBlocks(sculpt);
+  if (far_sheets) mapping.BuildBlocks(sculpt);
   const double t_blocks = clock.seconds();
   const int levels = correspondence.levels;
   correspondence = SculptCorrespondence{};

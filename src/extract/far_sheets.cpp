@@ -1,6 +1,7 @@
 #include "extract/far_sheets.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace dispex::extract {
@@ -83,14 +84,21 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, int face, int n,
   auto index = [&](std::size_t s) {
     return samples.empty() ? s : static_cast<std::size_t>(samples[s]);
   };
-  auto cell_of = [&](int i) {
-    return static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));
-  };
+  // The block of cells under each column (row) of samples, and the block of sample k (on a
+  // texel grid, n a power of two, k's row and column are a shift and a mask).
+  w.sample_block_of.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const auto cell = static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));
+    w.sample_block_of[static_cast<std::size_t>(i)] = cell / b;
+  }
+  const auto un = static_cast<std::size_t>(n);
+  const bool power_of_two = std::has_single_bit(un);
+  const int shift = std::countr_zero(un);
   auto block_of = [&](std::size_t k) {
-    const int i = static_cast<int>(k % static_cast<std::size_t>(n));
-    const int j = static_cast<int>(k / static_cast<std::size_t>(n));
-    return static_cast<std::size_t>(cell_of(j) / b) * static_cast<std::size_t>(per) +
-           static_cast<std::size_t>(cell_of(i) / b);
+    const std::size_t i = power_of_two ? k & (un - 1) : k % un;
+    const std::size_t j = power_of_two ? k >> shift : k / un;
+    return static_cast<std::size_t>(w.sample_block_of[j]) * static_cast<std::size_t>(per) +
+           static_cast<std::size_t>(w.sample_block_of[i]);
   };
   // Per block of samples, the box of their windows.
   const auto num_blocks = static_cast<std::size_t>(per) * static_cast<std::size_t>(per);
@@ -112,20 +120,31 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, int face, int n,
   const int width = per + 2;
   w.candidate_starts.assign(1, 0);
   w.candidate_ids.clear();
+  // The near blocks of a block of samples are stamped in near_stamp (one entry per sculpt
+  // block, kept by the thread), so each block met is looked up once.
+  if (w.near_stamp.size() != static_cast<std::size_t>(blocks.num_blocks())) {
+    w.near_stamp.assign(static_cast<std::size_t>(blocks.num_blocks()), 0);
+    w.stamp = 0;
+  }
   for (int bj = 0; bj < per; ++bj) {
     for (int bi = 0; bi < per; ++bi) {
       const std::size_t at = static_cast<std::size_t>(bj) * per + bi;
       if (w.sample_box_used[at]) {
-        blocks.ForEachMeeting(w.sample_boxes[at], [&](std::int64_t id) {
-          for (int dj = 0; dj <= 2; ++dj) {
-            for (int di = 0; di <= 2; ++di) {
-              const auto slot = static_cast<std::size_t>((bj + dj) * width + bi + di);
-              const auto begin = w.near_ids.begin() + w.near_starts[slot];
-              const auto end = w.near_ids.begin() + w.near_starts[slot + 1];
-              if (std::find(begin, end, id) != end) return;
+        if (++w.stamp == 0) {
+          std::fill(w.near_stamp.begin(), w.near_stamp.end(), 0);
+          w.stamp = 1;
+        }
+        for (int dj = 0; dj <= 2; ++dj) {
+          for (int di = 0; di <= 2; ++di) {
+            const auto slot = static_cast<std::size_t>((bj + dj) * width + bi + di);
+            for (std::int32_t k = w.near_starts[slot]; k < w.near_starts[slot + 1]; ++k) {
+              w.near_stamp[static_cast<std::size_t>(w.near_ids[static_cast<std::size_t>(k)])] =
+                  w.stamp;
             }
           }
-          w.candidate_ids.push_back(id);
+        }
+        blocks.ForEachMeeting(w.sample_boxes[at], [&](std::int64_t id) {
+          if (w.near_stamp[static_cast<std::size_t>(id)] != w.stamp) w.candidate_ids.push_back(id);
         });
       }
       w.candidate_starts.push_back(static_cast<std::int32_t>(w.candidate_ids.size()));

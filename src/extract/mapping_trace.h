@@ -166,6 +166,9 @@ struct MappingScratch {
   std::vector<std::uint8_t> sample_box_used;
   std::vector<std::int32_t> candidate_starts;
   std::vector<std::int64_t> candidate_ids;
+  std::vector<std::int32_t> sample_block_of;  // per sample column (row): its block of cells
+  std::vector<std::uint32_t> near_stamp;  // per sculpt block: the stamp of the last block near it
+  std::uint32_t stamp = 0;
 };
 
 // Lays out scratch.near_* for `face` (after LayOut's corners): each block slot's sculpt
