@@ -38,6 +38,7 @@
 #include <utility>
 
 #include "core/check.h"
+#include "core/default_init_allocator.h"
 #include "core/first_error.h"
 #include "core/system.h"
 #include "core/vec3.h"
@@ -342,15 +343,26 @@ class Matcher {
     return error.failed() ? error.status() : Status::Ok();
   }
 
-  // Sculpt vertices bucketed by VertexClass, for the seed candidates.
+  // Sculpt vertices counted by VertexClass, for the seed's class, and bucketed by it for the
+  // candidates when there are several components (one needs a single scan of the vertices).
   void IndexSculptVertexClasses() {
     const int num_classes = VertexClass(kMaxClassValence, true) + 1;
-    class_offsets_.assign(num_classes + 1, 0);
     const std::size_t num_vertices = sculpt_.num_vertices();
-    for (std::size_t x = 0; x < num_vertices; ++x) {
-      ++class_offsets_[SculptClass(x) + 1];
-    }
+    tbb::combinable<std::vector<std::uint32_t>> counts(
+        [num_classes] { return std::vector<std::uint32_t>(num_classes + 1, 0); });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, num_vertices, 1 << 14),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        std::vector<std::uint32_t>& mine = counts.local();
+                        for (std::size_t x = r.begin(); x < r.end(); ++x) {
+                          ++mine[SculptClass(x) + 1];
+                        }
+                      });
+    class_offsets_.assign(num_classes + 1, 0);
+    counts.combine_each([&](const std::vector<std::uint32_t>& mine) {
+      for (int c = 0; c <= num_classes; ++c) class_offsets_[c] += mine[c];
+    });
     for (int c = 0; c < num_classes; ++c) class_offsets_[c + 1] += class_offsets_[c];
+    if (components_.size() == 1) return;
     std::vector<std::uint32_t> next(class_offsets_.begin(), class_offsets_.end() - 1);
     class_vertices_.resize(num_vertices);
     for (std::size_t x = 0; x < num_vertices; ++x) {
@@ -565,12 +577,17 @@ class Matcher {
       if (list.size() > kCandidates) list.resize(kCandidates);
     };
     tbb::combinable<Found> found;
-    const std::uint32_t* begin = class_vertices_.data() + class_offsets_[vertex_class];
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ClassSize(vertex_class), 4096),
+    // The class's vertices: from its bucket, or (one component) all vertices of the class.
+    const bool bucketed = !class_vertices_.empty();
+    const std::uint32_t* begin =
+        bucketed ? class_vertices_.data() + class_offsets_[vertex_class] : nullptr;
+    const std::size_t count = bucketed ? ClassSize(vertex_class) : sculpt_.num_vertices();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 4096),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         Found& mine = found.local();
                         for (std::size_t k = r.begin(); k < r.end(); ++k) {
-                          const std::uint32_t x = begin[k];
+                          const auto x = bucketed ? begin[k] : static_cast<std::uint32_t>(k);
+                          if (!bucketed && SculptClass(x) != vertex_class) continue;
                           const std::uint32_t component =
                               sculpt_component_[adjacency_.first_half_edge[x] / 4];
                           if (sculpt_component_matched_[component] ||
@@ -680,7 +697,7 @@ class Matcher {
       cell_offsets_[p + 1] = cell_offsets_[p] + n * n;
     }
     DISPEX_CHECK_EQ(static_cast<std::size_t>(cell_offsets_.back()), sculpt_.num_faces());
-    cells_.assign(sculpt_.num_faces(), kNoLabel);
+    cells_.resize(sculpt_.num_faces());
     out_.grid_vertices.assign(out_.grid_offsets.back(), VertexId());
     FirstError error;
     tbb::parallel_for(tbb::blocked_range<int>(0, num_ptex), [&](const tbb::blocked_range<int>& r) {
@@ -1013,8 +1030,8 @@ class Matcher {
     int edge = 0;
   } stuck_;
 
-  std::vector<std::int64_t> cell_offsets_;  // per Ptex face, into cells_
-  std::vector<Label> cells_;
+  std::vector<std::int64_t> cell_offsets_;                 // per Ptex face, into cells_
+  std::vector<Label, DefaultInitAllocator<Label>> cells_;  // fully written when FillGrids succeeds
 
   SculptCorrespondence out_;
 };
