@@ -38,7 +38,6 @@
 #include <utility>
 
 #include "core/check.h"
-#include "core/default_init_allocator.h"
 #include "core/first_error.h"
 #include "core/system.h"
 #include "core/vec3.h"
@@ -697,7 +696,7 @@ class Matcher {
       cell_offsets_[p + 1] = cell_offsets_[p] + n * n;
     }
     DISPEX_CHECK_EQ(static_cast<std::size_t>(cell_offsets_.back()), sculpt_.num_faces());
-    cells_.resize(sculpt_.num_faces());
+    cells_.resize(sculpt_.num_faces());  // every cell is written when FillGrids succeeds
     out_.grid_vertices.assign(out_.grid_offsets.back(), VertexId());
     FirstError error;
     tbb::parallel_for(tbb::blocked_range<int>(0, num_ptex), [&](const tbb::blocked_range<int>& r) {
@@ -767,13 +766,19 @@ class Matcher {
     return {p, static_cast<int>(local % n), static_cast<int>(local / n)};
   }
 
-  // Each quad claims its face_ptex slot; a quad claimed twice fails, named by a slower pass
-  // that finds the lowest cell holding a quad an earlier cell holds too.
+  // Each quad claims its slot (its face_ptex entry, or its bit when there are no per-face
+  // tables); a quad claimed twice fails, named by a slower pass that finds the lowest cell
+  // holding a quad an earlier cell holds too. The cells then become cell_labels.
   Status CheckFaces() {
     const std::size_t num_faces = sculpt_.num_faces();
-    out_.face_ptex.assign(num_faces, PtexFaceId());
-    out_.face_cell.assign(num_faces, -1);
-    out_.face_rotation.assign(num_faces, 0);
+    std::vector<std::uint64_t> claimed;
+    if (options_.face_tables) {
+      out_.face_ptex.assign(num_faces, PtexFaceId());
+      out_.face_cell.assign(num_faces, -1);
+      out_.face_rotation.assign(num_faces, 0);
+    } else {
+      claimed.resize((num_faces + 63) / 64);
+    }
     std::atomic<bool> twice{false};
     tbb::parallel_for(
         tbb::blocked_range<int>(0, cage_.num_ptex_faces()), [&](const tbb::blocked_range<int>& r) {
@@ -781,6 +786,15 @@ class Matcher {
             const std::int64_t begin = cell_offsets_[p], end = cell_offsets_[p + 1];
             for (std::int64_t c = begin; c < end; ++c) {
               const std::uint32_t face = cells_[c] / 4;
+              if (!options_.face_tables) {
+                const std::uint64_t bit = std::uint64_t{1} << (face % 64);
+                if (std::atomic_ref<std::uint64_t>(claimed[face / 64])
+                        .fetch_or(bit, std::memory_order_relaxed) &
+                    bit) {
+                  twice.store(true, std::memory_order_relaxed);
+                }
+                continue;
+              }
               std::int32_t unclaimed = -1;
               if (!std::atomic_ref<std::int32_t>(out_.face_ptex[face].value)
                        .compare_exchange_strong(unclaimed, p, std::memory_order_relaxed)) {
@@ -793,6 +807,7 @@ class Matcher {
           }
         });
     if (twice.load()) return FaceInTwoCells();
+    out_.cell_labels = std::move(cells_);
     cells_ = {};
     return Status::Ok();
   }
@@ -1030,8 +1045,8 @@ class Matcher {
     int edge = 0;
   } stuck_;
 
-  std::vector<std::int64_t> cell_offsets_;                 // per Ptex face, into cells_
-  std::vector<Label, DefaultInitAllocator<Label>> cells_;  // fully written when FillGrids succeeds
+  std::vector<std::int64_t> cell_offsets_;  // per Ptex face, into cells_
+  std::vector<Label> cells_;
 
   SculptCorrespondence out_;
 };
