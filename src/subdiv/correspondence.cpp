@@ -832,7 +832,7 @@ class Matcher {
   }
 
   VertexId GridVertex(int p, GridPoint at) const {
-    const int n = cage_.grid_size(p);
+    const int n = out_.grid_sizes[p];
     return out_
         .grid_vertices[out_.grid_offsets[p] + static_cast<std::int64_t>(at.j) * (n + 1) + at.i];
   }

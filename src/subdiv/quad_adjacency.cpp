@@ -124,10 +124,12 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
     std::uint32_t& bad = lowest_bad.local();
     std::vector<std::int32_t> ends, ins;  // b_k, c_k
     for (std::size_t a = r.begin(); a < r.end(); ++a) {
-      // The quads of a vertex some way ahead, fetched while this one waits for its own.
+      // The quads (and opposite slots) of a vertex some way ahead, fetched while this one
+      // waits for its own.
       if (a + kAhead < r.end()) {
         for (std::uint32_t k = first[a + kAhead]; k < first[a + kAhead + 1]; ++k) {
           __builtin_prefetch(start + (bucket[k] & ~3u));
+          __builtin_prefetch(&out.opposite[bucket[k]], 1);
         }
       }
       const std::uint32_t* around = &bucket[first[a]];
