@@ -900,14 +900,17 @@ class Matcher {
     constexpr std::int32_t kNone = std::numeric_limits<std::int32_t>::max();
     out_.vertex_faces.assign(num_vertices, PtexFaceId(kNone));
     out_.vertex_uvs.resize(2 * num_vertices);
-    const auto each_grid_point = [&](auto&& visit) {
+    // Row by row; with `borders_only`, the points on the grid's border only.
+    const auto each_grid_point = [&](bool borders_only, auto&& visit) {
       tbb::parallel_for(tbb::blocked_range<int>(0, cage_.num_ptex_faces()),
                         [&](const tbb::blocked_range<int>& r) {
                           for (int p = r.begin(); p < r.end(); ++p) {
-                            const int n = cage_.grid_size(p);
+                            const int n = out_.grid_sizes[p];
                             for (int j = 0; j <= n && n > 0; ++j) {
-                              for (int i = 0; i <= n; ++i) {
-                                const bool border = i == 0 || j == 0 || i == n || j == n;
+                              const bool border_row = j == 0 || j == n;
+                              const int step = borders_only && !border_row ? n : 1;
+                              for (int i = 0; i <= n; i += step) {
+                                const bool border = border_row || i == 0 || i == n;
                                 visit(p, n, i, j, border, GridVertex(p, {i, j}).value);
                               }
                             }
@@ -918,7 +921,7 @@ class Matcher {
       out_.vertex_uvs[2 * static_cast<std::size_t>(v)] = static_cast<float>(i) / n;
       out_.vertex_uvs[2 * static_cast<std::size_t>(v) + 1] = static_cast<float>(j) / n;
     };
-    each_grid_point([&](int p, int n, int i, int j, bool border, std::int32_t v) {
+    each_grid_point(false, [&](int p, int n, int i, int j, bool border, std::int32_t v) {
       std::atomic_ref<std::int32_t> home(out_.vertex_faces[v].value);
       if (!border) {
         home.store(p, std::memory_order_relaxed);
@@ -929,7 +932,7 @@ class Matcher {
       while (p < current && !home.compare_exchange_weak(current, p, std::memory_order_relaxed)) {
       }
     });
-    each_grid_point([&](int p, int n, int i, int j, bool border, std::int32_t v) {
+    each_grid_point(true, [&](int p, int n, int i, int j, bool border, std::int32_t v) {
       if (border && out_.vertex_faces[v].value == p) set_uv(n, i, j, v);
     });
     for (std::size_t v = 0; v < num_vertices; ++v) {

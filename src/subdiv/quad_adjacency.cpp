@@ -124,12 +124,10 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
     std::uint32_t& bad = lowest_bad.local();
     std::vector<std::int32_t> ends, ins;  // b_k, c_k
     for (std::size_t a = r.begin(); a < r.end(); ++a) {
-      // The quads (and opposite slots) of a vertex some way ahead, fetched while this one
-      // waits for its own.
+      // The quads of a vertex some way ahead, fetched while this one waits for its own.
       if (a + kAhead < r.end()) {
         for (std::uint32_t k = first[a + kAhead]; k < first[a + kAhead + 1]; ++k) {
           __builtin_prefetch(start + (bucket[k] & ~3u));
-          __builtin_prefetch(&out.opposite[bucket[k]], 1);
         }
       }
       const std::uint32_t* around = &bucket[first[a]];
@@ -218,6 +216,12 @@ std::vector<std::uint32_t> QuadComponents(const QuadAdjacency& adjacency,
   });
   tbb::parallel_for(Range(0, num_faces, 1 << 12), [&](const Range& r) {
     for (std::size_t f = r.begin(); f < r.end(); ++f) {
+      if (f + kAhead < r.end()) {  // the neighbours' parents some way ahead
+        for (int k = 0; k < 4; ++k) {
+          const std::uint32_t g = adjacency.opposite[4 * (f + kAhead) + k];
+          if (g != kNoHalfEdge) __builtin_prefetch(&parent[g / 4]);
+        }
+      }
       for (int k = 0; k < 4; ++k) {
         const std::uint32_t g = adjacency.opposite[4 * f + k];
         if (g == kNoHalfEdge || g / 4 < f) continue;
