@@ -33,6 +33,9 @@ struct MatchOptions {
   // surface rejects the match (object units; 0: 15% of the base's bounding-box diagonal).
   double max_offset = 0;
   int threads = 0;  // 0: TBB's default; the result does not depend on it
+  // Fill SculptCorrespondence::face_ptex, face_cell and face_rotation (cell_labels holds the
+  // same facts by cell; without the tables the match needs 9 bytes per sculpt face less).
+  bool face_tables = true;
 };
 
 struct SculptCorrespondence {
@@ -53,9 +56,14 @@ struct SculptCorrespondence {
   // Per sculpt face: its Ptex face, its cell (i, j) there as face_cell = i + j * n, and which
   // of its corners sits at the cell's (i, j) corner: the cell's corners (i,j), (i+1,j),
   // (i+1,j+1), (i,j+1) are the face's corners r, r+1, r+2, r+3 (mod 4), r = face_rotation.
+  // Empty unless MatchOptions::face_tables.
   std::vector<PtexFaceId> face_ptex;
   std::vector<std::int32_t> face_cell;
   std::vector<std::uint8_t> face_rotation;
+  // The same by cell, the Ptex faces in order and each grid's cells row by row (cell (i, j) of
+  // Ptex face f at the sum of grid_sizes[g]^2 over g < f, plus i + j * n): 4 x the sculpt
+  // face there + its face_rotation.
+  std::vector<std::uint32_t> cell_labels;
 
   std::size_t components = 0;  // connected components matched (edge-connected)
 
@@ -100,8 +108,8 @@ Float3 SculptPointAt(const SculptCorrespondence& correspondence, const Mesh& scu
 // the result.
 //
 // Runs in a TBB arena of options.threads; the result is the same for any thread count. Memory
-// besides the sculpt: about 60 bytes per sculpt face at the peak (its half-edge adjacency),
-// of which the result keeps about 26.
+// besides the sculpt: about 40 bytes per sculpt face at the peak (its half-edge adjacency),
+// of which the result keeps about 29 (20 without the face tables).
 StatusOr<SculptCorrespondence> MatchRefinedSculpt(const LimitSurface& surface, const Mesh& sculpt,
                                                   const MatchOptions& options = {});
 

@@ -25,6 +25,7 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   Stopwatch clock;
   MatchOptions match;
   match.threads = report.threads;
+  match.face_tables = false;  // the mapping reads the cells
   StatusOr<SculptCorrespondence> correspondence =
       MatchRefinedSculpt(inputs.surface, inputs.sculpt, match);
   if (!correspondence.ok()) {
@@ -38,8 +39,8 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   report.mapping_levels = correspondence->levels;
   report.mapping_max_offset = correspondence->max_offset;
   report.mapping_rms_offset = correspondence->rms_offset;
-  DISPEX_ASSIGN_OR_RETURN(SculptMapping mapping,
-                          SculptMapping::Build(*correspondence, inputs.sculpt, inputs.faces));
+  DISPEX_ASSIGN_OR_RETURN(SculptMapping mapping, SculptMapping::Build(std::move(*correspondence),
+                                                                      inputs.sculpt, inputs.faces));
   DISPEX_RETURN_IF_ERROR(mapping.MarkFolds(inputs.surface, inputs.sculpt, inputs.faces));
   mapping.BuildBlocks(inputs.sculpt);
   inputs.mapping = std::make_unique<SculptMapping>(std::move(mapping));

@@ -161,6 +161,16 @@ Crossing EdgeCrossing(std::span<const PtexFaceInfo> faces, std::span<const std::
 StatusOr<SculptMapping> SculptMapping::Build(const SculptCorrespondence& correspondence,
                                              const Mesh& sculpt,
                                              std::span<const PtexFaceInfo> faces) {
+  SculptCorrespondence needed;
+  needed.levels = correspondence.levels;
+  needed.grid_sizes = correspondence.grid_sizes;
+  needed.cell_labels = correspondence.cell_labels;
+  return Build(std::move(needed), sculpt, faces);
+}
+
+StatusOr<SculptMapping> SculptMapping::Build(SculptCorrespondence&& correspondence,
+                                             const Mesh& sculpt,
+                                             std::span<const PtexFaceInfo> faces) {
   const std::size_t num_faces = sculpt.num_faces();
   if (sculpt.face_indices.size() != 4 * num_faces) {
     return Status::Error(fmt::format("{}: the mapping needs a sculpt of quads", sculpt.source));
@@ -170,13 +180,13 @@ StatusOr<SculptMapping> SculptMapping::Build(const SculptCorrespondence& corresp
         fmt::format("{}: {} faces, more than the mapping's 2^30", sculpt.source, num_faces));
   }
   const std::size_t num_ptex = correspondence.grid_sizes.size();
-  if (faces.size() != num_ptex || correspondence.face_ptex.size() != num_faces) {
+  if (faces.size() != num_ptex || correspondence.cell_labels.size() != num_faces) {
     return Status::Error(
         fmt::format("{}: the correspondence does not fit the sculpt", sculpt.source));
   }
   SculptMapping out;
   out.levels_ = correspondence.levels;
-  out.grid_sizes_ = correspondence.grid_sizes;
+  out.grid_sizes_ = std::move(correspondence.grid_sizes);
   out.cell_offsets_.resize(num_ptex + 1, 0);
   for (std::size_t f = 0; f < num_ptex; ++f) {
     const std::int64_t m = out.grid_sizes_[f];
@@ -186,15 +196,13 @@ StatusOr<SculptMapping> SculptMapping::Build(const SculptCorrespondence& corresp
     return Status::Error(fmt::format("{}: the correspondence's grids hold {} cells for {} faces",
                                      sculpt.source, out.cell_offsets_.back(), num_faces));
   }
-  out.cells_.resize(num_faces);
+  // The labels (4 x face + rotation) become face | rotation << 30, in place.
+  out.cells_ = std::move(correspondence.cell_labels);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, num_faces, 1 << 16),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t s = range.begin(); s != range.end(); ++s) {
-                        const auto f = static_cast<std::size_t>(correspondence.face_ptex[s].value);
-                        const auto slot = static_cast<std::size_t>(out.cell_offsets_[f] +
-                                                                   correspondence.face_cell[s]);
-                        out.cells_[slot] = static_cast<std::uint32_t>(s) |
-                                           (std::uint32_t{correspondence.face_rotation[s]} << 30);
+                      for (std::size_t c = range.begin(); c != range.end(); ++c) {
+                        const std::uint32_t label = out.cells_[c];
+                        out.cells_[c] = label >> 2 | (label & 3u) << 30;
                       }
                     });
   out.crossings_.resize(4 * num_ptex);

@@ -67,12 +67,15 @@ class SculptMapping {
   // faces or more, or does not fit the correspondence (one line naming it).
   static StatusOr<SculptMapping> Build(const SculptCorrespondence& correspondence,
                                        const Mesh& sculpt, std::span<const PtexFaceInfo> faces);
+  // The same, taking over the correspondence's grid sizes and cell labels (no copy of them).
+  static StatusOr<SculptMapping> Build(SculptCorrespondence&& correspondence, const Mesh& sculpt,
+                                       std::span<const PtexFaceInfo> faces);
 
   int levels() const { return levels_; }
   int num_ptex_faces() const { return static_cast<int>(grid_sizes_.size()); }
   int grid_size(int face) const { return grid_sizes_[static_cast<std::size_t>(face)]; }
   // The sculpt face of cell (i, j) of Ptex face `face` and which of its corners sits at the
-  // cell's (i, j) corner (SculptCorrespondence::face_rotation).
+  // cell's (i, j) corner (SculptCorrespondence::face_rotation, cell_labels).
   std::uint32_t cell(int face, int i, int j) const {
     return cells_[static_cast<std::size_t>(cell_offsets_[static_cast<std::size_t>(face)] +
                                            std::int64_t{j} * grid_size(face) + i)];

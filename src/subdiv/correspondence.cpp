@@ -342,15 +342,26 @@ class Matcher {
     return error.failed() ? error.status() : Status::Ok();
   }
 
-  // Sculpt vertices bucketed by VertexClass, for the seed candidates.
+  // Sculpt vertices counted by VertexClass, for the seed's class, and bucketed by it for the
+  // candidates when there are several components (one needs a single scan of the vertices).
   void IndexSculptVertexClasses() {
     const int num_classes = VertexClass(kMaxClassValence, true) + 1;
-    class_offsets_.assign(num_classes + 1, 0);
     const std::size_t num_vertices = sculpt_.num_vertices();
-    for (std::size_t x = 0; x < num_vertices; ++x) {
-      ++class_offsets_[SculptClass(x) + 1];
-    }
+    tbb::combinable<std::vector<std::uint32_t>> counts(
+        [num_classes] { return std::vector<std::uint32_t>(num_classes + 1, 0); });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, num_vertices, 1 << 14),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        std::vector<std::uint32_t>& mine = counts.local();
+                        for (std::size_t x = r.begin(); x < r.end(); ++x) {
+                          ++mine[SculptClass(x) + 1];
+                        }
+                      });
+    class_offsets_.assign(num_classes + 1, 0);
+    counts.combine_each([&](const std::vector<std::uint32_t>& mine) {
+      for (int c = 0; c <= num_classes; ++c) class_offsets_[c] += mine[c];
+    });
     for (int c = 0; c < num_classes; ++c) class_offsets_[c + 1] += class_offsets_[c];
+    if (components_.size() == 1) return;
     std::vector<std::uint32_t> next(class_offsets_.begin(), class_offsets_.end() - 1);
     class_vertices_.resize(num_vertices);
     for (std::size_t x = 0; x < num_vertices; ++x) {
@@ -565,12 +576,17 @@ class Matcher {
       if (list.size() > kCandidates) list.resize(kCandidates);
     };
     tbb::combinable<Found> found;
-    const std::uint32_t* begin = class_vertices_.data() + class_offsets_[vertex_class];
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ClassSize(vertex_class), 4096),
+    // The class's vertices: from its bucket, or (one component) all vertices of the class.
+    const bool bucketed = !class_vertices_.empty();
+    const std::uint32_t* begin =
+        bucketed ? class_vertices_.data() + class_offsets_[vertex_class] : nullptr;
+    const std::size_t count = bucketed ? ClassSize(vertex_class) : sculpt_.num_vertices();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 4096),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         Found& mine = found.local();
                         for (std::size_t k = r.begin(); k < r.end(); ++k) {
-                          const std::uint32_t x = begin[k];
+                          const auto x = bucketed ? begin[k] : static_cast<std::uint32_t>(k);
+                          if (!bucketed && SculptClass(x) != vertex_class) continue;
                           const std::uint32_t component =
                               sculpt_component_[adjacency_.first_half_edge[x] / 4];
                           if (sculpt_component_matched_[component] ||
@@ -680,7 +696,7 @@ class Matcher {
       cell_offsets_[p + 1] = cell_offsets_[p] + n * n;
     }
     DISPEX_CHECK_EQ(static_cast<std::size_t>(cell_offsets_.back()), sculpt_.num_faces());
-    cells_.assign(sculpt_.num_faces(), kNoLabel);
+    cells_.resize(sculpt_.num_faces());  // every cell is written when FillGrids succeeds
     out_.grid_vertices.assign(out_.grid_offsets.back(), VertexId());
     FirstError error;
     tbb::parallel_for(tbb::blocked_range<int>(0, num_ptex), [&](const tbb::blocked_range<int>& r) {
@@ -750,13 +766,19 @@ class Matcher {
     return {p, static_cast<int>(local % n), static_cast<int>(local / n)};
   }
 
-  // Each quad claims its face_ptex slot; a quad claimed twice fails, named by a slower pass
-  // that finds the lowest cell holding a quad an earlier cell holds too.
+  // Each quad claims its slot (its face_ptex entry, or its bit when there are no per-face
+  // tables); a quad claimed twice fails, named by a slower pass that finds the lowest cell
+  // holding a quad an earlier cell holds too. The cells then become cell_labels.
   Status CheckFaces() {
     const std::size_t num_faces = sculpt_.num_faces();
-    out_.face_ptex.assign(num_faces, PtexFaceId());
-    out_.face_cell.assign(num_faces, -1);
-    out_.face_rotation.assign(num_faces, 0);
+    std::vector<std::uint64_t> claimed;
+    if (options_.face_tables) {
+      out_.face_ptex.assign(num_faces, PtexFaceId());
+      out_.face_cell.assign(num_faces, -1);
+      out_.face_rotation.assign(num_faces, 0);
+    } else {
+      claimed.resize((num_faces + 63) / 64);
+    }
     std::atomic<bool> twice{false};
     tbb::parallel_for(
         tbb::blocked_range<int>(0, cage_.num_ptex_faces()), [&](const tbb::blocked_range<int>& r) {
@@ -764,6 +786,15 @@ class Matcher {
             const std::int64_t begin = cell_offsets_[p], end = cell_offsets_[p + 1];
             for (std::int64_t c = begin; c < end; ++c) {
               const std::uint32_t face = cells_[c] / 4;
+              if (!options_.face_tables) {
+                const std::uint64_t bit = std::uint64_t{1} << (face % 64);
+                if (std::atomic_ref<std::uint64_t>(claimed[face / 64])
+                        .fetch_or(bit, std::memory_order_relaxed) &
+                    bit) {
+                  twice.store(true, std::memory_order_relaxed);
+                }
+                continue;
+              }
               std::int32_t unclaimed = -1;
               if (!std::atomic_ref<std::int32_t>(out_.face_ptex[face].value)
                        .compare_exchange_strong(unclaimed, p, std::memory_order_relaxed)) {
@@ -776,6 +807,7 @@ class Matcher {
           }
         });
     if (twice.load()) return FaceInTwoCells();
+    out_.cell_labels = std::move(cells_);
     cells_ = {};
     return Status::Ok();
   }
@@ -800,7 +832,7 @@ class Matcher {
   }
 
   VertexId GridVertex(int p, GridPoint at) const {
-    const int n = cage_.grid_size(p);
+    const int n = out_.grid_sizes[p];
     return out_
         .grid_vertices[out_.grid_offsets[p] + static_cast<std::int64_t>(at.j) * (n + 1) + at.i];
   }
@@ -868,14 +900,17 @@ class Matcher {
     constexpr std::int32_t kNone = std::numeric_limits<std::int32_t>::max();
     out_.vertex_faces.assign(num_vertices, PtexFaceId(kNone));
     out_.vertex_uvs.resize(2 * num_vertices);
-    const auto each_grid_point = [&](auto&& visit) {
+    // Row by row; with `borders_only`, the points on the grid's border only.
+    const auto each_grid_point = [&](bool borders_only, auto&& visit) {
       tbb::parallel_for(tbb::blocked_range<int>(0, cage_.num_ptex_faces()),
                         [&](const tbb::blocked_range<int>& r) {
                           for (int p = r.begin(); p < r.end(); ++p) {
-                            const int n = cage_.grid_size(p);
+                            const int n = out_.grid_sizes[p];
                             for (int j = 0; j <= n && n > 0; ++j) {
-                              for (int i = 0; i <= n; ++i) {
-                                const bool border = i == 0 || j == 0 || i == n || j == n;
+                              const bool border_row = j == 0 || j == n;
+                              const int step = borders_only && !border_row ? n : 1;
+                              for (int i = 0; i <= n; i += step) {
+                                const bool border = border_row || i == 0 || i == n;
                                 visit(p, n, i, j, border, GridVertex(p, {i, j}).value);
                               }
                             }
@@ -886,7 +921,7 @@ class Matcher {
       out_.vertex_uvs[2 * static_cast<std::size_t>(v)] = static_cast<float>(i) / n;
       out_.vertex_uvs[2 * static_cast<std::size_t>(v) + 1] = static_cast<float>(j) / n;
     };
-    each_grid_point([&](int p, int n, int i, int j, bool border, std::int32_t v) {
+    each_grid_point(false, [&](int p, int n, int i, int j, bool border, std::int32_t v) {
       std::atomic_ref<std::int32_t> home(out_.vertex_faces[v].value);
       if (!border) {
         home.store(p, std::memory_order_relaxed);
@@ -897,7 +932,7 @@ class Matcher {
       while (p < current && !home.compare_exchange_weak(current, p, std::memory_order_relaxed)) {
       }
     });
-    each_grid_point([&](int p, int n, int i, int j, bool border, std::int32_t v) {
+    each_grid_point(true, [&](int p, int n, int i, int j, bool border, std::int32_t v) {
       if (border && out_.vertex_faces[v].value == p) set_uv(n, i, j, v);
     });
     for (std::size_t v = 0; v < num_vertices; ++v) {

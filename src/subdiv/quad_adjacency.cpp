@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <memory>
 
 #include "core/check.h"
 
@@ -15,6 +16,9 @@ namespace dispex::subdiv {
 namespace {
 
 using Range = tbb::blocked_range<std::size_t>;
+
+// How far ahead the scattered reads are prefetched (vertices, half-edges).
+constexpr std::size_t kAhead = 16;
 
 std::uint32_t Load(std::uint32_t& slot) {
   return std::atomic_ref<std::uint32_t>(slot).load(std::memory_order_relaxed);
@@ -66,74 +70,97 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
   // owns, so that the scattered updates need no atomics (which would serialise the cache
   // misses of a sculpt numbered at random). Counted, summed into bucket ends, then filled
   // from the last half-edge down so that the ends become the starts.
-  const auto for_each_owned = [&](bool downwards, auto&& visit) {
+  std::vector<std::uint32_t> first(num_vertices + 1, 0);
+  const auto for_each_owned = [&](bool downwards, std::uint32_t* dest, auto&& visit) {
     const std::size_t parts = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
     tbb::parallel_for(std::size_t{0}, parts, [&](std::size_t part) {
       const auto lo = static_cast<std::uint32_t>(num_vertices * part / parts);
       const auto hi = static_cast<std::uint32_t>(num_vertices * (part + 1) / parts);
       for (std::size_t k = 0; k < num_half_edges; ++k) {
         const std::size_t h = downwards ? num_half_edges - 1 - k : k;
+        // The scattered slots of half-edges ahead, fetched early: first[] far ahead, then
+        // (filling) the bucket slot it names nearer.
+        if (k + 4 * kAhead < num_half_edges) {
+          const auto w = static_cast<std::uint32_t>(
+              start[downwards ? num_half_edges - 1 - k - 4 * kAhead : k + 4 * kAhead]);
+          if (w - lo < hi - lo) __builtin_prefetch(&first[w], 1);
+        }
+        if (dest != nullptr && k + 2 * kAhead < num_half_edges) {
+          const auto w = static_cast<std::uint32_t>(start[num_half_edges - 1 - k - 2 * kAhead]);
+          if (w - lo < hi - lo) __builtin_prefetch(dest + first[w] - 1, 1);
+        }
         const auto v = static_cast<std::uint32_t>(start[h]);
         if (v - lo < hi - lo) visit(v, h);
       }
     });
   };
-  std::vector<std::uint32_t> first(num_vertices + 1, 0);
-  for_each_owned(false, [&](std::uint32_t v, std::size_t) { ++first[v]; });
+  for_each_owned(false, nullptr, [&](std::uint32_t v, std::size_t) { ++first[v]; });
   const std::size_t unused =
       LowestWhere(num_vertices, num_vertices, [&](std::size_t v) { return first[v] == 0; });
   if (unused != num_vertices) {
     return Status::Error(fmt::format("{}: vertex {} is used by no face", mesh.source, unused));
   }
-  QuadAdjacency out;
-  out.valence.resize(num_vertices);
-  for (std::size_t v = 0; v < num_vertices; ++v) {
-    out.valence[v] = static_cast<std::uint16_t>(std::min<std::uint32_t>(first[v], 65535));
-  }
   std::uint32_t sum = 0;
   for (std::size_t v = 0; v < num_vertices; ++v) first[v] = sum += first[v];
   first[num_vertices] = sum;
-  // Each entry packs the half-edge's end vertex (high half) with the half-edge (low half), so
-  // that the scans below read buckets only, not the faces.
-  std::vector<std::uint64_t> bucket(num_half_edges);
-  for_each_owned(true, [&](std::uint32_t v, std::size_t h) {
-    bucket[--first[v]] = static_cast<std::uint64_t>(end(h)) << 32 | h;
-  });
-  const auto end_of = [](std::uint64_t entry) { return static_cast<std::int32_t>(entry >> 32); };
-  const auto half_edge_of = [](std::uint64_t entry) { return static_cast<std::uint32_t>(entry); };
+  // Every entry is written below: no need to clear it first.
+  const std::unique_ptr<std::uint32_t[]> bucket(new std::uint32_t[num_half_edges]);
+  for_each_owned(true, bucket.get(),
+                 [&](std::uint32_t v, std::size_t h) { bucket[--first[v]] = std::uint32_t(h); });
 
-  // Per half-edge a -> b: the half-edges a -> b (itself only) and, from the lower of a and b
-  // only, b -> a (its opposite, at most one; both are set from there). The lowest half-edge
-  // breaking either rule names the error.
-  out.opposite.assign(num_half_edges, kNoHalfEdge);
-  out.first_half_edge.resize(num_vertices);
+  // Around vertex a, the quads of its half-edges a -> b_k (its bucket) also hold the half-edges
+  // c_k -> a that end there (each one's previous), so its bucket alone answers every question
+  // about the edges at a: the half-edges a -> b (same way) and b -> a (other way; the opposite
+  // when each is one). The lowest half-edge a -> b with two or more the same way, or with a < b
+  // and two or more the other way, names the error. A vertex is on a boundary when a half-edge
+  // leaving it or ending there has no opposite: as many end there as leave, and the opposites
+  // pair those that do, so it is enough to look at those leaving.
+  QuadAdjacency out;
+  out.opposite.resize(num_half_edges);
+  out.valence.resize(num_vertices);
+  out.boundary.resize(num_vertices);
   tbb::combinable<std::uint32_t> lowest_bad([] { return kNoHalfEdge; });
   tbb::parallel_for(Range(0, num_vertices, 2048), [&](const Range& r) {
     std::uint32_t& bad = lowest_bad.local();
+    std::vector<std::int32_t> ends, ins;  // b_k, c_k
     for (std::size_t a = r.begin(); a < r.end(); ++a) {
-      for (std::uint32_t i = first[a]; i < first[a + 1]; ++i) {
-        const std::uint32_t h = half_edge_of(bucket[i]);
-        const std::int32_t b = end_of(bucket[i]);
-        int same_way = 0;
-        for (std::uint32_t k = first[a]; k < first[a + 1]; ++k) same_way += end_of(bucket[k]) == b;
-        if (same_way > 1) bad = std::min(bad, h);
-        if (b < static_cast<std::int32_t>(a)) continue;
-        int other_way = 0;
-        std::uint32_t g = kNoHalfEdge;
-        for (std::uint32_t k = first[b]; k < first[b + 1]; ++k) {
-          if (end_of(bucket[k]) == static_cast<std::int32_t>(a)) {
-            ++other_way;
-            g = half_edge_of(bucket[k]);
-          }
-        }
-        if (other_way > 1) {
-          bad = std::min(bad, h);
-        } else if (other_way == 1 && same_way == 1) {
-          out.opposite[h] = g;
-          out.opposite[g] = h;
+      // The quads of a vertex some way ahead, fetched while this one waits for its own.
+      if (a + kAhead < r.end()) {
+        for (std::uint32_t k = first[a + kAhead]; k < first[a + kAhead + 1]; ++k) {
+          __builtin_prefetch(start + (bucket[k] & ~3u));
         }
       }
-      out.first_half_edge[a] = half_edge_of(bucket[first[a]]);
+      const std::uint32_t* around = &bucket[first[a]];
+      const std::uint32_t count = first[a + 1] - first[a];
+      ends.resize(count);
+      ins.resize(count);
+      for (std::uint32_t k = 0; k < count; ++k) {
+        const std::uint32_t h = around[k];
+        ends[k] = start[QuadAdjacency::Next(h)];
+        ins[k] = start[QuadAdjacency::Prev(h)];
+      }
+      bool border = false;
+      for (std::uint32_t k = 0; k < count; ++k) {
+        const std::int32_t b = ends[k];
+        int same_way = 0, other_way = 0;
+        std::uint32_t g = kNoHalfEdge;
+        for (std::uint32_t j = 0; j < count; ++j) {
+          same_way += ends[j] == b;
+          if (ins[j] == b) {
+            ++other_way;
+            g = QuadAdjacency::Prev(around[j]);
+          }
+        }
+        const std::uint32_t h = around[k];
+        if (same_way > 1 || (b > static_cast<std::int32_t>(a) && other_way > 1)) {
+          bad = std::min(bad, h);
+        }
+        const bool paired = same_way == 1 && other_way == 1;
+        out.opposite[h] = paired ? g : kNoHalfEdge;
+        border |= !paired;
+      }
+      out.valence[a] = static_cast<std::uint16_t>(std::min<std::uint32_t>(count, 65535));
+      out.boundary[a] = border ? 1 : 0;
     }
   });
   const std::uint32_t bad =
@@ -142,10 +169,10 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
     const std::int32_t a = start[bad], b = end(bad);
     std::vector<std::uint32_t> same_way, other_way;
     for (std::uint32_t k = first[a]; k < first[a + 1]; ++k) {
-      if (end_of(bucket[k]) == b) same_way.push_back(half_edge_of(bucket[k]) / 4);
+      if (end(bucket[k]) == b) same_way.push_back(bucket[k] / 4);
     }
     for (std::uint32_t k = first[b]; k < first[b + 1]; ++k) {
-      if (end_of(bucket[k]) == a) other_way.push_back(half_edge_of(bucket[k]) / 4);
+      if (end(bucket[k]) == a) other_way.push_back(bucket[k] / 4);
     }
     std::sort(same_way.begin(), same_way.end());
     if (same_way.size() + other_way.size() > 2) {
@@ -159,14 +186,13 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
         "{}: faces {} and {} both run edge {}-{} from {} to {} (their windings disagree)",
         mesh.source, same_way[0], same_way[1], a, b, a, b));
   }
-  out.boundary.assign(num_vertices, 0);
-  tbb::parallel_for(Range(0, num_half_edges, 1 << 14), [&](const Range& r) {
-    for (std::size_t h = r.begin(); h < r.end(); ++h) {
-      if (out.opposite[h] != kNoHalfEdge) continue;
-      std::atomic_ref<std::uint8_t>(out.boundary[start[h]]).store(1, std::memory_order_relaxed);
-      std::atomic_ref<std::uint8_t>(out.boundary[end(h)]).store(1, std::memory_order_relaxed);
-    }
+  // The lowest half-edge leaving each vertex: the first of its bucket, in place of the
+  // bucket's start.
+  tbb::parallel_for(Range(0, num_vertices, 1 << 14), [&](const Range& r) {
+    for (std::size_t v = r.begin(); v < r.end(); ++v) first[v] = bucket[first[v]];
   });
+  first.pop_back();
+  out.first_half_edge = std::move(first);
   return out;
 }
 
@@ -190,6 +216,12 @@ std::vector<std::uint32_t> QuadComponents(const QuadAdjacency& adjacency,
   });
   tbb::parallel_for(Range(0, num_faces, 1 << 12), [&](const Range& r) {
     for (std::size_t f = r.begin(); f < r.end(); ++f) {
+      if (f + kAhead < r.end()) {  // the neighbours' parents some way ahead
+        for (int k = 0; k < 4; ++k) {
+          const std::uint32_t g = adjacency.opposite[4 * (f + kAhead) + k];
+          if (g != kNoHalfEdge) __builtin_prefetch(&parent[g / 4]);
+        }
+      }
       for (int k = 0; k < 4; ++k) {
         const std::uint32_t g = adjacency.opposite[4 * f + k];
         if (g == kNoHalfEdge || g / 4 < f) continue;

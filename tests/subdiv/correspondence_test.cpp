@@ -252,6 +252,39 @@ TEST(MatchRefinedSculpt, SameResultAtAnyThreadCount) {
   EXPECT_EQ(a->worst_vertex, b->worst_vertex);
 }
 
+// cell_labels state, cell by cell, what the face tables state face by face, with or without
+// the tables; rejects labels in another cell order, with another rotation, or a match whose
+// result depends on whether the tables are filled.
+TEST(MatchRefinedSculpt, CellLabelsAgreeWithTheFaceTables) {
+  TempDir dir;
+  const std::string cage = Cage("keenan_spot/spot_control_mesh.obj");
+  const Sculpt sculpt = MakeRefined(dir, cage, 2);
+  const LimitSurface surface = Surface(cage);
+  const Shuffled shuffled = Shuffle(sculpt.mesh, 11);
+  MatchOptions without;
+  without.face_tables = false;
+  auto a = MatchRefinedSculpt(surface, shuffled.mesh);
+  auto b = MatchRefinedSculpt(surface, shuffled.mesh, without);
+  ASSERT_TRUE(a.ok() && b.ok());
+  const std::size_t num_faces = shuffled.mesh.num_faces();
+  ASSERT_EQ(a->cell_labels.size(), num_faces);
+  std::vector<std::int64_t> cell_offsets(a->grid_sizes.size() + 1, 0);
+  for (std::size_t p = 0; p < a->grid_sizes.size(); ++p) {
+    cell_offsets[p + 1] = cell_offsets[p] + std::int64_t{a->grid_sizes[p]} * a->grid_sizes[p];
+  }
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    const std::int64_t c = cell_offsets[a->face_ptex[f].value] + a->face_cell[f];
+    ASSERT_EQ(a->cell_labels[c], 4 * f + a->face_rotation[f]) << "face " << f;
+  }
+  EXPECT_EQ(a->cell_labels, b->cell_labels);
+  EXPECT_TRUE(b->face_ptex.empty() && b->face_cell.empty() && b->face_rotation.empty());
+  EXPECT_EQ(a->grid_vertices, b->grid_vertices);
+  EXPECT_EQ(a->vertex_faces, b->vertex_faces);
+  EXPECT_EQ(a->vertex_uvs, b->vertex_uvs);
+  EXPECT_EQ(a->rms_offset, b->rms_offset);
+  EXPECT_EQ(a->worst_vertex, b->worst_vertex);
+}
+
 TEST(MatchRefinedSculpt, SculptPointAtIsBilinearOverTheGrid) {
   TempDir dir;
   const std::string cage = Cage("catmark_nonquads");

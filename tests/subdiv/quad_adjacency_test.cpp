@@ -3,6 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <map>
+#include <numeric>
+#include <random>
+#include <utility>
 #include <vector>
 
 namespace dispex::subdiv {
@@ -60,6 +66,72 @@ TEST(QuadAdjacency, Errors) {
             "quads.obj: vertex 9 is used by no face");
   EXPECT_EQ(BuildQuadAdjacency(Quads(4, {0, 1, 2, 1})).status().message(),
             "quads.obj: face 0 uses vertex 1 twice");
+}
+
+// Against a map of the directed edges, on a grid with holes, numbered at random: every
+// opposite, valence, boundary flag and lowest half-edge. Rejects an opposite that is another
+// half-edge of the right vertices' quads, a boundary vertex not flagged, and a first half-edge
+// that is not the lowest.
+TEST(QuadAdjacency, AgreesWithAMapOfEdgesOnAShuffledGridWithHoles) {
+  constexpr int kSide = 40;
+  std::mt19937 random(7);
+  std::vector<std::int32_t> label((kSide + 1) * (kSide + 1));
+  std::iota(label.begin(), label.end(), 0);
+  std::shuffle(label.begin(), label.end(), random);
+  std::vector<std::array<std::int32_t, 4>> quads;
+  for (int j = 0; j < kSide; ++j) {
+    for (int i = 0; i < kSide; ++i) {
+      if ((i * 7 + j * 3) % 11 == 0) continue;  // holes, some meeting at a corner only
+      const auto at = [&](int x, int y) { return label[y * (kSide + 1) + x]; };
+      std::array<std::int32_t, 4> q{at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)};
+      std::rotate(q.begin(), q.begin() + random() % 4, q.end());
+      quads.push_back(q);
+    }
+  }
+  std::shuffle(quads.begin(), quads.end(), random);
+  // Vertices no quad uses are dropped (the adjacency rejects them), keeping the shuffle.
+  std::vector<std::int32_t> renumber(label.size(), -1);
+  int used = 0;
+  for (int v = 0; v < static_cast<int>(label.size()); ++v) {
+    for (const auto& q : quads) {
+      if (std::find(q.begin(), q.end(), v) != q.end()) {
+        renumber[v] = used++;
+        break;
+      }
+    }
+  }
+  std::vector<std::int32_t> corners;
+  for (const auto& q : quads) {
+    for (std::int32_t v : q) corners.push_back(renumber[v]);
+  }
+  const Mesh mesh = Quads(used, corners);
+  auto adjacency = BuildQuadAdjacency(mesh);
+  ASSERT_TRUE(adjacency.ok()) << adjacency.status().message();
+
+  std::map<std::pair<std::int32_t, std::int32_t>, std::uint32_t> edges;
+  for (std::uint32_t h = 0; h < corners.size(); ++h) {
+    edges[{corners[h], corners[QuadAdjacency::Next(h)]}] = h;
+  }
+  std::vector<std::uint16_t> valence(used, 0);
+  std::vector<std::uint8_t> boundary(used, 0);
+  std::vector<std::uint32_t> first(used, kNoHalfEdge);
+  int boundary_edges = 0;
+  for (std::uint32_t h = 0; h < corners.size(); ++h) {
+    const std::int32_t a = corners[h], b = corners[QuadAdjacency::Next(h)];
+    const auto other = edges.find({b, a});
+    const std::uint32_t expected = other == edges.end() ? kNoHalfEdge : other->second;
+    ASSERT_EQ(adjacency->opposite[h], expected) << "half-edge " << h;
+    ++valence[a];
+    first[a] = std::min(first[a], h);
+    if (other == edges.end()) {
+      boundary[a] = boundary[b] = 1;
+      ++boundary_edges;
+    }
+  }
+  EXPECT_GT(boundary_edges, 4 * kSide);  // the holes made boundaries inside too
+  EXPECT_EQ(adjacency->valence, valence);
+  EXPECT_EQ(adjacency->boundary, boundary);
+  EXPECT_EQ(adjacency->first_half_edge, first);
 }
 
 }  // namespace
