@@ -17,6 +17,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dispex/correspondence.h"
@@ -177,6 +178,15 @@ ExtractOptions Options(const std::string& base, const std::string& sculpt,
   o.method = method;
   o.threads = 2;
   return o;
+}
+
+// The same extraction both ways, into `dir`: through the mapping (mapping.ptx) and through rays
+// (rays.ptx), each with `adjust` applied to its options.
+template <class Adjust>
+std::pair<StatusOr<ExtractReport>, StatusOr<ExtractReport>> ExtractBothWays(
+    const std::string& cage, const std::string& sculpt, const TempDir& dir, Adjust adjust) {
+  return {Extract(adjust(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kMapping))),
+          Extract(adjust(Options(cage, sculpt, dir / "rays.ptx", ExtractMethod::kRays)))};
 }
 
 // Every face's texels of both maps: resolutions equal, and the largest |difference| (in ulps
@@ -436,10 +446,8 @@ TEST(MappingFallback, HitsBeyondTheRingsGoToABvhAndTheMapEqualsTheRayMap) {
     o.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.3};
     return o;
   };
-  auto mapping =
-      Extract(fixed(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kMapping)));
+  auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, fixed);
   ASSERT_TRUE(mapping.ok()) << mapping.status().message();
-  auto rays = Extract(fixed(Options(cage, sculpt, dir / "rays.ptx", ExtractMethod::kRays)));
   ASSERT_TRUE(rays.ok()) << rays.status().message();
   EXPECT_EQ(mapping->method, ExtractMethod::kMapping);
   EXPECT_GT(mapping->mapping_fallback_samples, 0);
@@ -508,9 +516,7 @@ TEST(MappingFallback, FoldsGoToTheBvh) {
     o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0.2};
     return o;
   };
-  auto mapping =
-      Extract(given(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kMapping)));
-  auto rays = Extract(given(Options(cage, sculpt, dir / "rays.ptx", ExtractMethod::kRays)));
+  auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, given);
   ASSERT_TRUE(mapping.ok() && rays.ok());
   EXPECT_GT(mapping->mapping_fallback_faces, 0);
   EXPECT_EQ(mapping->search_distance, rays->search_distance);
@@ -536,8 +542,7 @@ TEST(MappingFallback, AutomaticDistanceIsTheRayPaths) {
   ASSERT_GT(made->folded_faces, 0u);
   auto base = ReadMesh(cage);
   ASSERT_TRUE(base.ok());
-  auto mapping = Extract(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kMapping));
-  auto rays = Extract(Options(cage, sculpt, dir / "rays.ptx", ExtractMethod::kRays));
+  auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, [](ExtractOptions o) { return o; });
   ASSERT_TRUE(mapping.ok() && rays.ok());
   EXPECT_EQ(mapping->search_distance, rays->search_distance);
   const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
@@ -586,10 +591,8 @@ TEST(MappingFallback, NearerSheetOfAnotherPartGoesToTheBvh) {
     o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0.12};
     return o;
   };
-  auto mapping =
-      Extract(fixed(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kMapping)));
+  auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, fixed);
   ASSERT_TRUE(mapping.ok()) << mapping.status().message();
-  auto rays = Extract(fixed(Options(cage, sculpt, dir / "rays.ptx", ExtractMethod::kRays)));
   ASSERT_TRUE(rays.ok()) << rays.status().message();
   EXPECT_EQ(mapping->method, ExtractMethod::kMapping);
   EXPECT_GT(mapping->mapping_fallback_samples, 0);
