@@ -176,9 +176,11 @@ int main(int argc, char** argv) {
       });
       seconds = std::min(seconds, clock.seconds());
     }
-    out["mapping_kernel"] = {{"what", "the mapping kernel alone on the samples (no fallback BVH)"},
-                             {"seconds", seconds},
-                             {"samples", start[n]}};
+    out["mapping_kernel"] = {
+        {"what",
+         "the mapping kernel alone on the samples (rings and far-sheet check, no fallback BVH)"},
+        {"seconds", seconds},
+        {"samples", start[n]}};
   }
   std::vector<float> distances;  // packet8's, for the spectral stage
   for (RayMode mode : {RayMode::kPacket8, RayMode::kSingle}) {
