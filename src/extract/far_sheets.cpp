@@ -8,6 +8,13 @@ namespace dispex::extract {
 
 namespace {
 
+// How far sample k's window reaches each way: up to its hit under the nearest policy (nothing
+// nearer may exist), else the query's whole distance.
+float Window(std::size_t k, const NormalQuery& query, const NormalHits& out) {
+  const bool hit = out.flags[k] & HitFlags::kHit;
+  return hit && query.policy == HitPolicy::kNearest ? std::fabs(out.t[k]) : query.distance;
+}
+
 // The box of sample k's window, or false when it has none to check (a sample not decided, or
 // one with no valid line: a miss by rule).
 bool WindowBox(std::size_t k, std::span<const Float3> origins, std::span<const Float3> normals,
@@ -21,8 +28,7 @@ bool WindowBox(std::size_t k, std::span<const Float3> origins, std::span<const F
     if (!std::isfinite(c[a]) || !std::isfinite(n[a])) return false;
   }
   if (n[0] == 0 && n[1] == 0 && n[2] == 0) return false;
-  const bool hit = out.flags[k] & HitFlags::kHit;
-  const float w = hit && query.policy == HitPolicy::kNearest ? std::fabs(out.t[k]) : query.distance;
+  const float w = Window(k, query, out);
   if (!std::isfinite(w)) return false;
   const float scale = std::max({std::fabs(c[0]), std::fabs(c[1]), std::fabs(c[2])}) + w;
   // Each bound is within a few roundings of the exact o -+ w |n|; 2^-20 of the magnitudes
@@ -158,9 +164,7 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, int face, int n,
     const std::size_t at = block_of(k);
     if (w.candidate_starts[at] == w.candidate_starts[at + 1]) continue;
     if (!WindowBox(k, origins, normals, query, out, undecided, box)) continue;
-    const bool hit = out.flags[k] & HitFlags::kHit;
-    const double window = hit && query.policy == HitPolicy::kNearest ? std::fabs(double(out.t[k]))
-                                                                     : double(query.distance);
+    const double window = Window(k, query, out);
     for (std::int32_t c = w.candidate_starts[at]; c < w.candidate_starts[at + 1]; ++c) {
       const BlockBox& candidate = blocks.box(w.candidate_ids[static_cast<std::size_t>(c)]);
       if (candidate.Meets(box) && SegmentMeets(origins[k], normals[k], window, candidate)) {

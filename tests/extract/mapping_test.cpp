@@ -497,6 +497,15 @@ ExtractOptions PerSample(ExtractOptions o, int levels) {
   return o;
 }
 
+// Spot (`cage`) refined 3 times with the detail pattern, which folds: sculpt.obj in `dir`.
+std::string MakeFoldingSpot(const TempDir& dir, const std::string& cage) {
+  const std::string sculpt = dir / "sculpt.obj";
+  auto made = MakeSculpt(dispex::testing::SculptOptions(cage, sculpt, 3, Pattern::kDetail, 0));
+  EXPECT_TRUE(made.ok());
+  EXPECT_GT(made.ok() ? made->folded_faces : 0u, 0u);
+  return sculpt;
+}
+
 // Spot at level 3 with the detail pattern folds (MakeSculpt counts quads turned over): the faces
 // around the folds go to the BVH whole, and samples farther away whose windows a folded sheet
 // could reach go to it through the far-sheet check. Rejects a fold check that never fires, and
@@ -505,10 +514,7 @@ ExtractOptions PerSample(ExtractOptions o, int levels) {
 TEST(MappingFallback, FoldsGoToTheBvh) {
   TempDir dir;
   const std::string cage = DataPath("meshes/keenan_spot/spot_quadrangulated.obj");
-  const std::string sculpt = dir / "sculpt.obj";
-  auto made = MakeSculpt(dispex::testing::SculptOptions(cage, sculpt, 3, Pattern::kDetail, 0));
-  ASSERT_TRUE(made.ok());
-  ASSERT_GT(made->folded_faces, 0u);
+  const std::string sculpt = MakeFoldingSpot(dir, cage);
   auto base = ReadMesh(cage);
   ASSERT_TRUE(base.ok());
   auto given = [&](ExtractOptions o) {
@@ -536,10 +542,7 @@ TEST(MappingFallback, FoldsGoToTheBvh) {
 TEST(MappingFallback, AutomaticDistanceIsTheRayPaths) {
   TempDir dir;
   const std::string cage = DataPath("meshes/keenan_spot/spot_quadrangulated.obj");
-  const std::string sculpt = dir / "sculpt.obj";
-  auto made = MakeSculpt(dispex::testing::SculptOptions(cage, sculpt, 3, Pattern::kDetail, 0));
-  ASSERT_TRUE(made.ok());
-  ASSERT_GT(made->folded_faces, 0u);
+  const std::string sculpt = MakeFoldingSpot(dir, cage);
   auto base = ReadMesh(cage);
   ASSERT_TRUE(base.ok());
   auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, [](ExtractOptions o) { return o; });
