@@ -75,19 +75,29 @@ Mesh SculptInBlocksMeeting(const ExtractInputs& inputs, std::span<const BlockBox
 }
 
 // The sculpt the normal queries from `origins` along +- `directions`, `distance` long, can
-// reach: each segment's box, grown by 2^-16 of the coordinates' magnitude and of the distance
-// (well beyond the margin Embree's window gets, trace/batch_kernels.h).
+// reach: each segment cut into pieces about a grid cell of the blocks long (a long segment's
+// one box would cover most of the grid), each piece's box grown by 2^-16 of the coordinates'
+// magnitude and of the distance (well beyond the margin Embree's window gets,
+// trace/batch_kernels.h).
 Mesh SculptNearSegments(const ExtractInputs& inputs, std::span<const Float3> origins,
                         std::span<const Float3> directions, float distance) {
-  std::vector<BlockBox> boxes(origins.size());
+  const double cell = inputs.mapping->blocks().cell_size();
+  std::vector<BlockBox> boxes;
   for (std::size_t k = 0; k < origins.size(); ++k) {
-    const float o[3] = {origins[k].x, origins[k].y, origins[k].z};
-    const float d[3] = {directions[k].x, directions[k].y, directions[k].z};
-    for (int a = 0; a < 3; ++a) {
-      const float reach = std::fabs(d[a]) * distance;
-      const float margin = (std::fabs(o[a]) + distance + inputs.tracer_options.scale) * 0x1p-16f;
-      boxes[k].lower[a] = o[a] - reach - margin;
-      boxes[k].upper[a] = o[a] + reach + margin;
+    const double o[3] = {origins[k].x, origins[k].y, origins[k].z};
+    const double d[3] = {directions[k].x, directions[k].y, directions[k].z};
+    const double length =
+        2.0 * distance * std::max({std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])});
+    const int pieces = static_cast<int>(std::clamp(std::ceil(length / cell), 1.0, 4096.0));
+    for (int p = 0; p < pieces; ++p) {
+      const double t0 = distance * (2.0 * p / pieces - 1),
+                   t1 = distance * (2.0 * (p + 1) / pieces - 1);
+      BlockBox& box = boxes.emplace_back();
+      for (int a = 0; a < 3; ++a) {
+        const double margin = (std::fabs(o[a]) + distance + inputs.tracer_options.scale) * 0x1p-16;
+        box.lower[a] = static_cast<float>(o[a] + std::min(t0 * d[a], t1 * d[a]) - margin);
+        box.upper[a] = static_cast<float>(o[a] + std::max(t0 * d[a], t1 * d[a]) + margin);
+      }
     }
   }
   return SculptInBlocksMeeting(inputs, boxes);

@@ -75,7 +75,7 @@ void Grow(BlockBox& into, const BlockBox& box) {
 
 }  // namespace
 
-std::uint64_t CheckFarSheets(const SculptMapping& mapping, int face, int n,
+std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, int face, int n,
                              std::span<const std::int32_t> samples, std::span<const Float3> origins,
                              std::span<const Float3> normals, const NormalQuery& query,
                              const NormalHits& out, std::span<std::uint8_t> undecided,
@@ -165,9 +165,15 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, int face, int n,
     if (w.candidate_starts[at] == w.candidate_starts[at + 1]) continue;
     if (!WindowBox(k, origins, normals, query, out, undecided, box)) continue;
     const double window = Window(k, query, out);
+    // A crossing within rounding beyond the window's end counts: the ray path may find it inside.
+    const Float3& o = origins[k];
+    const auto reach = static_cast<float>(
+        window + (std::max({std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)}) + window) * 0x1p-20);
     for (std::int32_t c = w.candidate_starts[at]; c < w.candidate_starts[at + 1]; ++c) {
-      const BlockBox& candidate = blocks.box(w.candidate_ids[static_cast<std::size_t>(c)]);
-      if (candidate.Meets(box) && SegmentMeets(origins[k], normals[k], window, candidate)) {
+      const std::int64_t id = w.candidate_ids[static_cast<std::size_t>(c)];
+      const BlockBox& candidate = blocks.box(id);
+      if (candidate.Meets(box) && SegmentMeets(o, normals[k], window, candidate) &&
+          WindowCrossesBlock(mapping, sculpt, id, o, normals[k], reach)) {
         undecided[k] = 1;
         ++sent;
         break;

@@ -1048,6 +1048,22 @@ void TraceRingsOfFace(const SculptMapping& mapping, const Mesh& sculpt, PtexFace
 
 }  // namespace
 
+bool WindowCrossesBlock(const SculptMapping& mapping, const Mesh& sculpt, std::int64_t block,
+                        const Float3& origin, const Float3& normal, float window) {
+  const SculptBlocks& blocks = mapping.blocks();
+  const SculptBlocks::Place at = blocks.block(block);
+  const int b = blocks.block_size(at.face);
+  const Line line(origin, FlushTiny(normal));
+  Crossings x;
+  x.distance = window;
+  for (int j = at.bj * b; j < (at.bj + 1) * b; ++j) {
+    for (int i = at.bi * b; i < (at.bi + 1) * b; ++i) {
+      TestQuad(line, sculpt, SculptMapping::FaceOf(mapping.cell(at.face, i, j)), 0, x);
+    }
+  }
+  return x.degenerate || x.plus.found() || x.minus.found();
+}
+
 void TraceMapped(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId face, int n,
                  std::span<const std::int32_t> samples, std::span<const Float3> origins,
                  std::span<const Float3> normals, const NormalQuery& query, const NormalHits& out,
@@ -1062,8 +1078,8 @@ void TraceMapped(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId fa
   }
   TraceRingsOfFace(mapping, sculpt, face, n, samples, origins, normals, query, out, undecided, w,
                    counters);
-  const std::uint64_t far =
-      CheckFarSheets(mapping, face.value, n, samples, origins, normals, query, out, undecided, w);
+  const std::uint64_t far = CheckFarSheets(mapping, sculpt, face.value, n, samples, origins,
+                                           normals, query, out, undecided, w);
   counters.decided -= far;
   counters.far_sheets += far;
 }

@@ -28,10 +28,10 @@
 // cannot be laid out, a degenerate triangle, quads tested that face the line both ways (the
 // sheet folds or stands edge-on there) -- are left undecided for a BVH to answer, and so are
 // all samples of faces near a quad turned over against the limit normal (MarkFolds). Then the
-// decided samples whose ray window could meet any part of the sculpt outside the blocks of
-// cells near them -- the other side of a thin part, a fold farther than two faces, another
-// part that comes close -- are left undecided too (CheckFarSheets, far_sheets.h: boxes of
-// 4 x 4-cell blocks against the boxes of the windows up to the hit kept).
+// decided samples whose ray window crosses any part of the sculpt outside the blocks of cells
+// near them -- the other side of a thin part, a fold farther than two faces, another part
+// that comes close -- are left undecided too (CheckFarSheets, far_sheets.h: boxes of 4 x 4-cell
+// blocks against the windows up to the hit kept, then the quads of the blocks they meet).
 //
 // Speed. The samples of one cell go through rings 0 and 1 together (4 lanes): the cell's 4 x 4
 // lattice of corners projected in float, each edge's value once, and a triangle classified as
@@ -179,14 +179,19 @@ struct MappingScratch {
 // extraordinary corner the corner blocks of every face around it.
 void LayOutNearBlocks(const SculptMapping& mapping, int face, MappingScratch& scratch);
 
+// Whether the line origin + t normal crosses a quad of sculpt block `block` (SculptBlocks id)
+// at |t| <= window, tested as the rings test quads (a triangle with no plane counts as crossed).
+bool WindowCrossesBlock(const SculptMapping& mapping, const Mesh& sculpt, std::int64_t block,
+                        const Float3& origin, const Float3& normal, float window);
+
 // The normal queries of samples `samples` (grid indices j * n + i of face `face`'s n x n
 // grid of texel centres ((i + 0.5) / n, (j + 0.5) / n); all n * n when empty) of `origins` and
 // unit `normals` (both n * n, indexed by grid index) against the sculpt through `mapping`.
 // Decided samples get out.t / out.flags (and out.prim when not empty) at their grid index as
 // Tracer::TraceNormals sets them and undecided[k] = 0; the others undecided[k] = 1, out
 // untouched. `sculpt` is the matched mesh. Every sample of a face at risk of folds
-// (SculptMapping::fold_risk) is undecided, and so is every sample whose window could meet a
-// sculpt block not near it (CheckFarSheets, when BuildBlocks ran).
+// (SculptMapping::fold_risk) is undecided, and so is every sample whose window crosses a quad
+// of a sculpt block not near it (CheckFarSheets, when BuildBlocks ran).
 void TraceMapped(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId face, int n,
                  std::span<const std::int32_t> samples, std::span<const Float3> origins,
                  std::span<const Float3> normals, const NormalQuery& query, const NormalHits& out,

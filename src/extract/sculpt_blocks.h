@@ -46,6 +46,8 @@ class SculptBlocks {
   };
   Place block(std::int64_t id) const;
   std::size_t bytes() const;
+  // The side of the grid's cells.
+  float cell_size() const { return cell_; }
 
   // Calls fn(id) once for each block whose box meets `query`, in an order fixed by the boxes.
   template <typename Fn>

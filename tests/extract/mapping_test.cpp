@@ -553,6 +553,40 @@ TEST(MappingFallback, AutomaticDistanceIsTheRayPaths) {
   EXPECT_EQ(t.beyond, 0u) << t.beyond << " of " << t.texels << " texels differ beyond rounding";
 }
 
+// Two 3 x 3-quad sheets over [0, 3]^2 as one cage of two components: the lower at z = 0, the
+// upper at z = upper_z(i) over x = i.
+template <typename Height>
+std::string WriteSheets(const TempDir& dir, Height upper_z) {
+  const std::string cage = dir / "sheets.obj";
+  std::ofstream obj(cage);
+  for (int s = 0; s < 2; ++s) {
+    for (int j = 0; j <= 3; ++j) {
+      for (int i = 0; i <= 3; ++i) obj << "v " << i << " " << j << " " << s * upper_z(i) << "\n";
+    }
+  }
+  for (int s = 0; s < 2; ++s) {
+    for (int j = 0; j < 3; ++j) {
+      for (int i = 0; i < 3; ++i) {
+        const int v = 16 * s + 4 * j + i + 1;
+        obj << "f " << v << " " << v + 1 << " " << v + 5 << " " << v + 4 << "\n";
+      }
+    }
+  }
+  return cage;
+}
+
+// The sheets' cage refined 3 times, the lower sheet's sculpt (z < 0.01) lifted by `lift`
+// (empty on failure).
+std::string LiftLowerSheet(const TempDir& dir, const std::string& cage, float lift) {
+  auto lifted = ReadMesh(MakeRefined(dir, cage, 3, Pattern::kNone));
+  if (!lifted.ok()) return "";
+  for (Float3& p : lifted->positions) {
+    if (p.z < 0.01f) p.z += lift;
+  }
+  const std::string sculpt = dir / "lifted.obj";
+  return WriteObj(sculpt, *lifted).ok() ? sculpt : "";
+}
+
 // Two parallel 3 x 3-quad sheets 0.05 apart (two components of one cage); the sculpt is the
 // cage refined 3 times with the lower sheet then lifted 0.08, over the upper one. A sample of
 // the lower sheet's limit surface meets its own sculpt at t = 0.08 in its rings and the other
@@ -562,31 +596,9 @@ TEST(MappingFallback, AutomaticDistanceIsTheRayPaths) {
 // thread count.
 TEST(MappingFallback, NearerSheetOfAnotherPartGoesToTheBvh) {
   TempDir dir;
-  const std::string cage = dir / "sheets.obj";
-  {
-    std::ofstream obj(cage);
-    for (int s = 0; s < 2; ++s) {
-      for (int j = 0; j <= 3; ++j) {
-        for (int i = 0; i <= 3; ++i) obj << "v " << i << " " << j << " " << 0.05 * s << "\n";
-      }
-    }
-    for (int s = 0; s < 2; ++s) {
-      for (int j = 0; j < 3; ++j) {
-        for (int i = 0; i < 3; ++i) {
-          const int v = 16 * s + 4 * j + i + 1;
-          obj << "f " << v << " " << v + 1 << " " << v + 5 << " " << v + 4 << "\n";
-        }
-      }
-    }
-  }
-  const std::string refined = MakeRefined(dir, cage, 3, Pattern::kNone);
-  auto lifted = ReadMesh(refined);
-  ASSERT_TRUE(lifted.ok());
-  for (Float3& p : lifted->positions) {
-    if (p.z < 0.025f) p.z += 0.08f;
-  }
-  const std::string sculpt = dir / "lifted.obj";
-  ASSERT_TRUE(WriteObj(sculpt, *lifted).ok());
+  const std::string cage = WriteSheets(dir, [](int) { return 0.05; });
+  const std::string sculpt = LiftLowerSheet(dir, cage, 0.08f);
+  ASSERT_FALSE(sculpt.empty());
   auto base = ReadMesh(cage);
   ASSERT_TRUE(base.ok());
   auto fixed = [&](ExtractOptions o) {
@@ -612,6 +624,34 @@ TEST(MappingFallback, NearerSheetOfAnotherPartGoesToTheBvh) {
   ASSERT_TRUE(single.ok());
   EXPECT_EQ(single->mapping_fallback_samples, mapping->mapping_fallback_samples);
   EXPECT_EQ(dispex::testing::Slurp(dir / "one.ptx"), dispex::testing::Slurp(dir / "mapping.ptx"));
+}
+
+// The upper sheet tilted, z = 0.02 + 0.02 x, over the lower one lifted 0.03: a lower sample at
+// x meets the upper sheet nearer than its own sculpt only where x < 0.5, 8 of its 48 columns
+// (texel centres (i + 0.5) / 16). The upper sheet's blocks of 4 x 4 cells span 0.01 in z, so
+// those over 0.5 < x < 1 reach below z = 0.03 too: their box meets the windows of 8 columns
+// more, whose lines pass above them. Rejects a check by boxes alone (768 samples to the BVH)
+// and one that misses a crossing (fewer than 384, and texels unlike the ray map's).
+TEST(MappingFallback, OnlySamplesWhoseLinesCrossAnotherSheetGoToTheBvh) {
+  TempDir dir;
+  const std::string cage = WriteSheets(dir, [](int i) { return 0.02 + 0.02 * i; });
+  const std::string sculpt = LiftLowerSheet(dir, cage, 0.03f);
+  ASSERT_FALSE(sculpt.empty());
+  auto base = ReadMesh(cage);
+  ASSERT_TRUE(base.ok());
+  auto fixed = [&](ExtractOptions o) {
+    o = PerSample(o, 3);
+    o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0.12};
+    return o;
+  };
+  auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, fixed);
+  ASSERT_TRUE(mapping.ok()) << mapping.status().message();
+  ASSERT_TRUE(rays.ok()) << rays.status().message();
+  EXPECT_EQ(mapping->method, ExtractMethod::kMapping);
+  EXPECT_EQ(mapping->mapping_fallback_samples, 8 * 48);
+  const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
+  EXPECT_TRUE(t.same_resolutions);
+  EXPECT_EQ(t.beyond, 0u) << t.beyond << " of " << t.texels << " texels differ beyond rounding";
 }
 
 // ---- The command line -----------------------------------------------------------------------
