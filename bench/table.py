@@ -140,8 +140,10 @@ def print_components(name, components):
             figure = f'{c["samples"]/1e6:.1f}M samples -> {c["texels"]/1e6:.1f}M texels'
         elif "bytes" in c:
             figure = f'{c["bytes"]/1e6:.0f} MB'
-        else:
+        elif "samples" in c:
             figure = f'{c["samples"]/1e6:.1f}M samples, {c["samples"]/1e6/c["seconds"]:.0f} M/s'
+        else:
+            figure = ""  # a stage with no count of its own (the match, the cell table)
         print(f'| {c["what"]} | {c["seconds"]:.2f} s | {figure} |')
 
 

@@ -47,10 +47,6 @@ OversamplingPlan PlanOversampling(const LimitSurface& surface, const Mesh& sculp
   plan.log2.assign(static_cast<std::size_t>(num_faces), 0);
   const int min_log2 = Log2Of(min_samples), max_log2 = Log2Of(max_samples);
   for (double a : face_areas) plan.base_area += a;
-  plan.sculpt_area = MeshArea(sculpt);
-  for (std::size_t f = 0; f < sculpt.num_faces(); ++f) {
-    plan.sculpt_quads += 0.5 * (sculpt.face_size(f) - 2);
-  }
   if (fixed > 0) {
     for (int f = 0; f < num_faces; ++f) {
       if (!surface.is_hole(PtexFaceId(f))) plan.log2[f] = static_cast<std::uint8_t>(Log2Of(fixed));
@@ -58,6 +54,14 @@ OversamplingPlan PlanOversampling(const LimitSurface& surface, const Mesh& sculp
     return plan;
   }
   plan.subdivision_level = SubdivisionLevel(surface, sculpt);
+  // The sculpt's density, which only a sculpt that is not the base refined needs (a pass over
+  // every sculpt face).
+  if (plan.subdivision_level < 0) {
+    plan.sculpt_area = MeshArea(sculpt);
+    for (std::size_t f = 0; f < sculpt.num_faces(); ++f) {
+      plan.sculpt_quads += 0.5 * (sculpt.face_size(f) - 2);
+    }
+  }
   const double density = plan.sculpt_area > 0 ? plan.sculpt_quads / plan.sculpt_area : 0;
   for (int f = 0; f < num_faces; ++f) {
     PtexFaceId face(f);

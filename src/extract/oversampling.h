@@ -19,7 +19,8 @@ namespace dispex::extract {
 struct OversamplingPlan {
   std::vector<std::uint8_t> log2;  // per Ptex face: samples per side = 1 << log2 (0 for holes)
   int subdivision_level = -1;      // L when the sculpt is the base subdivided L times
-  double sculpt_quads = 0;         // sculpt area in quad equivalents
+  // Measured only when the density decides (no subdivision level, no fixed rate):
+  double sculpt_quads = 0;  // sculpt area in quad equivalents
   double sculpt_area = 0;
   double base_area = 0;
 };
