@@ -203,11 +203,9 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
     report.parts_merged = static_cast<std::int64_t>(parts->size());
     previous = PreviousMap::FromParts(std::move(*parts), num_faces);
   } else if (options.incremental) {
-    // Vector maps are made whole; an up-to-date map of either kind is left as it is.
-    if (!options.vector) previous = PreviousMap::Open(options.output_path, num_faces);
-    const std::string stored = options.vector      ? StoredInputsKey(options.output_path)
-                               : previous.usable() ? previous.MetaString(kInputsKeyMetaKey)
-                                                   : "";
+    // An up-to-date map is left as it is.
+    previous = PreviousMap::Open(options.output_path, num_faces, options.vector.has_value());
+    const std::string stored = previous.usable() ? previous.MetaString(kInputsKeyMetaKey) : "";
     if (stored == report.inputs_key) {
       report.unchanged = true;
       report.t_total = total_clock.seconds();
@@ -215,15 +213,14 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
       return report;
     }
   }
-  if (options.incremental && options.vector) {
-    report.redo_reason = "a vector map is extracted whole when anything changed";
-  } else if (options.incremental && !merge) {
+  if (options.incremental && !merge) {
     previous.CheckFaceData();
     if (!previous.notice().empty()) report.warnings.push_back(previous.notice());
     report.redo_reason = RedoReason(previous, report);
   }
   if (options.vector) {
-    return ExtractVectorShape(options, std::move(inputs), std::move(report), total_clock);
+    return ExtractVectorShape(options, std::move(inputs), std::move(report), total_clock,
+                              previous.usable() ? &previous : nullptr);
   }
   // Through the subdivision correspondence no BVH is built up front (extract_mapping.h).
   DISPEX_RETURN_IF_ERROR(ChooseMethod(options, inputs, report));

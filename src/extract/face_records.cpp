@@ -21,6 +21,17 @@ void Fields(Io& io, FaceRecord& r) {
   for (float& m : r.edge_means.mean) io(m);
 }
 
+template <class Io>
+void Fields(Io& io, VectorFaceStats& s) {
+  io(s.samples), io(s.normal_min), io(s.normal_max), io(s.tangential_max), io(s.length_max);
+  io(s.sum_squares);
+  SpectralFaceStats& p = s.spectral;
+  io(p.texels_before), io(p.texels_after), io(p.bound), io(p.measured_error);
+  io(p.bound_ulog2), io(p.bound_vlog2), io(p.step_ups), io(p.constant), io(p.edge_error);
+  io(p.edge_limited);
+  io(s.ulog2), io(s.vlog2);
+}
+
 struct Writer {
   std::vector<std::int8_t>& out;
   template <class T>
@@ -46,20 +57,39 @@ struct Reader {
 };
 
 // Values a map from another source could hold that index arrays or size buffers later.
+bool Plausible(const SpectralFaceStats& p, std::int64_t samples, int ulog2, int vlog2) {
+  auto log2_ok = [](int v) { return v >= 0 && v <= 15; };
+  return log2_ok(ulog2) && log2_ok(vlog2) && log2_ok(p.bound_ulog2) && log2_ok(p.bound_vlog2) &&
+         samples >= 0 && p.step_ups >= 0 && p.texels_before >= 0 && p.texels_after >= 0;
+}
 bool Plausible(const FaceRecord& r) {
   const FaceStats& s = r.stats;
-  auto log2_ok = [](int v) { return v >= 0 && v <= 15; };
-  return log2_ok(s.ulog2) && log2_ok(s.vlog2) && log2_ok(s.spectral.bound_ulog2) &&
-         log2_ok(s.spectral.bound_vlog2) && s.samples >= 0 && s.misses >= 0 && s.rays >= 0 &&
-         s.spectral.step_ups >= 0 && s.spectral.texels_before >= 0 && s.spectral.texels_after >= 0;
+  return Plausible(s.spectral, s.samples, s.ulog2, s.vlog2) && s.misses >= 0 && s.rays >= 0;
+}
+bool Plausible(const VectorFaceStats& s) {
+  return Plausible(s.spectral, s.samples, s.ulog2, s.vlog2);
 }
 
+template <class Record>
 std::size_t RecordSize() {
   std::vector<std::int8_t> bytes;
   Writer w{bytes};
-  FaceRecord r;
+  Record r;
   Fields(w, r);
   return bytes.size();
+}
+
+template <class Record>
+std::optional<std::vector<Record>> Decode(std::span<const std::uint8_t> bytes,
+                                          std::size_t num_faces) {
+  if (bytes.size() != num_faces * RecordSize<Record>()) return std::nullopt;
+  std::vector<Record> records(num_faces);
+  Reader r{bytes.data()};
+  for (Record& record : records) {
+    Fields(r, record);
+    if (!Plausible(record)) return std::nullopt;
+  }
+  return records;
 }
 
 }  // namespace
@@ -67,7 +97,7 @@ std::size_t RecordSize() {
 std::vector<std::int8_t> EncodeFaceRecords(std::span<const FaceStats> stats,
                                            std::span<const EdgeMeans> edge_means) {
   std::vector<std::int8_t> out;
-  out.reserve(stats.size() * RecordSize());
+  out.reserve(stats.size() * RecordSize<FaceRecord>());
   Writer w{out};
   for (std::size_t f = 0; f < stats.size(); ++f) {
     FaceRecord r{stats[f], edge_means[f]};
@@ -78,14 +108,20 @@ std::vector<std::int8_t> EncodeFaceRecords(std::span<const FaceStats> stats,
 
 std::optional<std::vector<FaceRecord>> DecodeFaceRecords(std::span<const std::uint8_t> bytes,
                                                          std::size_t num_faces) {
-  if (bytes.size() != num_faces * RecordSize()) return std::nullopt;
-  std::vector<FaceRecord> records(num_faces);
-  Reader r{bytes.data()};
-  for (FaceRecord& record : records) {
-    Fields(r, record);
-    if (!Plausible(record)) return std::nullopt;
-  }
-  return records;
+  return Decode<FaceRecord>(bytes, num_faces);
+}
+
+std::vector<std::int8_t> EncodeVectorFaceRecords(std::span<const VectorFaceStats> stats) {
+  std::vector<std::int8_t> out;
+  out.reserve(stats.size() * RecordSize<VectorFaceStats>());
+  Writer w{out};
+  for (VectorFaceStats s : stats) Fields(w, s);
+  return out;
+}
+
+std::optional<std::vector<VectorFaceStats>> DecodeVectorFaceRecords(
+    std::span<const std::uint8_t> bytes, std::size_t num_faces) {
+  return Decode<VectorFaceStats>(bytes, num_faces);
 }
 
 std::vector<std::int8_t> EncodeFaceKeys(std::span<const Hash128> keys) {

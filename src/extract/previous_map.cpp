@@ -8,7 +8,7 @@
 
 namespace dispex::extract {
 
-PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces) {
+PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces, bool vector) {
   PreviousMap out;
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return out;
@@ -25,20 +25,29 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces) {
     return ignore(fmt::format("written by dispex {}, not {}", version->AsString(), Version()));
   }
   const PtexMetaItem* keys = file->FindMetaData(kFaceKeysMetaKey);
-  const PtexMetaItem* records = file->FindMetaData(kFaceRecordsMetaKey);
+  const PtexMetaItem* records =
+      file->FindMetaData(vector ? kVectorFaceRecordsMetaKey : kFaceRecordsMetaKey);
   if (keys == nullptr || records == nullptr) return ignore("has no face keys");
-  if (file->header().num_channels != 1 || (file->header().data_type != PtexDataType::kFloat &&
-                                           file->header().data_type != PtexDataType::kHalf)) {
-    return ignore("is not a one-channel float or half map");
+  if (file->header().num_channels != (vector ? 3 : 1) ||
+      (file->header().data_type != PtexDataType::kFloat &&
+       file->header().data_type != PtexDataType::kHalf)) {
+    return ignore(vector ? "is not a three-channel float or half map"
+                         : "is not a one-channel float or half map");
   }
   if (static_cast<std::size_t>(file->num_faces()) != num_faces) {
     return ignore(fmt::format("has {} faces, the base now {}", file->num_faces(), num_faces));
   }
   auto decoded_keys = DecodeFaceKeys(keys->bytes, num_faces);
-  auto decoded_records = DecodeFaceRecords(records->bytes, num_faces);
-  if (!decoded_keys || !decoded_records) return ignore("has malformed face keys");
+  if (vector) {
+    auto decoded = DecodeVectorFaceRecords(records->bytes, num_faces);
+    if (!decoded_keys || !decoded) return ignore("has malformed face keys");
+    out.vector_records_ = std::move(*decoded);
+  } else {
+    auto decoded = DecodeFaceRecords(records->bytes, num_faces);
+    if (!decoded_keys || !decoded) return ignore("has malformed face keys");
+    out.records_ = std::move(*decoded);
+  }
   out.keys_ = std::move(*decoded_keys);
-  out.records_ = std::move(*decoded_records);
   out.files_.push_back(std::move(*file));
   return out;
 }
@@ -66,19 +75,6 @@ PreviousMap PreviousMap::FromParts(std::vector<ShardPart> parts, std::size_t num
   return out;
 }
 
-std::string StoredInputsKey(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return "";
-  StatusOr<PtexFile> file = PtexFile::Open(path);
-  if (!file.ok()) return "";
-  const PtexMetaItem* version = file->FindMetaData("dispex:version");
-  const PtexMetaItem* key = file->FindMetaData(kInputsKeyMetaKey);
-  if (version == nullptr || key == nullptr || version->AsString() != Version()) {
-    return "";
-  }
-  return key->AsString();
-}
-
 void PreviousMap::CheckFaceData() {
   if (files_.size() != 1) return;  // none, or parts (OpenShardPart checks them)
   Status valid = files_[0].Validate();
@@ -96,9 +92,13 @@ std::string PreviousMap::MetaString(const std::string& key) const {
 
 bool PreviousMap::Reusable(std::size_t f, const Hash128& key) const {
   if (files_.empty() || keys_[f] != key) return false;
+  const PtexFaceInfo& info = file(f).face_info(PtexFaceId(static_cast<int>(f)));
+  if (!vector_records_.empty()) {
+    const VectorFaceStats& s = vector_records_[f];
+    return s.samples == 0 || (info.ulog2 == s.ulog2 && info.vlog2 == s.vlog2);
+  }
   const FaceStats& s = records_[f].stats;
   if (s.all_missed || s.samples == 0) return true;  // written from the neighbours, or a hole
-  const PtexFaceInfo& info = file(f).face_info(PtexFaceId(static_cast<int>(f)));
   return info.ulog2 == s.ulog2 && info.vlog2 == s.vlog2;
 }
 
@@ -108,8 +108,9 @@ Status PreviousMap::ReadTexels(std::size_t f, KeptFace& out) const {
   out.ulog2 = info.ulog2;
   out.vlog2 = info.vlog2;
   out.kept = true;
-  if (info.ulog2 == 0 && info.vlog2 == 0) {
-    out.texels.resize(1);
+  out.constant = info.constant;
+  if (info.constant || (info.ulog2 == 0 && info.vlog2 == 0)) {
+    out.texels.resize(static_cast<std::size_t>(file(f).header().num_channels));
     file(f).ConstantValue(face, out.texels.data());
     return Status::Ok();
   }

@@ -15,17 +15,13 @@
 
 namespace dispex::extract {
 
-// The dispex:inputs_key of the map at `path` when it is one this version of dispex wrote and
-// its structure is sound; "" otherwise (missing, unreadable, foreign). A map with the key of
-// the inputs and options at hand is up to date.
-std::string StoredInputsKey(const std::string& path);
-
 class PreviousMap {
  public:
   // Never fails: a missing file re-uses nothing and leaves notice() empty; a map that cannot be
-  // read, was not written by this version of dispex, or has another number of faces re-uses
-  // nothing, and notice() says why in one line.
-  static PreviousMap Open(const std::string& path, std::size_t num_faces);
+  // read, was not written by this version of dispex, has another number of faces or is not of
+  // the kind asked for (a scalar map, or a vector map when `vector`) re-uses nothing, and
+  // notice() says why in one line.
+  static PreviousMap Open(const std::string& path, std::size_t num_faces, bool vector = false);
   // The parts of a sharded extraction (CheckShardParts' order) as one map: each face as the part
   // of its shard holds it.
   static PreviousMap FromParts(std::vector<ShardPart> parts, std::size_t num_faces);
@@ -42,7 +38,9 @@ class PreviousMap {
   // watertight edges did not raise its resolution afterwards).
   bool Reusable(std::size_t f, const Hash128& key) const;
   const FaceRecord& record(std::size_t f) const { return records_[f]; }
-  // The face's texels as KeptFace holds them (one value for a constant face).
+  // A vector map's (Open with `vector`).
+  const VectorFaceStats& vector_record(std::size_t f) const { return vector_records_[f]; }
+  // The face's texels as KeptFace holds them (one value per channel for a constant face).
   Status ReadTexels(std::size_t f, KeptFace& out) const;
 
  private:
@@ -51,7 +49,8 @@ class PreviousMap {
   std::vector<PtexFile> files_;
   std::vector<std::uint32_t> part_of_;  // per face, its file; empty: one file
   std::vector<Hash128> keys_;
-  std::vector<FaceRecord> records_;
+  std::vector<FaceRecord> records_;              // a scalar map's
+  std::vector<VectorFaceStats> vector_records_;  // a vector map's
   std::string notice_;
 };
 

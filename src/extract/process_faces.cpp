@@ -45,11 +45,6 @@ void AddCpuTimes(const tbb::enumerable_thread_specific<FaceScratch>& scratches,
 
 // Kept texels hold what the map will store, so that the edges are measured on it and a face
 // read back from the map is kept exactly as it was.
-void RoundToDataType(PtexDataType type, std::vector<float>& texels) {
-  if (type != PtexDataType::kHalf) return;
-  for (float& t : texels) t = HalfToFloat(FloatToHalf(t));
-}
-
 KeptFace Keep(const FaceResult& result, PtexDataType type) {
   KeptFace kept;
   switch (result.kind) {
@@ -70,6 +65,11 @@ KeptFace Keep(const FaceResult& result, PtexDataType type) {
 }
 
 }  // namespace
+
+void RoundToDataType(PtexDataType type, std::span<float> texels) {
+  if (type != PtexDataType::kHalf) return;
+  for (float& t : texels) t = HalfToFloat(FloatToHalf(t));
+}
 
 PtexFaceInfo FaceInfo(const ExtractInputs& inputs, PtexFaceId face, int ulog2, int vlog2) {
   PtexFaceInfo info = inputs.faces[static_cast<std::size_t>(face.value)];

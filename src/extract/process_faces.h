@@ -26,8 +26,12 @@ struct WorkerTotals {
 struct KeptFace {
   std::int8_t ulog2 = 0, vlog2 = 0;
   bool kept = false;          // false: a face that missed entirely (written when filled)
-  std::vector<float> texels;  // ures x vres, or one value for a constant face
+  bool constant = false;      // as a previous map stores it (PreviousMap::ReadTexels)
+  std::vector<float> texels;  // ures x vres, or one value for a constant face (per channel)
 };
+
+// Texels rounded to what a map of `type` stores (half: to the nearest half; float as is).
+void RoundToDataType(PtexDataType type, std::span<float> texels);
 
 struct ProcessedFaces {
   std::vector<FaceStats> stats;       // per Ptex face

@@ -19,6 +19,8 @@
 #include "dispex/vector_space.h"
 #include "extract/extract_meta.h"
 #include "extract/extract_settings.h"
+#include "extract/face_keys.h"
+#include "extract/face_records.h"
 #include "extract/parallel_errors.h"
 #include "extract/process_faces.h"
 #include "extract/uv_maps.h"
@@ -26,17 +28,6 @@
 namespace dispex::extract {
 
 namespace {
-
-// What one face contributes to the report.
-struct VectorFaceStats {
-  std::int64_t samples = 0;
-  float normal_min = 0, normal_max = 0;  // D . N
-  double tangential_max = 0;             // |D - (D . N) N|
-  double length_max = 0;                 // |D|
-  double sum_squares = 0;                // of |D|
-  SpectralFaceStats spectral;
-  std::int8_t ulog2 = 0, vlog2 = 0;
-};
 
 struct VectorScratch {
   explicit VectorScratch(const LimitSurface& surface) : evaluator(surface) {}
@@ -144,13 +135,14 @@ Status ProcessVectorFace(PtexFaceId face, VectorSpace space, const ExtractInputs
     w.cpu_spectral += spectral_clock.seconds();
     if (!analysed->stats.edge_limited || log2 >= max_log2) break;
   }
-  std::span<const float> texels = analysed->texels;
-  if (scale != 1.0f) {
-    w.texels.assign(texels.begin(), texels.end());
-    ScaleTangentChannels(w.texels, 1.0f / scale);
-    ScaleTangentChannels(analysed->constant_value, 1.0f / scale);
-    texels = w.texels;
-  }
+  // The texels as the map stores them, so that a face copied from it later (incremental
+  // extraction) is written from the same values.
+  w.texels.assign(analysed->texels.begin(), analysed->texels.end());
+  ScaleTangentChannels(w.texels, 1.0f / scale);
+  ScaleTangentChannels(analysed->constant_value, 1.0f / scale);
+  RoundToDataType(settings.data_type, w.texels);
+  RoundToDataType(settings.data_type, analysed->constant_value);
+  std::span<const float> texels = w.texels;
   stats.spectral = analysed->stats;
   stats.ulog2 = static_cast<std::int8_t>(analysed->ulog2);
   stats.vlog2 = static_cast<std::int8_t>(analysed->vlog2);
@@ -162,13 +154,58 @@ Status ProcessVectorFace(PtexFaceId face, VectorSpace space, const ExtractInputs
   return written;
 }
 
+// Per Ptex face, what its texels are made from: the settings (SettingsKey) and vector space,
+// its limit patch and sub-face, its planned samples, and the positions of its grid of sculpt
+// vertices in grid order (a face reads the sculpt only inside its own cells, SculptPointAt).
+std::vector<Hash128> VectorFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings,
+                                    const SculptCorrespondence& correspondence, VectorSpace space) {
+  const LimitSurface& surface = inputs.surface;
+  const std::vector<BaseFacePatch> patches = BaseFacePatches(surface);
+  Hasher global;
+  global.Add(SettingsKey(settings)).Add(std::string_view("vector")).Add(VectorSpaceName(space));
+  const Hash128 settings_key = global.Digest();
+  std::vector<Hash128> keys(static_cast<std::size_t>(surface.num_ptex_faces()));
+  tbb::enumerable_thread_specific<std::vector<Float3>> grids;
+  tbb::parallel_for(std::size_t{0}, keys.size(), [&](std::size_t f) {
+    const PtexFaceId face(static_cast<int>(f));
+    const BaseFacePatch& patch = patches[static_cast<std::size_t>(surface.base_face(face).value)];
+    Hasher h;
+    h.Add(settings_key).Add(patch.key[0]).Add(patch.key[1]);
+    h.Add(surface.sub_face(face)).Add(surface.is_hole(face)).Add(settings.plan.log2[f]);
+    const int n = correspondence.grid_size(face);
+    h.Add(n);
+    std::vector<Float3>& grid = grids.local();
+    grid.clear();
+    for (std::int64_t k = correspondence.grid_offsets[f]; k < correspondence.grid_offsets[f + 1];
+         ++k) {
+      grid.push_back(inputs.sculpt.positions[static_cast<std::size_t>(
+          correspondence.grid_vertices[static_cast<std::size_t>(k)].value)]);
+    }
+    h.AddArray(std::span<const Float3>(grid));
+    keys[f] = h.Digest();
+  });
+  return keys;
+}
+
+// Face f of `previous` into `writer`, as it is stored.
+Status CopyVectorFace(PtexFaceId face, const ExtractInputs& inputs, const PreviousMap& previous,
+                      PtexWriter& writer) {
+  KeptFace kept;
+  DISPEX_RETURN_IF_ERROR(previous.ReadTexels(static_cast<std::size_t>(face.value), kept));
+  const PtexFaceInfo info = FaceInfo(inputs, face, kept.ulog2, kept.vlog2);
+  return kept.constant ? writer.SetConstantFace(face, info, kept.texels)
+                       : writer.SetFace(face, info, kept.texels);
+}
+
 Status ProcessVectorFaces(const ExtractOptions& options, const ExtractInputs& inputs,
                           const ExtractSettings& settings,
-                          const SculptCorrespondence& correspondence, PtexWriter& writer,
+                          const SculptCorrespondence& correspondence, std::span<const Hash128> keys,
+                          const PreviousMap* previous, PtexWriter& writer,
                           std::vector<VectorFaceStats>& stats, ExtractReport& report) {
   const VectorSpace space = *options.vector;
   const int num_faces = inputs.surface.num_ptex_faces();
   stats.assign(static_cast<std::size_t>(num_faces), {});
+  std::vector<std::uint8_t> copied(static_cast<std::size_t>(num_faces), 0);
   tbb::enumerable_thread_specific<VectorScratch> scratches(
       [&] { return VectorScratch(inputs.surface); });
   Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", options.progress,
@@ -176,11 +213,18 @@ Status ProcessVectorFaces(const ExtractOptions& options, const ExtractInputs& in
   Status status = ForEachFace(
       num_faces, [](int k) { return k; }, scratches, &bar,
       [&](PtexFaceId face, VectorScratch& w) {
+        const auto f = static_cast<std::size_t>(face.value);
+        if (previous != nullptr && previous->Reusable(f, keys[f])) {
+          stats[f] = previous->vector_record(f);
+          copied[f] = 1;
+          return CopyVectorFace(face, inputs, *previous, writer);
+        }
         return ProcessVectorFace(face, space, inputs, settings, correspondence, writer, w,
-                                 stats[static_cast<std::size_t>(face.value)]);
+                                 stats[f]);
       });
   bar.Finish();
   DISPEX_RETURN_IF_ERROR(status);
+  report.faces_copied = std::count(copied.begin(), copied.end(), 1);
   for (const VectorScratch& w : scratches) {
     report.cpu_limit += w.cpu_limit;
     report.cpu_spectral += w.cpu_spectral;
@@ -229,7 +273,8 @@ StatusOr<PtexWriter> CreateVectorMap(const ExtractOptions& options, const Extrac
 }  // namespace
 
 StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, ExtractInputs inputs,
-                                           ExtractReport report, const Stopwatch& total_clock) {
+                                           ExtractReport report, const Stopwatch& total_clock,
+                                           const PreviousMap* previous) {
   report.vector_space = std::string(VectorSpaceName(*options.vector));
   report.watertight = WatertightEdges::kOff;
   Stopwatch match_clock;
@@ -255,16 +300,25 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
   if (CancelRequested()) return Cancelled();
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateVectorMap(options, inputs));
 
+  Stopwatch keys_clock;
+  const std::vector<Hash128> keys =
+      VectorFaceKeys(inputs, settings, *correspondence, *options.vector);
+  report.t_keys = keys_clock.seconds();
   Stopwatch faces_clock;
   std::vector<VectorFaceStats> stats;
-  DISPEX_RETURN_IF_ERROR(
-      ProcessVectorFaces(options, inputs, settings, *correspondence, writer, stats, report));
-  report.faces_extracted = inputs.surface.num_ptex_faces() - inputs.surface.stats().hole_ptex_faces;
+  DISPEX_RETURN_IF_ERROR(ProcessVectorFaces(options, inputs, settings, *correspondence, keys,
+                                            previous, writer, stats, report));
+  report.faces_extracted = inputs.surface.num_ptex_faces() -
+                           inputs.surface.stats().hole_ptex_faces - report.faces_copied;
   report.t_sample_trace = faces_clock.seconds();
   SumVectorFaces(inputs, settings, stats, report);
 
   Stopwatch write_clock;
   DISPEX_RETURN_IF_ERROR(AddExtractMetaData(writer, inputs.base, report, {}, {}, {}));
+  DISPEX_RETURN_IF_ERROR(
+      writer.AddMetaData(kFaceKeysMetaKey, std::span<const std::int8_t>(EncodeFaceKeys(keys))));
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
+      kVectorFaceRecordsMetaKey, std::span<const std::int8_t>(EncodeVectorFaceRecords(stats))));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData(std::string(kVectorSpaceMetaKey), report.vector_space));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData(std::string(kVectorChannelsMetaKey),
                                             std::string(VectorSpaceChannels(*options.vector))));

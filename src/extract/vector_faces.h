@@ -8,12 +8,15 @@
 #include "core/system.h"
 #include "dispex/extract.h"
 #include "extract/extract_inputs.h"
+#include "extract/previous_map.h"
 
 namespace dispex::extract {
 
 // Steps 2-9 of ExtractShape for ExtractOptions::vector: correspondence, settings (no search
-// distance), faces, totals, the map with its vector meta data.
+// distance), faces, totals, the map with its vector meta data. Faces whose key (VectorFaceKeys)
+// is unchanged in `previous` (a vector map, or null) are copied from it.
 StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, ExtractInputs inputs,
-                                           ExtractReport report, const Stopwatch& total_clock);
+                                           ExtractReport report, const Stopwatch& total_clock,
+                                           const PreviousMap* previous);
 
 }  // namespace dispex::extract
