@@ -54,12 +54,12 @@ namespace {
 // The quads of every block of cells (the mapping's SculptBlocks) whose box meets one of
 // `boxes`, as a mesh (SculptPart). A quad's box lies in its block's, so this holds every quad
 // whose box meets one of them; it reads only the blocks found, not every sculpt face.
-Mesh SculptInBlocksMeeting(const ExtractInputs& inputs, std::span<const BlockBox> boxes) {
+Mesh SculptInBlocksMeeting(const ExtractInputs& inputs, std::span<const Box> boxes) {
   const SculptMapping& mapping = *inputs.mapping;
   const SculptBlocks& blocks = mapping.blocks();
   std::vector<std::uint8_t> keep(inputs.sculpt.num_faces(), 0);
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(blocks.num_blocks()), 0);
-  for (const BlockBox& query : boxes) {
+  for (const Box& query : boxes) {
     blocks.ForEachMeeting(query, [&](std::int64_t id) {
       if (std::exchange(seen[static_cast<std::size_t>(id)], 1)) return;
       const auto [face, bi, bj] = blocks.block(id);
@@ -82,7 +82,7 @@ Mesh SculptInBlocksMeeting(const ExtractInputs& inputs, std::span<const BlockBox
 Mesh SculptNearSegments(const ExtractInputs& inputs, std::span<const Float3> origins,
                         std::span<const Float3> directions, float distance) {
   const double cell = inputs.mapping->blocks().cell_size();
-  std::vector<BlockBox> boxes;
+  std::vector<Box> boxes;
   for (std::size_t k = 0; k < origins.size(); ++k) {
     const double o[3] = {origins[k].x, origins[k].y, origins[k].z};
     const double d[3] = {directions[k].x, directions[k].y, directions[k].z};
@@ -92,7 +92,7 @@ Mesh SculptNearSegments(const ExtractInputs& inputs, std::span<const Float3> ori
     for (int p = 0; p < pieces; ++p) {
       const double t0 = distance * (2.0 * p / pieces - 1),
                    t1 = distance * (2.0 * (p + 1) / pieces - 1);
-      BlockBox& box = boxes.emplace_back();
+      Box& box = boxes.emplace_back();
       for (int a = 0; a < 3; ++a) {
         const double margin = (std::fabs(o[a]) + distance + inputs.tracer_options.scale) * 0x1p-16;
         box.lower[a] = static_cast<float>(o[a] + std::min(t0 * d[a], t1 * d[a]) - margin);
@@ -106,15 +106,10 @@ Mesh SculptNearSegments(const ExtractInputs& inputs, std::span<const Float3> ori
 // SculptWithinReach through the blocks: the quads of every block whose box meets the reach
 // box of a flagged face.
 Mesh SculptNearFaces(const ExtractInputs& inputs, std::span<const std::uint8_t> flagged) {
-  std::vector<BlockBox> boxes;
+  std::vector<Box> boxes;
   for (std::size_t f = 0; f < flagged.size(); ++f) {
     if (!flagged[f] || inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
-    const Box& reach = inputs.face_keys->reach_boxes[f];
-    BlockBox& box = boxes.emplace_back();
-    for (int a = 0; a < 3; ++a) {
-      box.lower[a] = reach.lower[static_cast<std::size_t>(a)];
-      box.upper[a] = reach.upper[static_cast<std::size_t>(a)];
-    }
+    boxes.push_back(inputs.face_keys->reach_boxes[f]);
   }
   return SculptInBlocksMeeting(inputs, boxes);
 }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/hash128.h"
+#include "extract/box.h"
 #include "extract/extract_inputs.h"
 #include "extract/extract_settings.h"
 
@@ -25,9 +26,6 @@ Hash128 SettingsKey(const ExtractSettings& settings);
 // those whose bounding box meets the face's reach box (the patch's box grown by the longest search
 // distance and a margin), as an order-free sum of each sculpt face's key (its corners' positions,
 // in order). The keys do not depend on the thread count.
-struct Box {
-  std::array<float, 3> lower{}, upper{};
-};
 
 struct FaceKeys {
   std::vector<Hash128> keys;     // per Ptex face

@@ -19,7 +19,7 @@ float Window(std::size_t k, const NormalQuery& query, const NormalHits& out) {
 // one with no valid line: a miss by rule).
 bool WindowBox(std::size_t k, std::span<const Float3> origins, std::span<const Float3> normals,
                const NormalQuery& query, const NormalHits& out,
-               std::span<const std::uint8_t> undecided, BlockBox& box) {
+               std::span<const std::uint8_t> undecided, Box& box) {
   if (undecided[k]) return false;
   const Float3& o = origins[k];
   const Float3& d = normals[k];
@@ -45,7 +45,7 @@ bool WindowBox(std::size_t k, std::span<const Float3> origins, std::span<const F
 // Whether sample k's window, the segment o + t n for |t| <= w, meets `box` widened by its
 // rounding margin (in double: a slab test, far tighter than the window's box where n is
 // oblique to the axes).
-bool SegmentMeets(const Float3& o, const Float3& d, double w, const BlockBox& box) {
+bool SegmentMeets(const Float3& o, const Float3& d, double w, const Box& box) {
   const double c[3] = {o.x, o.y, o.z}, n[3] = {d.x, d.y, d.z};
   double t0 = -w, t1 = w;
   for (int a = 0; a < 3; ++a) {
@@ -66,7 +66,7 @@ bool SegmentMeets(const Float3& o, const Float3& d, double w, const BlockBox& bo
   return true;
 }
 
-void Grow(BlockBox& into, const BlockBox& box) {
+void Grow(Box& into, const Box& box) {
   for (int a = 0; a < 3; ++a) {
     into.lower[a] = std::min(into.lower[a], box.lower[a]);
     into.upper[a] = std::max(into.upper[a], box.upper[a]);
@@ -110,7 +110,7 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, i
   const auto num_blocks = static_cast<std::size_t>(per) * static_cast<std::size_t>(per);
   w.sample_boxes.resize(num_blocks);
   w.sample_box_used.assign(num_blocks, 0);
-  BlockBox box;
+  Box box;
   for (std::size_t s = 0; s < count; ++s) {
     const std::size_t k = index(s);
     if (!WindowBox(k, origins, normals, query, out, undecided, box)) continue;
@@ -171,7 +171,7 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, i
         window + (std::max({std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)}) + window) * 0x1p-20);
     for (std::int32_t c = w.candidate_starts[at]; c < w.candidate_starts[at + 1]; ++c) {
       const std::int64_t id = w.candidate_ids[static_cast<std::size_t>(c)];
-      const BlockBox& candidate = blocks.box(id);
+      const Box& candidate = blocks.box(id);
       if (candidate.Meets(box) && SegmentMeets(o, normals[k], window, candidate) &&
           WindowCrossesBlock(mapping, sculpt, id, o, normals[k], reach)) {
         undecided[k] = 1;

@@ -165,7 +165,7 @@ struct MappingScratch {
   std::vector<std::int32_t> near_starts;
   std::vector<std::int64_t> near_ids;
   // The check's buffers: per block of the face its samples' box and its candidates.
-  std::vector<BlockBox> sample_boxes;
+  std::vector<Box> sample_boxes;
   std::vector<std::uint8_t> sample_box_used;
   std::vector<std::int32_t> candidate_starts;
   std::vector<std::int64_t> candidate_ids;

@@ -29,7 +29,7 @@ SculptBlocks SculptBlocks::Build(const SculptMapping& mapping, const Mesh& sculp
     const int b = out.sizes_[f], per = out.per_side_[f];
     for (int bj = 0; bj < per; ++bj) {
       for (int bi = 0; bi < per; ++bi) {
-        BlockBox box;
+        Box box;
         for (int a = 0; a < 3; ++a) {
           box.lower[a] = INFINITY;
           box.upper[a] = -INFINITY;
@@ -56,7 +56,7 @@ SculptBlocks SculptBlocks::Build(const SculptMapping& mapping, const Mesh& sculp
   // The grid: cells about the mean block's largest side, at most about 2 cells per block.
   double lower[3] = {INFINITY, INFINITY, INFINITY}, upper[3] = {-INFINITY, -INFINITY, -INFINITY};
   double side = 0;
-  for (const BlockBox& box : out.boxes_) {
+  for (const Box& box : out.boxes_) {
     double largest = 0;
     for (int a = 0; a < 3; ++a) {
       lower[a] = std::min(lower[a], double(box.lower[a]));
@@ -85,7 +85,7 @@ SculptBlocks SculptBlocks::Build(const SculptMapping& mapping, const Mesh& sculp
   const std::size_t num_cells = static_cast<std::size_t>(out.dims_[0]) * out.dims_[1] *
                                 static_cast<std::size_t>(out.dims_[2]);
   out.starts_.assign(num_cells + 1, 0);
-  auto for_each_cell = [&](const BlockBox& box, auto&& fn) {
+  auto for_each_cell = [&](const Box& box, auto&& fn) {
     int lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
       lo[a] = out.Cell(a, box.lower[a]);
@@ -99,7 +99,7 @@ SculptBlocks SculptBlocks::Build(const SculptMapping& mapping, const Mesh& sculp
       }
     }
   };
-  for (const BlockBox& box : out.boxes_)
+  for (const Box& box : out.boxes_)
     for_each_cell(box, [&](std::size_t c) { ++out.starts_[c + 1]; });
   for (std::size_t c = 0; c < num_cells; ++c) out.starts_[c + 1] += out.starts_[c];
   out.ids_.resize(static_cast<std::size_t>(out.starts_.back()));
@@ -131,7 +131,7 @@ int SculptBlocks::Cell(int axis, float v) const {
 std::size_t SculptBlocks::bytes() const {
   return (sizes_.capacity() + per_side_.capacity()) * sizeof(std::int32_t) +
          (offsets_.capacity() + starts_.capacity()) * sizeof(std::int64_t) +
-         ids_.capacity() * sizeof(std::int32_t) + boxes_.capacity() * sizeof(BlockBox);
+         ids_.capacity() * sizeof(std::int32_t) + boxes_.capacity() * sizeof(Box);
 }
 
 }  // namespace dispex::extract

@@ -9,18 +9,11 @@
 #include <vector>
 
 #include "dispex/mesh.h"
+#include "extract/box.h"
 
 namespace dispex::extract {
 
 class SculptMapping;
-
-struct BlockBox {
-  float lower[3] = {0, 0, 0}, upper[3] = {0, 0, 0};
-  bool Meets(const BlockBox& o) const {
-    return lower[0] <= o.upper[0] && o.lower[0] <= upper[0] && lower[1] <= o.upper[1] &&
-           o.lower[1] <= upper[1] && lower[2] <= o.upper[2] && o.lower[2] <= upper[2];
-  }
-};
 
 class SculptBlocks {
  public:
@@ -38,7 +31,7 @@ class SculptBlocks {
   std::int64_t id(int face, int bi, int bj) const {
     return offsets_[static_cast<std::size_t>(face)] + std::int64_t{bj} * blocks_per_side(face) + bi;
   }
-  const BlockBox& box(std::int64_t id) const { return boxes_[static_cast<std::size_t>(id)]; }
+  const Box& box(std::int64_t id) const { return boxes_[static_cast<std::size_t>(id)]; }
   std::int64_t num_blocks() const { return static_cast<std::int64_t>(boxes_.size()); }
   // The Ptex face and block coordinates (bi, bj) of block `id`.
   struct Place {
@@ -51,7 +44,7 @@ class SculptBlocks {
 
   // Calls fn(id) once for each block whose box meets `query`, in an order fixed by the boxes.
   template <typename Fn>
-  void ForEachMeeting(const BlockBox& query, Fn&& fn) const {
+  void ForEachMeeting(const Box& query, Fn&& fn) const {
     int lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
       lo[a] = Cell(a, query.lower[a]);
@@ -64,7 +57,7 @@ class SculptBlocks {
           const std::size_t c = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0] + x;
           for (std::int64_t k = starts_[c]; k < starts_[c + 1]; ++k) {
             const std::int64_t b = ids_[static_cast<std::size_t>(k)];
-            const BlockBox& box = boxes_[static_cast<std::size_t>(b)];
+            const Box& box = boxes_[static_cast<std::size_t>(b)];
             if (!box.Meets(query)) continue;
             // Once: in the grid cell of the lower corner of the boxes' overlap.
             bool first = true;
@@ -84,7 +77,7 @@ class SculptBlocks {
 
   std::vector<std::int32_t> sizes_, per_side_;  // per Ptex face
   std::vector<std::int64_t> offsets_;           // per Ptex face: its first block's id
-  std::vector<BlockBox> boxes_;                 // per block
+  std::vector<Box> boxes_;                      // per block
   // The grid: cells of side cell_ from origin_, dims_ per axis; each cell's blocks (those
   // whose box overlaps it) at ids_[starts_[c] .. starts_[c + 1]).
   float origin_[3] = {0, 0, 0};
