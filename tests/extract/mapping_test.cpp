@@ -587,6 +587,31 @@ std::string LiftLowerSheet(const TempDir& dir, const std::string& cage, float li
   return WriteObj(sculpt, *lifted).ok() ? sculpt : "";
 }
 
+// The sheets' options: one sample per texel, a search distance of 0.12.
+ExtractOptions SheetOptions(ExtractOptions o) {
+  o = PerSample(o, 3);
+  o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0.12};
+  return o;
+}
+
+// The sheets through the mapping (`mapping`: its report) and through rays (ExtractBothWays):
+// the mapping was used, the misses are the same and no texel differs beyond rounding.
+void ExpectSheetsMatchRays(const TempDir& dir, const std::string& cage, const std::string& sculpt,
+                           ExtractReport& mapping) {
+  auto base = ReadMesh(cage);
+  ASSERT_TRUE(base.ok());
+  auto [through_mapping, rays] = ExtractBothWays(cage, sculpt, dir, SheetOptions);
+  ASSERT_TRUE(through_mapping.ok()) << through_mapping.status().message();
+  ASSERT_TRUE(rays.ok()) << rays.status().message();
+  mapping = *through_mapping;
+  EXPECT_EQ(mapping.method, ExtractMethod::kMapping);
+  EXPECT_EQ(mapping.misses, rays->misses);
+  const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
+  EXPECT_TRUE(t.same_resolutions);
+  EXPECT_GT(t.texels, 0u);
+  EXPECT_EQ(t.beyond, 0u) << t.beyond << " of " << t.texels << " texels differ beyond rounding";
+}
+
 // Two parallel 3 x 3-quad sheets 0.05 apart (two components of one cage); the sculpt is the
 // cage refined 3 times with the lower sheet then lifted 0.08, over the upper one. A sample of
 // the lower sheet's limit surface meets its own sculpt at t = 0.08 in its rings and the other
@@ -599,30 +624,17 @@ TEST(MappingFallback, NearerSheetOfAnotherPartGoesToTheBvh) {
   const std::string cage = WriteSheets(dir, [](int) { return 0.05; });
   const std::string sculpt = LiftLowerSheet(dir, cage, 0.08f);
   ASSERT_FALSE(sculpt.empty());
-  auto base = ReadMesh(cage);
-  ASSERT_TRUE(base.ok());
-  auto fixed = [&](ExtractOptions o) {
-    o = PerSample(o, 3);
-    o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0.12};
-    return o;
-  };
-  auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, fixed);
-  ASSERT_TRUE(mapping.ok()) << mapping.status().message();
-  ASSERT_TRUE(rays.ok()) << rays.status().message();
-  EXPECT_EQ(mapping->method, ExtractMethod::kMapping);
-  EXPECT_GT(mapping->mapping_fallback_samples, 0);
-  EXPECT_LT(mapping->mapping_fallback_samples, mapping->samples);
-  EXPECT_EQ(mapping->misses, rays->misses);
-  const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
-  EXPECT_TRUE(t.same_resolutions);
-  EXPECT_GT(t.texels, 0u);
-  EXPECT_EQ(t.beyond, 0u) << t.beyond << " of " << t.texels << " texels differ beyond rounding";
+  ExtractReport mapping;
+  ExpectSheetsMatchRays(dir, cage, sculpt, mapping);
+  EXPECT_GT(mapping.mapping_fallback_samples, 0);
+  EXPECT_LT(mapping.mapping_fallback_samples, mapping.samples);
 
-  ExtractOptions one = fixed(Options(cage, sculpt, dir / "one.ptx", ExtractMethod::kMapping));
+  ExtractOptions one =
+      SheetOptions(Options(cage, sculpt, dir / "one.ptx", ExtractMethod::kMapping));
   one.threads = 1;
   auto single = Extract(one);
   ASSERT_TRUE(single.ok());
-  EXPECT_EQ(single->mapping_fallback_samples, mapping->mapping_fallback_samples);
+  EXPECT_EQ(single->mapping_fallback_samples, mapping.mapping_fallback_samples);
   EXPECT_EQ(dispex::testing::Slurp(dir / "one.ptx"), dispex::testing::Slurp(dir / "mapping.ptx"));
 }
 
@@ -637,21 +649,9 @@ TEST(MappingFallback, OnlySamplesWhoseLinesCrossAnotherSheetGoToTheBvh) {
   const std::string cage = WriteSheets(dir, [](int i) { return 0.02 + 0.02 * i; });
   const std::string sculpt = LiftLowerSheet(dir, cage, 0.03f);
   ASSERT_FALSE(sculpt.empty());
-  auto base = ReadMesh(cage);
-  ASSERT_TRUE(base.ok());
-  auto fixed = [&](ExtractOptions o) {
-    o = PerSample(o, 3);
-    o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0.12};
-    return o;
-  };
-  auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, fixed);
-  ASSERT_TRUE(mapping.ok()) << mapping.status().message();
-  ASSERT_TRUE(rays.ok()) << rays.status().message();
-  EXPECT_EQ(mapping->method, ExtractMethod::kMapping);
-  EXPECT_EQ(mapping->mapping_fallback_samples, 8 * 48);
-  const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
-  EXPECT_TRUE(t.same_resolutions);
-  EXPECT_EQ(t.beyond, 0u) << t.beyond << " of " << t.texels << " texels differ beyond rounding";
+  ExtractReport mapping;
+  ExpectSheetsMatchRays(dir, cage, sculpt, mapping);
+  EXPECT_EQ(mapping.mapping_fallback_samples, 8 * 48);
 }
 
 // ---- The command line -----------------------------------------------------------------------
