@@ -108,8 +108,7 @@ Status PreviousMap::ReadTexels(std::size_t f, KeptFace& out) const {
   out.ulog2 = info.ulog2;
   out.vlog2 = info.vlog2;
   out.kept = true;
-  out.constant = info.constant;
-  if (info.constant || (info.ulog2 == 0 && info.vlog2 == 0)) {
+  if (info.ulog2 == 0 && info.vlog2 == 0) {
     out.texels.resize(static_cast<std::size_t>(file(f).header().num_channels));
     file(f).ConstantValue(face, out.texels.data());
     return Status::Ok();

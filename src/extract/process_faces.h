@@ -26,7 +26,6 @@ struct WorkerTotals {
 struct KeptFace {
   std::int8_t ulog2 = 0, vlog2 = 0;
   bool kept = false;          // false: a face that missed entirely (written when filled)
-  bool constant = false;      // as a previous map stores it (PreviousMap::ReadTexels)
   std::vector<float> texels;  // ures x vres, or one value for a constant face (per channel)
 };
 

@@ -193,8 +193,8 @@ Status CopyVectorFace(PtexFaceId face, const ExtractInputs& inputs, const Previo
   KeptFace kept;
   DISPEX_RETURN_IF_ERROR(previous.ReadTexels(static_cast<std::size_t>(face.value), kept));
   const PtexFaceInfo info = FaceInfo(inputs, face, kept.ulog2, kept.vlog2);
-  return kept.constant ? writer.SetConstantFace(face, info, kept.texels)
-                       : writer.SetFace(face, info, kept.texels);
+  return kept.ulog2 == 0 && kept.vlog2 == 0 ? writer.SetConstantFace(face, info, kept.texels)
+                                            : writer.SetFace(face, info, kept.texels);
 }
 
 Status ProcessVectorFaces(const ExtractOptions& options, const ExtractInputs& inputs,
