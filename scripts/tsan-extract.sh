@@ -4,7 +4,8 @@
 # binary of a -DDISPEX_TSAN=ON build, loading a libtbb built with TSan
 # (scripts/build-tsan-tbb.sh) so that TBB's own hand-offs between threads are seen; any data
 # race reported fails the run. Nothing is suppressed: libembree3 is not instrumented, so a TSan
-# build runs Embree's BVH build on the calling thread alone (src/trace/embree_scene.cpp).
+# build runs Embree's BVH build on the calling thread alone, and one build or release of a scene
+# at a time across threads (src/trace/embree_scene.cpp).
 #   scripts/tsan-extract.sh [build-dir]
 set -euo pipefail
 build="${1:-build-tsan}"

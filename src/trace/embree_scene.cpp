@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <new>
 
 #include "trace/sculpt_check.h"
@@ -56,7 +57,22 @@ StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Mesh& mesh,
   return scene;
 }
 
+#if defined(__SANITIZE_THREAD__)
+namespace {
+// Under ThreadSanitizer: builds and releases of scenes one at a time across threads. Embree's
+// allocator hands memory a build on one thread freed to a build on another (two shapes
+// extracted side by side), through locks in libembree3 that ThreadSanitizer cannot see.
+std::mutex& EmbreeMemoryLock() {
+  static std::mutex lock;
+  return lock;
+}
+}  // namespace
+#endif
+
 EmbreeScene::~EmbreeScene() {
+#if defined(__SANITIZE_THREAD__)
+  const std::lock_guard<std::mutex> lock(EmbreeMemoryLock());
+#endif
   if (scene_ != nullptr) rtcReleaseScene(scene_);
   // device_ (declared first) is released after the scene that refers to it.
 }
@@ -165,8 +181,12 @@ Status EmbreeScene::Setup(const Mesh& mesh, const TracerOptions& options) {
 #if defined(__SANITIZE_THREAD__)
   // libembree3 is not instrumented: the TBB tasks of its BVH build read a task_group_context
   // on this thread's stack, and ThreadSanitizer cannot see that they finished before the frame
-  // is reused (scripts/tsan-extract.sh). Under TSan the build runs on this thread alone.
-  tbb::task_arena(1).execute([&] { rtcCommitScene(scene_); });
+  // is reused (scripts/tsan-extract.sh). Under TSan the build runs on this thread alone, and
+  // one build at a time (EmbreeMemoryLock).
+  {
+    const std::lock_guard<std::mutex> lock(EmbreeMemoryLock());
+    tbb::task_arena(1).execute([&] { rtcCommitScene(scene_); });
+  }
 #else
   rtcCommitScene(scene_);
 #endif
