@@ -89,14 +89,17 @@ Mesh SculptNearSegments(const ExtractInputs& inputs, std::span<const Float3> ori
     const double length =
         2.0 * distance * std::max({std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])});
     const int pieces = static_cast<int>(std::clamp(std::ceil(length / cell), 1.0, 4096.0));
+    double margin[3];
+    for (int a = 0; a < 3; ++a) {
+      margin[a] = (std::fabs(o[a]) + distance + inputs.tracer_options.scale) * 0x1p-16;
+    }
     for (int p = 0; p < pieces; ++p) {
       const double t0 = distance * (2.0 * p / pieces - 1),
                    t1 = distance * (2.0 * (p + 1) / pieces - 1);
       Box& box = boxes.emplace_back();
       for (int a = 0; a < 3; ++a) {
-        const double margin = (std::fabs(o[a]) + distance + inputs.tracer_options.scale) * 0x1p-16;
-        box.lower[a] = static_cast<float>(o[a] + std::min(t0 * d[a], t1 * d[a]) - margin);
-        box.upper[a] = static_cast<float>(o[a] + std::max(t0 * d[a], t1 * d[a]) + margin);
+        box.lower[a] = static_cast<float>(o[a] + std::min(t0 * d[a], t1 * d[a]) - margin[a]);
+        box.upper[a] = static_cast<float>(o[a] + std::max(t0 * d[a], t1 * d[a]) + margin[a]);
       }
     }
   }

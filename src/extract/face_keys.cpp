@@ -251,16 +251,21 @@ FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& set
 
   out.keys.resize(num_faces);
   tbb::parallel_for(std::size_t{0}, num_faces, [&](std::size_t f) {
-    const PtexFaceId face(static_cast<int>(f));
-    const BaseFacePatch& patch = patches[static_cast<std::size_t>(surface.base_face(face).value)];
     Hasher h;
     h.Add(settings_key);
-    h.Add(patch.key[0]).Add(patch.key[1]);
-    h.Add(surface.sub_face(face)).Add(skip[f]).Add(settings.plan.log2[f]);
+    AddFacePatchKey(h, surface, patches, settings, f);
     h.Add(sculpt[f]);
     out.keys[f] = h.Digest();
   });
   return out;
+}
+
+void AddFacePatchKey(Hasher& h, const LimitSurface& surface, std::span<const BaseFacePatch> patches,
+                     const ExtractSettings& settings, std::size_t f) {
+  const PtexFaceId face(static_cast<int>(f));
+  const BaseFacePatch& patch = patches[static_cast<std::size_t>(surface.base_face(face).value)];
+  h.Add(patch.key[0]).Add(patch.key[1]);
+  h.Add(surface.sub_face(face)).Add(surface.is_hole(face)).Add(settings.plan.log2[f]);
 }
 
 Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,

@@ -21,6 +21,12 @@ Hash128 MeshContentKey(const Mesh& mesh);
 // watertight mode, sampling caps) and the version of the pipeline.
 Hash128 SettingsKey(const ExtractSettings& settings);
 
+// Adds to `h` what every kind of map's key of Ptex face `f` holds besides its settings and
+// its sculpt: the face's limit patch (`patches`: BaseFacePatches), its sub-face, whether it is
+// a hole, and its planned samples.
+void AddFacePatchKey(Hasher& h, const LimitSurface& surface, std::span<const BaseFacePatch> patches,
+                     const ExtractSettings& settings, std::size_t f);
+
 // Per Ptex face: SettingsKey and the tracer's scale (TracerStats::scale), the face's limit patch
 // (BaseFacePatches) and sub-face, its planned samples, and every sculpt face its rays can reach:
 // those whose bounding box meets the face's reach box (the patch's box grown by the longest search

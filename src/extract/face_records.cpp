@@ -9,14 +9,18 @@ namespace {
 
 // Writes or reads the same fields in the same order: one function for both directions.
 template <class Io>
+void Fields(Io& io, SpectralFaceStats& p) {
+  io(p.texels_before), io(p.texels_after), io(p.bound), io(p.measured_error);
+  io(p.bound_ulog2), io(p.bound_vlog2), io(p.step_ups), io(p.constant), io(p.edge_error);
+  io(p.edge_limited);
+}
+
+template <class Io>
 void Fields(Io& io, FaceRecord& r) {
   FaceStats& s = r.stats;
   io(s.samples), io(s.misses), io(s.recovered), io(s.filled), io(s.hits_negative);
   io(s.hits_opposed), io(s.all_missed), io(s.min), io(s.max), io(s.sum_squares);
-  SpectralFaceStats& p = s.spectral;
-  io(p.texels_before), io(p.texels_after), io(p.bound), io(p.measured_error);
-  io(p.bound_ulog2), io(p.bound_vlog2), io(p.step_ups), io(p.constant), io(p.edge_error);
-  io(p.edge_limited);
+  Fields(io, s.spectral);
   io(s.ulog2), io(s.vlog2), io(s.rays), io(s.fallback_normals);
   for (float& m : r.edge_means.mean) io(m);
 }
@@ -25,10 +29,7 @@ template <class Io>
 void Fields(Io& io, VectorFaceStats& s) {
   io(s.samples), io(s.normal_min), io(s.normal_max), io(s.tangential_max), io(s.length_max);
   io(s.sum_squares);
-  SpectralFaceStats& p = s.spectral;
-  io(p.texels_before), io(p.texels_after), io(p.bound), io(p.measured_error);
-  io(p.bound_ulog2), io(p.bound_vlog2), io(p.step_ups), io(p.constant), io(p.edge_error);
-  io(p.edge_limited);
+  Fields(io, s.spectral);
   io(s.ulog2), io(s.vlog2);
 }
 

@@ -15,6 +15,13 @@ float Window(std::size_t k, const NormalQuery& query, const NormalHits& out) {
   return hit && query.policy == HitPolicy::kNearest ? std::fabs(out.t[k]) : query.distance;
 }
 
+// Each bound of the window o -+ w |n| is within a few roundings of the exact one; 2^-20 of the
+// magnitudes covers them, and the smallest normal float covers underflow.
+float RoundingMargin(const Float3& o, float w) {
+  const float scale = std::max({std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)}) + w;
+  return scale * 0x1p-20f + 0x1p-126f;
+}
+
 // The box of sample k's window, or false when it has none to check (a sample not decided, or
 // one with no valid line: a miss by rule).
 bool WindowBox(std::size_t k, std::span<const Float3> origins, std::span<const Float3> normals,
@@ -30,10 +37,7 @@ bool WindowBox(std::size_t k, std::span<const Float3> origins, std::span<const F
   if (n[0] == 0 && n[1] == 0 && n[2] == 0) return false;
   const float w = Window(k, query, out);
   if (!std::isfinite(w)) return false;
-  const float scale = std::max({std::fabs(c[0]), std::fabs(c[1]), std::fabs(c[2])}) + w;
-  // Each bound is within a few roundings of the exact o -+ w |n|; 2^-20 of the magnitudes
-  // covers them, and the smallest normal float covers underflow.
-  const float e = scale * 0x1p-20f + 0x1p-126f;
+  const float e = RoundingMargin(o, w);
   for (int a = 0; a < 3; ++a) {
     const float r = w * std::fabs(n[a]);
     box.lower[a] = c[a] - r - e;
@@ -164,11 +168,10 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, i
     const std::size_t at = block_of(k);
     if (w.candidate_starts[at] == w.candidate_starts[at + 1]) continue;
     if (!WindowBox(k, origins, normals, query, out, undecided, box)) continue;
-    const double window = Window(k, query, out);
+    const float window = Window(k, query, out);
     // A crossing within rounding beyond the window's end counts: the ray path may find it inside.
     const Float3& o = origins[k];
-    const auto reach = static_cast<float>(
-        window + (std::max({std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)}) + window) * 0x1p-20);
+    const float reach = window + RoundingMargin(o, window);
     for (std::int32_t c = w.candidate_starts[at]; c < w.candidate_starts[at + 1]; ++c) {
       const std::int64_t id = w.candidate_ids[static_cast<std::size_t>(c)];
       const Box& candidate = blocks.box(id);

@@ -38,16 +38,12 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces, bo
     return ignore(fmt::format("has {} faces, the base now {}", file->num_faces(), num_faces));
   }
   auto decoded_keys = DecodeFaceKeys(keys->bytes, num_faces);
-  if (vector) {
-    auto decoded = DecodeVectorFaceRecords(records->bytes, num_faces);
-    if (!decoded_keys || !decoded) return ignore("has malformed face keys");
-    out.vector_records_ = std::move(*decoded);
-  } else {
-    auto decoded = DecodeFaceRecords(records->bytes, num_faces);
-    if (!decoded_keys || !decoded) return ignore("has malformed face keys");
-    out.records_ = std::move(*decoded);
-  }
+  auto scalar = vector ? std::nullopt : DecodeFaceRecords(records->bytes, num_faces);
+  auto vectors = vector ? DecodeVectorFaceRecords(records->bytes, num_faces) : std::nullopt;
+  if (!decoded_keys || !(scalar || vectors)) return ignore("has malformed face keys");
   out.keys_ = std::move(*decoded_keys);
+  if (scalar) out.records_ = std::move(*scalar);
+  if (vectors) out.vector_records_ = std::move(*vectors);
   out.files_.push_back(std::move(*file));
   return out;
 }

@@ -137,12 +137,15 @@ Status ProcessVectorFace(PtexFaceId face, VectorSpace space, const ExtractInputs
   }
   // The texels as the map stores them, so that a face copied from it later (incremental
   // extraction) is written from the same values.
-  w.texels.assign(analysed->texels.begin(), analysed->texels.end());
-  ScaleTangentChannels(w.texels, 1.0f / scale);
-  ScaleTangentChannels(analysed->constant_value, 1.0f / scale);
-  RoundToDataType(settings.data_type, w.texels);
-  RoundToDataType(settings.data_type, analysed->constant_value);
-  std::span<const float> texels = w.texels;
+  std::span<const float> texels = analysed->texels;
+  if (scale != 1.0f || settings.data_type == PtexDataType::kHalf) {
+    w.texels.assign(texels.begin(), texels.end());
+    ScaleTangentChannels(w.texels, 1.0f / scale);
+    ScaleTangentChannels(analysed->constant_value, 1.0f / scale);
+    RoundToDataType(settings.data_type, w.texels);
+    RoundToDataType(settings.data_type, analysed->constant_value);
+    texels = w.texels;
+  }
   stats.spectral = analysed->stats;
   stats.ulog2 = static_cast<std::int8_t>(analysed->ulog2);
   stats.vlog2 = static_cast<std::int8_t>(analysed->vlog2);
@@ -167,13 +170,10 @@ std::vector<Hash128> VectorFaceKeys(const ExtractInputs& inputs, const ExtractSe
   std::vector<Hash128> keys(static_cast<std::size_t>(surface.num_ptex_faces()));
   tbb::enumerable_thread_specific<std::vector<Float3>> grids;
   tbb::parallel_for(std::size_t{0}, keys.size(), [&](std::size_t f) {
-    const PtexFaceId face(static_cast<int>(f));
-    const BaseFacePatch& patch = patches[static_cast<std::size_t>(surface.base_face(face).value)];
     Hasher h;
-    h.Add(settings_key).Add(patch.key[0]).Add(patch.key[1]);
-    h.Add(surface.sub_face(face)).Add(surface.is_hole(face)).Add(settings.plan.log2[f]);
-    const int n = correspondence.grid_size(face);
-    h.Add(n);
+    h.Add(settings_key);
+    AddFacePatchKey(h, surface, patches, settings, f);
+    h.Add(correspondence.grid_size(PtexFaceId(static_cast<int>(f))));
     std::vector<Float3>& grid = grids.local();
     grid.clear();
     for (std::int64_t k = correspondence.grid_offsets[f]; k < correspondence.grid_offsets[f + 1];
