@@ -21,6 +21,7 @@ namespace {
 
 constexpr FlagName kBatchFlags[] = {
     {"shard_count", "--shard"},
+    {"shard_sculpt", "--shard-sculpt"},
     {"threads", "--threads"},
 };
 
@@ -29,6 +30,7 @@ struct BatchArgs {
   std::string asset;
   std::string shard;
   std::string parts_dir;
+  std::string shard_sculpt = "whole";
   std::string report_path;
   int threads = 0;
   bool incremental = false;
@@ -56,6 +58,11 @@ int RunBatch(BatchArgs& args) {
     ExtractOptions& o = assets->front().options;
     Status parsed = ParseShard(args.shard, o.shard_index, o.shard_count);
     if (!parsed.ok()) return ReportFailure(parsed.WithPrefix("--shard"), 2);
+    auto shard_sculpt = ParseShardSculpt(args.shard_sculpt);
+    if (!shard_sculpt.ok()) {
+      return ReportFailure(shard_sculpt.status().WithPrefix("--shard-sculpt"), 2);
+    }
+    o.shard_sculpt = *shard_sculpt;
     o.output_path = PartPath(args.parts_dir, args.asset, o.shard_index, o.shard_count);
   } else if (!args.parts_dir.empty()) {
     return ReportFailure(Status::Error("--parts-dir needs --shard"), 2);
@@ -120,6 +127,9 @@ void SetupBatch(CLI::App& app, int& exit_code) {
                   "`dispex farm` jobs run)");
   cmd->add_option("--parts-dir", args->parts_dir,
                   "with --shard: the part is DIR/<asset>.part-I-of-N.ptx");
+  cmd->add_option("--shard-sculpt", args->shard_sculpt,
+                  "with --shard: what the shard keeps of the sculpt, whole or part (docs/FARM.md)")
+      ->capture_default_str();
   cmd->add_option("--threads", args->threads, "worker threads (0: all cores)")
       ->capture_default_str();
   cmd->add_flag("--incremental", args->incremental,

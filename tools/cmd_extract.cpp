@@ -35,6 +35,7 @@ constexpr FlagName kExtractFlags[] = {
     {"output_dir", "--out-dir"},
     {"method", "--method"},
     {"shard_count", "--shard"},
+    {"shard_sculpt", "--shard-sculpt"},
     {"uv_maps_dir", "--uv-maps"},
     {"uv_resolution", "--uv-resolution"},
     {"uv_padding", "--uv-padding"},
@@ -61,6 +62,7 @@ struct ExtractArgs {
   std::vector<std::string> shapes;
   std::string manifest_path;
   std::string shard;
+  std::string shard_sculpt = "whole";
   bool quiet = false;
 
   bool asset() const { return !output_dir.empty() || !manifest_path.empty(); }
@@ -168,6 +170,9 @@ Status Resolve(ExtractArgs& a) {
     Status shard = ParseShard(a.shard, o.shard_index, o.shard_count);
     if (!shard.ok()) return shard.WithPrefix("--shard");
   }
+  auto shard_sculpt = ParseShardSculpt(a.shard_sculpt);
+  if (!shard_sculpt.ok()) return shard_sculpt.status().WithPrefix("--shard-sculpt");
+  o.shard_sculpt = *shard_sculpt;
   if (!a.max_memory.empty()) {
     auto bytes = ParseBytes(a.max_memory);
     if (!bytes.ok()) return bytes.status();
@@ -355,6 +360,10 @@ void SetupExtract(CLI::App& app, int& exit_code) {
   cmd->add_option("--shard", args->shard,
                   "I/N: extract only the I-th of N shards of the faces (balanced by estimated "
                   "cost) into a part for `dispex merge` (docs/FARM.md)");
+  cmd->add_option("--shard-sculpt", args->shard_sculpt,
+                  "what a shard keeps of the sculpt: whole, or part (only what its faces' rays "
+                  "reach: memory falls with N; needs --method rays and --search-distance)")
+      ->capture_default_str();
   cmd->add_option("--report", args->report_path, "write a JSON report to this file");
   cmd->add_option("--preview", args->preview_dir,
                   "also write DIR/<map>_atlas.png and DIR/<map>_compare.png (base and base + "

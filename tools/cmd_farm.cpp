@@ -29,6 +29,7 @@ struct FarmArgs {
   std::string partition, time, mem;
   int cpus = 0;
   std::vector<std::string> sbatch_args;
+  std::string shard_sculpt = "whole";
   bool dry_run = false;
 };
 
@@ -99,8 +100,8 @@ Scripts WriteScripts(const FarmArgs& a, const std::vector<BatchAsset>& assets,
   s += "shard=$((SLURM_ARRAY_TASK_ID % shards + 1))\n";
   s += fmt::format(
       "exec {} batch {} --asset \"$asset\" --shard \"$shard/$shards\" --parts-dir {} "
-      "--threads \"${{SLURM_CPUS_PER_TASK:-0}}\" -q\n",
-      Quote(dispex), Quote(manifest), Quote(parts));
+      "--shard-sculpt {} --threads \"${{SLURM_CPUS_PER_TASK:-0}}\" -q\n",
+      Quote(dispex), Quote(manifest), Quote(parts), a.shard_sculpt);
   out.shards = s;
   for (const BatchAsset& asset : assets) {
     std::string m =
@@ -151,9 +152,25 @@ StatusOr<std::string> Submit(const FarmArgs& a, const std::string& extra,
 
 int RunFarmSlurm(FarmArgs& a) {
   if (a.shards < 1) return ReportFailure(Status::Error("--shards: must be 1 or more"), 2);
+  auto shard_sculpt = ParseShardSculpt(a.shard_sculpt);
+  if (!shard_sculpt.ok())
+    return ReportFailure(shard_sculpt.status().WithPrefix("--shard-sculpt"), 2);
   ExtractOptions defaults;
   auto assets = ReadBatchManifest(a.manifest, defaults);
   if (!assets.ok()) return ReportFailure(assets.status(), 2);
+  for (const BatchAsset& asset : *assets) {
+    if (*shard_sculpt == ShardSculpt::kWhole) break;
+    // A part needs options of its own: checked before anything is submitted.
+    ExtractOptions o = asset.options;
+    o.shard_index = 1;
+    o.shard_count = a.shards;
+    o.shard_sculpt = *shard_sculpt;
+    Status valid = ValidateExtractOptions(o);
+    if (!valid.ok()) {
+      return ReportFailure(valid.WithPrefix(fmt::format("{}: asset {}", a.manifest, asset.name)),
+                           2);
+    }
+  }
   std::string dispex = a.dispex;
   if (dispex.empty()) {
     auto self = ThisBinary();
@@ -231,6 +248,10 @@ void SetupFarm(CLI::App& app, int& exit_code) {
   cmd->add_option("--sbatch-arg", args->sbatch_args,
                   "another #SBATCH line for every job, e.g. --sbatch-arg=--account=fx");
   cmd->add_option("--sbatch", args->sbatch, "the sbatch to run")->capture_default_str();
+  cmd->add_option("--shard-sculpt", args->shard_sculpt,
+                  "what each shard keeps of the sculpt: whole, or part (memory falls with "
+                  "--shards; needs method rays and a given search_distance; docs/FARM.md)")
+      ->capture_default_str();
   cmd->add_flag("--dry-run", args->dry_run, "write the scripts, print their paths, submit nothing");
   cmd->callback([args, &exit_code] { exit_code = RunFarmSlurm(*args); });
 }

@@ -66,6 +66,11 @@ enum class ExtractMethod : std::uint8_t {
 std::string_view ExtractMethodName(ExtractMethod method);  // "auto", "rays", "mapping"
 StatusOr<ExtractMethod> ParseExtractMethod(std::string_view name);
 
+// What a farm shard keeps of the sculpt (ExtractOptions::shard_sculpt).
+enum class ShardSculpt : std::uint8_t { kWhole, kPart };
+std::string_view ShardSculptName(ShardSculpt s);  // "whole", "part"
+StatusOr<ShardSculpt> ParseShardSculpt(std::string_view name);
+
 struct ExtractOptions {
   std::string base_path;
   std::string sculpt_path;
@@ -158,6 +163,16 @@ struct ExtractOptions {
   // writes, byte for byte. Scalar maps of one shape only.
   int shard_index = 0;
   int shard_count = 0;
+  // What a shard keeps of the sculpt. kWhole: all of it, read, matched and traced (its memory
+  // does not fall with shard_count). kPart: the sculpt within reach of its faces (its BVH's
+  // part; the rest is released once the faces' keys are made), so each shard's memory falls
+  // with shard_count; it needs method kRays and a given search_distance (the correspondence
+  // and the automatic search distance read the whole sculpt). Hits do not depend on the BVH's
+  // extent at shared edges, vertices and folds (the tie rule, dispex/trace.h); only where two
+  // sheets of the sculpt that share no vertex cross within float rounding of each other on a
+  // sample's line may a part's hit differ from the whole's (docs/FARM.md). Not an option of
+  // the map: it is not recorded, and a merge does not check it.
+  ShardSculpt shard_sculpt = ShardSculpt::kWhole;
 };
 
 // The face table of every map of `surface`, taken from the limit surface (OpenSubdiv's Ptex

@@ -138,7 +138,11 @@ struct TraceCounters {
   // Closest-point queries cast no rays.
   std::uint64_t rays_cast = 0;
   std::uint64_t repair_rays = 0;  // of rays_cast, the vertex guard's
-  std::uint64_t hits = 0;         // queries that found something
+  // Hits within the tie band of a sculpt edge or vertex, resolved by the tie rule (the hit
+  // contract below; src/trace/batch_kernels.h, kEdgeBand). Which hits count may differ in the
+  // last bit of Embree's (u, v) between BVHs (not what they resolve to).
+  std::uint64_t tie_hits = 0;
+  std::uint64_t hits = 0;  // queries that found something
   TraceCounters& operator+=(const TraceCounters& other);
 };
 
@@ -178,8 +182,11 @@ struct TracerStats {
   std::int64_t backend_bytes = 0;       // bytes the backend holds now (BVH, its buffers)
   std::int64_t backend_peak_bytes = 0;  // peak during the build
   std::size_t copied_bytes = 0;         // bytes dispex copied from the mesh (0 when all shared)
-  bool shared_vertices = false;         // Embree reads mesh.positions in place
-  bool shared_indices = false;          // Embree reads mesh.face_indices in place
+  // The primitives around each vertex, for the tie rule at shared edges and vertices (the hit
+  // contract below): 4 bytes per vertex and per face corner.
+  std::size_t vertex_table_bytes = 0;
+  bool shared_vertices = false;  // Embree reads mesh.positions in place
+  bool shared_indices = false;   // Embree reads mesh.face_indices in place
   // TracerOptions::scale as used (the scene's largest |coordinate| when it was 0): the rounding
   // margins and sideways steps of the queries scale with it, so hits depend on it in rare cases.
   float scale = 0;
@@ -203,9 +210,14 @@ struct TracerStats {
 //  - Direction components smaller than 2^-24 of the largest are taken as exactly zero: they
 //    move a point on the ray by less than float rounding (and Embree's coherent 8-wide packets
 //    lose rays that carry them).
+//  - Ties: a normal query's hit within 2^-12 (of its triangle's barycentrics) of an edge or a
+//    vertex is taken on the triangle around that edge or vertex whose plane gives the least
+//    t (within the window margin), then the lowest sculpt face: whichever face Embree
+//    reported there, under any ISA, ray mode or BVH, even one of part of the sculpt. The back
+//    side flag is that triangle's.
 //  - Of two surfaces closer together along the ray than Embree's rounding (~1e-7 of the
-//    scale), which one is nearest is Embree's call. At a shared edge or vertex two ISAs may
-//    pick different faces: then t differs by rounding (up to ~1e-5 relative for grazing rays).
+//    scale) and not sharing an edge or vertex, which one is nearest is Embree's call (and
+//    for Intersect, at shared edges too: then t differs by rounding).
 
 class Tracer {
  public:

@@ -109,22 +109,25 @@ std::string RedoReason(const PreviousMap& previous, const ExtractReport& report)
 // if the edge pass asks for a face beyond (EnsureTraced).
 constexpr int kLocalRings = 2;
 
-// The tracer of an incremental run with a given search distance: the sculpt within reach of
-// the faces whose first pass runs (not copied) and of the faces kLocalRings around them; the
-// whole sculpt when that is most of it.
+// The tracer of an incremental run, a merge or a shard with a given search distance: the
+// sculpt within reach of the faces whose first pass runs (not copied; a shard's own) and of
+// the faces `rings` around them; the whole sculpt when that is most of it. Hits do not depend
+// on the BVH's extent (the tie rule, dispex/trace.h), so the map's bytes do not either.
 Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previous,
-                        const FaceKeys& keys, ExtractInputs& inputs, ExtractReport& report) {
+                        std::span<const std::uint8_t> in_shard, int rings, const FaceKeys& keys,
+                        ExtractInputs& inputs, ExtractReport& report) {
   const auto n = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
   std::vector<std::uint8_t> traced(n, 0);
   std::vector<int> ring;
   for (std::size_t f = 0; f < n; ++f) {
     if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
-    if (!previous.Reusable(f, keys.keys[f])) {
+    if (!in_shard.empty() && !in_shard[f]) continue;
+    if (!previous.usable() || !previous.Reusable(f, keys.keys[f])) {
       traced[f] = 1;
       ring.push_back(static_cast<int>(f));
     }
   }
-  for (int step = 0; step < kLocalRings && !ring.empty(); ++step) {
+  for (int step = 0; step < rings && !ring.empty(); ++step) {
     std::vector<int> next;
     for (int f : ring) {
       for (std::int32_t g : inputs.faces[static_cast<std::size_t>(f)].adjfaces) {
@@ -137,7 +140,7 @@ Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previo
     ring = std::move(next);
   }
   const auto count = static_cast<std::size_t>(std::count(traced.begin(), traced.end(), 1));
-  if (2 * count > n) return BuildTracer(options, inputs, report);
+  if (in_shard.empty() && 2 * count > n) return BuildTracer(options, inputs, report);
   SetTracerOptions(options, inputs);
   Stopwatch clock;
   Mesh part = SculptWithinReach(inputs, keys, traced);
@@ -226,11 +229,11 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   DISPEX_RETURN_IF_ERROR(ChooseMethod(options, inputs, report));
   const bool mapping = inputs.mapping != nullptr;
   // The automatic search distance is estimated with rays over the whole surface; a given one
-  // lets an incremental run or a merge trace only the sculpt within reach of the faces it
-  // extracts. A shard traces against the whole sculpt: a BVH of part of it may answer a ray
-  // that meets two sculpt triangles at once with the other one (docs/FARM.md).
+  // lets an incremental run, a merge or a shard of ShardSculpt::kPart trace only the sculpt
+  // within reach of the faces it extracts.
   const bool local = !mapping && options.search_distance.kind != SearchDistanceSpec::Kind::kAuto &&
-                     previous.usable() && (options.incremental || merge);
+                     ((previous.usable() && (options.incremental || merge)) ||
+                      (shard && options.shard_sculpt == ShardSculpt::kPart));
   if (mapping) {
     SetTracerOptions(options, inputs);
   } else if (!local) {
@@ -253,7 +256,13 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
     in_shard.assign(num_faces, 0);
     std::fill(in_shard.begin() + range.begin, in_shard.begin() + range.end, 1);
   }
-  if (local) DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, face_keys, inputs, report));
+  if (local) {
+    DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, in_shard, shard ? 0 : kLocalRings,
+                                            face_keys, inputs, report));
+    // A shard needs no more of the sculpt than its BVH holds (no stage crosses faces): its
+    // memory falls with the shard count.
+    if (shard && !inputs.traced.empty()) ReleaseSculpt(inputs);
+  }
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateMap(options, inputs));
 
   Stopwatch faces_clock;

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "core/check.h"
 #include "core/system.h"
 #include "dispex/cancel.h"
 #include "extract/face_keys.h"
@@ -198,8 +199,15 @@ Status BuildPartTracer(Mesh part, std::vector<std::uint8_t> traced, ExtractInput
   return Status::Ok();
 }
 
+void ReleaseSculpt(ExtractInputs& inputs) {
+  Mesh released;
+  released.source = inputs.sculpt.source;
+  inputs.sculpt = std::move(released);
+}
+
 Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces) {
   if (inputs.traced.empty()) return Status::Ok();
+  DISPEX_CHECK(inputs.sculpt.num_faces() > 0);  // not after ReleaseSculpt
   for (int f : faces) {
     if (inputs.traced[static_cast<std::size_t>(f)]) continue;
     DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, inputs.tracer_options));

@@ -71,4 +71,8 @@ Status BuildPartTracer(Mesh part, std::vector<std::uint8_t> traced, ExtractInput
 // everything their rays can reach.
 Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces);
 
+// Frees the sculpt's arrays (its source stays) once a part's tracer holds all a run needs: a
+// shard's, whose faces' keys, settings and BVH are made. EnsureTraced must not be called then.
+void ReleaseSculpt(ExtractInputs& inputs);
+
 }  // namespace dispex::extract

@@ -69,6 +69,17 @@ StatusOr<ExtractMethod> ParseExtractMethod(std::string_view name) {
   return Status::Error(fmt::format("unknown method '{}' (expected auto, rays or mapping)", name));
 }
 
+std::string_view ShardSculptName(ShardSculpt s) {
+  return s == ShardSculpt::kPart ? "part" : "whole";
+}
+
+StatusOr<ShardSculpt> ParseShardSculpt(std::string_view name) {
+  for (ShardSculpt s : {ShardSculpt::kWhole, ShardSculpt::kPart}) {
+    if (name == ShardSculptName(s)) return s;
+  }
+  return Status::Error(fmt::format("unknown shard sculpt '{}' (expected whole or part)", name));
+}
+
 namespace {
 bool IsPowerOfTwoIn(int v, int lo, int hi) {
   return v >= lo && v <= hi && std::has_single_bit(static_cast<unsigned>(v));
@@ -148,6 +159,13 @@ Status ValidateExtractOptions(const ExtractOptions& o) {
   if (o.shard_count > 0 && o.vector) {
     return Status::Error(
         "shard_count: vector maps are not made in shards (only scalar maps; docs/FARM.md)");
+  }
+  if (o.shard_count > 0 && o.shard_sculpt == ShardSculpt::kPart &&
+      (o.method != ExtractMethod::kRays ||
+       o.search_distance.kind == SearchDistanceSpec::Kind::kAuto)) {
+    return Status::Error(
+        "shard_sculpt part: needs method rays and a given search_distance (the correspondence "
+        "and the automatic search distance read the whole sculpt)");
   }
   SpectralOptions spectral;
   spectral.rule = o.resolution_rule;

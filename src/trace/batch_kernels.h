@@ -28,7 +28,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <span>
+#include <tuple>
 
 #include "core/vec3.h"
 #include "dispex/trace.h"
@@ -54,8 +56,9 @@ struct Candidate {
   float t = 0;
   unsigned geom = RTC_INVALID_GEOMETRY_ID;
   unsigned prim = 0;
-  bool back = false;  // dot(ray direction, Ng) > 0
-  Float3 ng;          // Embree's unnormalised geometric normal
+  bool back = false;   // dot(ray direction, Ng) > 0
+  Float3 ng;           // Embree's unnormalised geometric normal
+  float u = 0, v = 0;  // Embree's (u, v) on the primitive (the tie rule's)
   bool hit() const { return geom != RTC_INVALID_GEOMETRY_ID; }
 };
 
@@ -103,26 +106,52 @@ template <class Caster>
   return shift;
 }
 
-// The hit's t as dispex reports it: the line o + t d (the query's own origin, even when Embree
-// was given one moved sideways) at the plane of the hit triangle, in double, rounded once.
-// Of a quad's two triangles (v0 v1 v3) and (v2 v3 v1) Embree reports the second with
-// u + v > 1. Identical under every ISA for the same triangle; Embree's own t (`fallback`) only
-// for a degenerate one.
-inline float ExactT(const EmbreeScene& scene, unsigned geom, unsigned prim, float u, float v,
-                    const Float3& o, const Float3& d, float fallback) {
-  const GeometryView& g = scene.geometry(geom);
-  const std::int32_t* ids = g.indices + static_cast<std::size_t>(g.corners) * prim;
-  const Float3* p = scene.positions();
-  const bool second = g.corners == 4 && u + v > 1;
-  const Float3& fa = p[ids[second ? 2 : 0]];
-  const Float3& fb = p[ids[second ? 3 : 1]];
-  const Float3& fc = p[ids[second ? 1 : (g.corners == 4 ? 3 : 2)]];
+// The triangle of primitive `prim` that Embree's (u, v) fall in, its corners in ExactT's order,
+// and (u, v)'s barycentric weights of those corners. Of a quad's two triangles (v0 v1 v3) and
+// (v2 v3 v1) Embree reports the second with u + v > 1 (and (u, v) over the whole quad).
+struct HitTriangle {
+  std::int32_t ids[3];
+  float weights[3];
+  bool second = false;
+};
+inline HitTriangle TriangleOf(const GeometryView& g, unsigned prim, float u, float v) {
+  const std::int32_t* c = g.indices + static_cast<std::size_t>(g.corners) * prim;
+  if (g.corners == 3) return HitTriangle{{c[0], c[1], c[2]}, {1 - u - v, u, v}, false};
+  if (u + v > 1) return HitTriangle{{c[2], c[3], c[1]}, {u + v - 1, 1 - u, 1 - v}, true};
+  return HitTriangle{{c[0], c[1], c[3]}, {1 - u - v, u, v}, false};
+}
+
+// Where the line o + t d meets the plane of triangle ids[], in double, rounded once (NaN when
+// degenerate or parallel), and whether d points along its right-hand normal (the back side).
+struct PlaneHit {
+  float t;
+  bool back;
+};
+inline PlaneHit PlaneOf(const Float3* p, const std::int32_t ids[3], const Float3& o,
+                        const Float3& d) {
+  const Float3& fa = p[ids[0]];
   const Vec3d a = ToVec3d(fa);
-  const Vec3d n = Cross(ToVec3d(fb) - a, ToVec3d(fc) - a);
+  const Vec3d n = Cross(ToVec3d(p[ids[1]]) - a, ToVec3d(p[ids[2]]) - a);
   const double den = n.x * d.x + n.y * d.y + n.z * d.z;
   const double t =
       (n.x * (double(fa.x) - o.x) + n.y * (double(fa.y) - o.y) + n.z * (double(fa.z) - o.z)) / den;
-  return std::isfinite(t) ? static_cast<float>(t) : fallback;
+  return PlaneHit{
+      std::isfinite(t) ? static_cast<float>(t) : std::numeric_limits<float>::quiet_NaN(), den > 0};
+}
+
+// The hit's t as dispex reports it: the line o + t d (the query's own origin, even when Embree
+// was given one moved sideways) at the plane of the hit triangle (TriangleOf), and whether
+// the back side was met. Identical under every ISA for the same triangle; Embree's own t
+// (`fallback`) only for a degenerate one.
+inline PlaneHit ExactHit(const EmbreeScene& scene, unsigned geom, unsigned prim, float u, float v,
+                         const Float3& o, const Float3& d, float fallback) {
+  const PlaneHit hit =
+      PlaneOf(scene.positions(), TriangleOf(scene.geometry(geom), prim, u, v).ids, o, d);
+  return std::isnan(hit.t) ? PlaneHit{fallback, hit.back} : hit;
+}
+inline float ExactT(const EmbreeScene& scene, unsigned geom, unsigned prim, float u, float v,
+                    const Float3& o, const Float3& d, float fallback) {
+  return ExactHit(scene, geom, prim, u, v, o, d, fallback).t;
 }
 
 // An intersect context whose filter rejects every candidate with ExactT outside [tnear, tfar]:
@@ -151,6 +180,125 @@ struct WindowContext {
   }
 };
 
+// Ties at shared edges and vertices. Where a ray meets the sculpt at an edge or a vertex,
+// every face there is hit at (nearly) the same point, and which one Embree reports depends on
+// the order its BVH visits them, and on whether the ray was in a packet or alone there (a
+// packet goes on as single rays when few lanes remain, which depends on the BVH too). The
+// face decides t's last bits (ExactT is measured on its plane) and which side was met, so a
+// BVH of part of the sculpt (a farm shard's, an incremental run's) would answer otherwise
+// than one of the whole sculpt. It is common: a sample at the centre of a sculpt quad lies on
+// its diagonal, one on a sculpt grid line on an edge. The same holds at a fold, where the
+// sculpt turns back onto itself: faces around one vertex overlap, and a ray through both
+// meets them within rounding of each other, far from any edge.
+//
+// Hence ResolveTie answers again, in double precision and without Embree, every hit within
+// kEdgeBand (of the barycentrics: wide against the kernels' rounding of (u, v)) of an edge or
+// a vertex of its triangle, from the triangles around that edge or vertex (the scene's
+// VertexPrims), and every hit on a folded primitive (VertexPrims::folded), from the triangles
+// around its triangle's corners: of those the line passes through (InsideWeight >= 0) within
+// the window margin of the hit's t, the nearest (then the lowest sculpt face, primitive and
+// quad half); when it passes through none (rounding let Embree see a hit there), the one it
+// passes closest to, if the hit was in the band. That set is the same whichever of them
+// Embree reported, so the answer does not depend on the BVH.
+inline constexpr float kEdgeBand = 0x1p-12f;
+
+// How far inside triangle ids[] the line o + t d passes: the least barycentric weight of its
+// meeting point with the plane (negative outside), in double; NaN when the line runs along it.
+inline double InsideWeight(const Float3* p, const std::int32_t ids[3], const Float3& o,
+                           const Float3& d) {
+  const Vec3d a = ToVec3d(p[ids[0]]);
+  const Vec3d e1 = ToVec3d(p[ids[1]]) - a, e2 = ToVec3d(p[ids[2]]) - a;
+  const Vec3d dir = ToVec3d(d);
+  const Vec3d pv = Cross(dir, e2);
+  const double det = Dot(e1, pv);
+  const Vec3d tv = ToVec3d(o) - a;
+  const double u = Dot(tv, pv) / det;
+  const double v = Dot(dir, Cross(tv, e1)) / det;
+  return std::min({1 - u - v, u, v});
+}
+
+// The tie rule (see kEdgeBand) for `kept`, a hit along d from o: true when it applies
+// (`kept` is then the answer, t measured on the chosen triangle's plane).
+inline bool ResolveTie(const EmbreeScene& scene, const Float3& o, const Float3& d,
+                       Candidate& kept) {
+  const GeometryView& kept_geometry = scene.geometry(kept.geom);
+  const HitTriangle hit = TriangleOf(kept_geometry, kept.prim, kept.u, kept.v);
+  const bool folded = scene.vertex_prims().folded[scene.GlobalOf(kept.geom, kept.prim)] != 0;
+  // Near an edge: its two corners; near a vertex: it. Every triangle there holds them.
+  std::int32_t feature[3];
+  int count = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (hit.weights[k] >= kEdgeBand) feature[count++] = hit.ids[k];
+  }
+  const bool in_band = count < 3;
+  if (!in_band && !folded) return false;
+  const Float3* positions = scene.positions();
+  const float margin = WindowMargin(o, d, scene.scale(), kept.t);
+  // The ranking: passed through (within the margin of kept.t) before passed beside; then the
+  // nearer, or the less beside; then the lowest face, primitive and half.
+  struct Rank {
+    bool beside;
+    double order;  // t through, -InsideWeight beside
+    std::int32_t face;
+    unsigned prim;
+    int second;
+    auto key() const { return std::tie(beside, order, face, prim, second); }
+  };
+  std::optional<Rank> best;
+  unsigned best_geom = 0;
+  std::int32_t best_ids[3] = {0, 0, 0};
+  const auto consider = [&](unsigned geom, unsigned prim, int second) {
+    // A (u, v) inside the triangle wanted names it (u + v > 1: a quad's second).
+    const float inside = second ? 0.75f : 0.25f;
+    const HitTriangle tri = TriangleOf(scene.geometry(geom), prim, inside, inside);
+    if (in_band) {
+      for (int k = 0; k < count; ++k) {
+        if (tri.ids[0] != feature[k] && tri.ids[1] != feature[k] && tri.ids[2] != feature[k]) {
+          return;
+        }
+      }
+    }
+    const double weight = InsideWeight(positions, tri.ids, o, d);
+    if (std::isnan(weight)) return;
+    const float t = PlaneOf(positions, tri.ids, o, d).t;
+    const bool through = weight >= 0 && std::fabs(t - kept.t) <= margin;
+    if (!through && !in_band) return;
+    const Rank rank{!through, through ? t : -weight, scene.FaceOf(geom, prim), prim, second};
+    if (best && best->key() <= rank.key()) return;
+    best = rank;
+    best_geom = geom;
+    std::copy(tri.ids, tri.ids + 3, best_ids);
+  };
+  const auto consider_around = [&](std::int32_t vertex) {
+    for (std::uint32_t global : scene.vertex_prims().around(vertex)) {
+      const unsigned geom = scene.GeomOf(global), prim = scene.PrimOf(global);
+      for (int second = 0; second < (scene.geometry(geom).corners == 4 ? 2 : 1); ++second) {
+        consider(geom, prim, second);
+      }
+    }
+  };
+  const bool diagonal = kept_geometry.corners == 4 && count == 2 &&
+                        ((feature[0] == hit.ids[1] && feature[1] == hit.ids[2]) ||
+                         (feature[0] == hit.ids[2] && feature[1] == hit.ids[1]));
+  if (diagonal && !folded) {
+    // A quad's own diagonal: its two triangles are all there is.
+    consider(kept.geom, kept.prim, 0);
+    consider(kept.geom, kept.prim, 1);
+  } else if (in_band) {
+    consider_around(feature[0]);
+  } else {
+    for (std::int32_t corner : hit.ids) consider_around(corner);
+  }
+  if (!best) return true;
+  const PlaneHit plane = PlaneOf(positions, best_ids, o, d);
+  if (std::isnan(plane.t)) return true;
+  kept.t = plane.t;
+  kept.back = plane.back;
+  kept.geom = best_geom;
+  kept.prim = best->prim;
+  return true;
+}
+
 // One ray from `cast_origin` whose hit must have ExactT (measured from `origin`) in
 // [tnear, tfar]: nothing nearer is returned, whatever Embree's rounding.
 inline Candidate CastInWindow(const EmbreeScene& scene, const Float3& cast_origin,
@@ -165,10 +313,10 @@ inline Candidate CastInWindow(const EmbreeScene& scene, const Float3& cast_origi
   const float shift = SetWindow(caster, 0, cast_origin, d, tnear - m, tfar + m);
   caster.Cast(scene.scene(), &w.context, 1);
   if (!caster.Hit(0)) return Candidate{};
-  const Float3 ng = caster.Ng(0);
-  return Candidate{ExactT(scene, caster.Geom(0), caster.Prim(0), caster.U(0), caster.V(0), origin,
-                          d, caster.T(0) - shift),
-                   caster.Geom(0), caster.Prim(0), Dot(d, ng) > 0, ng};
+  const PlaneHit hit = ExactHit(scene, caster.Geom(0), caster.Prim(0), caster.U(0), caster.V(0),
+                                origin, d, caster.T(0) - shift);
+  return Candidate{hit.t,        caster.Geom(0), caster.Prim(0), hit.back,
+                   caster.Ng(0), caster.U(0),    caster.V(0)};
 }
 
 // The normal-query kernel for one block of at most kBlock queries.
@@ -201,6 +349,7 @@ class NormalBlock {
     }
     rays_ = 0;
     repair_rays_ = 0;
+    ties_ = 0;
     Resolve(list_, count, false);
     if (scene_.retry_misses()) {
       int misses = 0;
@@ -210,8 +359,10 @@ class NormalBlock {
       Resolve(suspects_, misses, true);
     }
     if (scene_.verify_hits()) Verify(count);
+    ResolveTies(count);
     counters.rays_cast += rays_ + repair_rays_;
     counters.repair_rays += repair_rays_;
+    counters.tie_hits += ties_;
     Write(m, out, base, counters);
   }
 
@@ -238,13 +389,15 @@ class NormalBlock {
         if (!caster_.Hit(lane)) continue;
         const int j = ids[k0 + lane];
         const Float3 dir{sign * d_[j].x, sign * d_[j].y, sign * d_[j].z};
-        const float t = ExactT(scene_, caster_.Geom(lane), caster_.Prim(lane), caster_.U(lane),
-                               caster_.V(lane), o_[j], dir, caster_.T(lane) - margin_[j]);
-        if (t < 0) {
+        const PlaneHit hit =
+            ExactHit(scene_, caster_.Geom(lane), caster_.Prim(lane), caster_.U(lane),
+                     caster_.V(lane), o_[j], dir, caster_.T(lane) - margin_[j]);
+        if (hit.t < 0) {
           recast_[recasts++] = j;  // a surface in the margin before 0 hid the window's start
-        } else if (t <= tfar_[j]) {
-          const Float3 ng = caster_.Ng(lane);
-          result[j] = Candidate{t, caster_.Geom(lane), caster_.Prim(lane), Dot(dir, ng) > 0, ng};
+        } else if (hit.t <= tfar_[j]) {
+          result[j] = Candidate{hit.t,          caster_.Geom(lane), caster_.Prim(lane),
+                                hit.back,       caster_.Ng(lane),   caster_.U(lane),
+                                caster_.V(lane)};
         }
       }
     }
@@ -294,6 +447,17 @@ class NormalBlock {
       const float other = nearest_ ? kept_[j].t : (take_second ? query_.distance : 0.0f);
       reach_plus_[j] = kept_sign_[j] > 0 ? kept_[j].t : other;
       reach_minus_[j] = kept_sign_[j] > 0 ? other : kept_[j].t;
+    }
+  }
+
+  // The tie rule (ResolveTie) for every kept hit.
+  void ResolveTies(int count) {
+    for (int k = 0; k < count; ++k) {
+      const int j = list_[k];
+      if (!kept_[j].hit()) continue;
+      const float sign = kept_sign_[j];
+      ties_ += ResolveTie(scene_, o_[j], Float3{sign * d_[j].x, sign * d_[j].y, sign * d_[j].z},
+                          kept_[j]);
     }
   }
 
@@ -378,7 +542,7 @@ class NormalBlock {
   const Float3* o_ = nullptr;
   Float3 d_[kBlock];      // the queries' normals, FlushTiny'd
   float margin_[kBlock];  // WindowMargin of each query at its longest window
-  std::uint64_t rays_ = 0, repair_rays_ = 0;
+  std::uint64_t rays_ = 0, repair_rays_ = 0, ties_ = 0;
   int list_[kBlock], list2_[kBlock], second_ids_[kBlock], suspects_[kBlock], recast_[kBlock];
   float tfar_[kBlock];
   float reach_plus_[kBlock], reach_minus_[kBlock], segment_start_[kBlock];

@@ -175,6 +175,10 @@ Status EmbreeScene::Setup(const Mesh& mesh, const TracerOptions& options) {
       geometries_[kTriangleGeometry].face_of_prim = triangle_faces_.data();
     }
   }
+  DISPEX_ASSIGN_OR_RETURN(vertex_prims_,
+                          BuildVertexPrims(quad_indices, counts.quads, triangle_indices,
+                                           counts.triangles, positions_, num_vertices));
+  stats_.vertex_table_bytes = vertex_prims_.bytes();
   stats_.setup_seconds = Seconds(setup_start);
 
   const auto build_start = Clock::now();

@@ -19,6 +19,7 @@
 #include "dispex/status.h"
 #include "dispex/trace.h"
 #include "trace/embree_device.h"
+#include "trace/vertex_prims.h"
 
 namespace dispex::trace {
 
@@ -56,6 +57,20 @@ class EmbreeScene {
     return g.face_of_prim != nullptr ? g.face_of_prim[prim_id] : static_cast<std::int32_t>(prim_id);
   }
 
+  // The primitives around each vertex (the tie rule, batch_kernels.h).
+  const VertexPrims& vertex_prims() const { return vertex_prims_; }
+  // Global primitive `p` of VertexPrims as (geometry, primitive).
+  unsigned GeomOf(std::uint32_t p) const {
+    return p < vertex_prims_.num_quads ? kQuadGeometry : kTriangleGeometry;
+  }
+  std::uint32_t GlobalOf(unsigned geom, unsigned prim) const {
+    return geom == kQuadGeometry ? prim
+                                 : static_cast<std::uint32_t>(vertex_prims_.num_quads + prim);
+  }
+  unsigned PrimOf(std::uint32_t p) const {
+    return p < vertex_prims_.num_quads ? p : static_cast<unsigned>(p - vertex_prims_.num_quads);
+  }
+
   const TracerStats& stats() const { return stats_; }
 
   // The vertex guard's settings (TracerOptions::retry_misses, verify_hits; see
@@ -78,6 +93,7 @@ class EmbreeScene {
   std::vector<std::int32_t> quad_indices_, quad_faces_;          // mixed meshes only
   std::vector<std::int32_t> triangle_indices_, triangle_faces_;  // n-gons or mixed meshes
   GeometryView geometries_[kNumGeometries];
+  VertexPrims vertex_prims_;
   TracerStats stats_;
   bool retry_misses_ = true;
   bool verify_hits_ = false;

@@ -74,6 +74,7 @@ TraceCounters& TraceCounters::operator+=(const TraceCounters& other) {
   invalid += other.invalid;
   rays_cast += other.rays_cast;
   repair_rays += other.repair_rays;
+  tie_hits += other.tie_hits;
   hits += other.hits;
   return *this;
 }

@@ -1,14 +1,16 @@
 // Farm shards (docs/FARM.md): the parts of N shards, merged in any order, must be byte for byte
 // the map one extraction writes, for N = 1, 2, 3, 5 -- with automatic and given settings, rays
-// and the subdivision correspondence, watertight edges (which cross shard boundaries) on and
-// off. A shard is idempotent; a merge with a part missing, given twice or made from other
-// inputs or options fails naming it and writes nothing.
+// (shards of the whole sculpt, and of only their part of it) and the subdivision
+// correspondence, watertight edges (which cross shard boundaries) on and off. A shard is
+// idempotent; a merge with a part missing, given twice or made from other inputs or options fails
+// naming it and writes nothing.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -72,7 +74,12 @@ class Shards : public ::testing::TestWithParam<Variant> {
     o.output_path = dir_ / ("part_" + std::to_string(i) + "_of_" + std::to_string(n) + ".ptx");
     o.shard_index = i;
     o.shard_count = n;
+    if (TracesPart()) o.shard_sculpt = ShardSculpt::kPart;
     return Extract(o);
+  }
+  // Through rays with a given search distance the shards keep only their part of the sculpt.
+  bool TracesPart() const {
+    return GetParam().method == ExtractMethod::kRays && !GetParam().auto_search_distance;
   }
   std::string PartPath(int i, int n) const {
     return dir_ / ("part_" + std::to_string(i) + "_of_" + std::to_string(n) + ".ptx");
@@ -81,6 +88,14 @@ class Shards : public ::testing::TestWithParam<Variant> {
   TempDir dir_;
   std::string base_, sculpt_;
 };
+
+// "..., K of N sculpt faces" of a tracer of part of the sculpt (ExtractReport::tracer).
+std::smatch PartOfSculpt(const std::string& tracer) {
+  static const std::regex pattern(R"(([0-9]+) of ([0-9]+) sculpt faces)");
+  std::smatch match;
+  std::regex_search(tracer, match, pattern);
+  return match;
+}
 
 TEST_P(Shards, MergedPartsEqualOneExtractionForAnyCountAndOrder) {
   const ExtractOptions full = Options(dir_ / "full.ptx");
@@ -100,6 +115,13 @@ TEST_P(Shards, MergedPartsEqualOneExtractionForAnyCountAndOrder) {
       auto shard = Shard(i, n, full);
       ASSERT_TRUE(shard.ok()) << i << "/" << n << ": " << shard.status().message();
       EXPECT_EQ(shard->shard_begin, next) << i << "/" << n;
+      if (TracesPart()) {
+        // The shard traces, and keeps, only the sculpt within reach of its faces; the tie
+        // rule keeps its hits those of the whole sculpt.
+        const std::smatch part = PartOfSculpt(shard->tracer);
+        ASSERT_FALSE(part.empty()) << shard->tracer;
+        if (n > 1) EXPECT_LT(std::stoll(part[1]), std::stoll(part[2])) << shard->tracer;
+      }
       next = shard->shard_end;
       extracted += shard->faces_extracted;
       parts.push_back(PartPath(i, n));
@@ -296,6 +318,15 @@ TEST(ShardOptions, BadShardsAndVectorMapsAreRefused) {
   EXPECT_NE(ValidateExtractOptions(o).message().find("vector maps are not made in shards"),
             std::string::npos);
   o.vector.reset();
+  // A shard of part of the sculpt needs rays and a given search distance.
+  o.shard_sculpt = ShardSculpt::kPart;
+  EXPECT_NE(ValidateExtractOptions(o).message().find("shard_sculpt part: needs method rays"),
+            std::string::npos);
+  o.method = ExtractMethod::kRays;
+  EXPECT_FALSE(ValidateExtractOptions(o).ok());
+  o.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.01};
+  EXPECT_TRUE(ValidateExtractOptions(o).ok());
+  o.shard_sculpt = ShardSculpt::kWhole;
   o.uv_maps_dir = "uv";
   EXPECT_EQ(ValidateExtractOptions(o).message(),
             "uv_maps_dir: UV-space maps are not made in shards (docs/FARM.md)");
