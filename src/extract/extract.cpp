@@ -103,16 +103,11 @@ std::string RedoReason(const PreviousMap& previous, const ExtractReport& report)
   return out;
 }
 
-// Faces the edge pass re-extracts lie near those whose first pass runs (it raises a ring of
-// faces per round, in at most 8 rounds, and most raises are beside the faces that changed):
-// the local tracer covers this many rings around them, and the whole sculpt's tracer is built
-// if the edge pass asks for a face beyond (EnsureTraced).
-constexpr int kLocalRings = 2;
-
-// The tracer of an incremental run, a merge or a shard with a given search distance: the
-// sculpt within reach of the faces whose first pass runs (not copied; a shard's own) and of
-// the faces `rings` around them; the whole sculpt when that is most of it. Hits do not depend
-// on the BVH's extent (the tie rule, dispex/trace.h), so the map's bytes do not either.
+// The tracer of an incremental run, a merge or a shard of part of the sculpt, with a given
+// search distance: the sculpt within reach of the faces whose first pass runs (not copied; a
+// shard's own) and of the faces `rings` around them; for a run not a shard, the whole sculpt
+// when that is most of it. The tie rule (dispex/trace.h) keeps hits at shared edges, vertices
+// and folds those of the whole sculpt's BVH.
 Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previous,
                         std::span<const std::uint8_t> in_shard, int rings, const FaceKeys& keys,
                         ExtractInputs& inputs, ExtractReport& report) {
@@ -127,18 +122,7 @@ Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previo
       ring.push_back(static_cast<int>(f));
     }
   }
-  for (int step = 0; step < rings && !ring.empty(); ++step) {
-    std::vector<int> next;
-    for (int f : ring) {
-      for (std::int32_t g : inputs.faces[static_cast<std::size_t>(f)].adjfaces) {
-        if (g >= 0 && !traced[static_cast<std::size_t>(g)]) {
-          traced[static_cast<std::size_t>(g)] = 1;
-          next.push_back(g);
-        }
-      }
-    }
-    ring = std::move(next);
-  }
+  AddRings(inputs.faces, rings, std::move(ring), traced);
   const auto count = static_cast<std::size_t>(std::count(traced.begin(), traced.end(), 1));
   if (in_shard.empty() && 2 * count > n) return BuildTracer(options, inputs, report);
   SetTracerOptions(options, inputs);
@@ -146,6 +130,9 @@ Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previo
   Mesh part = SculptWithinReach(inputs, keys, traced);
   report.t_bvh = clock.seconds();
   report.tracer_faces = static_cast<std::int64_t>(count);
+  // A shard needs no more of the sculpt than its part (no stage crosses faces): released
+  // before the BVH is built, its memory falls with the shard count.
+  if (!in_shard.empty() && part.num_faces() > 0) ReleaseSculpt(inputs);
   return BuildPartTracer(std::move(part), std::move(traced), inputs, report);
 }
 
@@ -259,9 +246,6 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   if (local) {
     DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, in_shard, shard ? 0 : kLocalRings,
                                             face_keys, inputs, report));
-    // A shard needs no more of the sculpt than its BVH holds (no stage crosses faces): its
-    // memory falls with the shard count.
-    if (shard && !inputs.traced.empty()) ReleaseSculpt(inputs);
   }
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateMap(options, inputs));
 
@@ -296,7 +280,12 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   DISPEX_RETURN_IF_ERROR(FillMissedFaces(options, inputs, faces, writer, report));
   if (settings.watertight != WatertightEdges::kOff) {
     DISPEX_RETURN_IF_ERROR(MatchEdges(inputs, settings, faces, report));
-    if (inputs.widened) report.tracer += "; then the whole sculpt, for faces the edges raised";
+    if (inputs.widened) {
+      report.tracer += inputs.traced.empty()
+                           ? std::string("; then the whole sculpt, for faces the edges raised")
+                           : fmt::format("; then {} of {} sculpt faces, for faces the edges raised",
+                                         inputs.traced_part.num_faces(), report.sculpt_faces);
+    }
     DISPEX_RETURN_IF_ERROR(WriteKeptFaces(writer, inputs, faces));
   }
   ListDiscontinuousFaces(inputs, faces, report);

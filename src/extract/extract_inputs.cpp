@@ -193,9 +193,9 @@ Status BuildPartTracer(Mesh part, std::vector<std::uint8_t> traced, ExtractInput
   DISPEX_ASSIGN_OR_RETURN(inputs.tracer,
                           MakeEmbreeTracer(inputs.traced_part, inputs.tracer_options));
   report.t_bvh += clock.seconds();
-  report.tracer = inputs.tracer->stats().backend + fmt::format(", {} of {} sculpt faces",
-                                                               inputs.traced_part.num_faces(),
-                                                               inputs.sculpt.num_faces());
+  report.tracer =
+      inputs.tracer->stats().backend +
+      fmt::format(", {} of {} sculpt faces", inputs.traced_part.num_faces(), report.sculpt_faces);
   return Status::Ok();
 }
 
@@ -205,17 +205,47 @@ void ReleaseSculpt(ExtractInputs& inputs) {
   inputs.sculpt = std::move(released);
 }
 
+void AddRings(const std::vector<PtexFaceInfo>& faces, int rings, std::vector<int> ring,
+              std::vector<std::uint8_t>& traced) {
+  for (int step = 0; step < rings && !ring.empty(); ++step) {
+    std::vector<int> next;
+    for (int f : ring) {
+      for (std::int32_t g : faces[static_cast<std::size_t>(f)].adjfaces) {
+        if (g >= 0 && !traced[static_cast<std::size_t>(g)]) {
+          traced[static_cast<std::size_t>(g)] = 1;
+          next.push_back(g);
+        }
+      }
+    }
+    ring = std::move(next);
+  }
+}
+
 Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces) {
   if (inputs.traced.empty()) return Status::Ok();
   DISPEX_CHECK(inputs.sculpt.num_faces() > 0);  // not after ReleaseSculpt
+  std::vector<int> beyond;
   for (int f : faces) {
-    if (inputs.traced[static_cast<std::size_t>(f)]) continue;
+    if (!inputs.traced[static_cast<std::size_t>(f)]) beyond.push_back(f);
+  }
+  if (beyond.empty()) return Status::Ok();
+  std::vector<std::uint8_t> traced = std::move(inputs.traced);
+  for (int f : beyond) traced[static_cast<std::size_t>(f)] = 1;
+  AddRings(inputs.faces, kLocalRings, std::move(beyond), traced);
+  inputs.widened = true;
+  inputs.tracer.reset();  // before the part it reads
+  inputs.traced_part = Mesh{};
+  const auto count = static_cast<std::size_t>(std::count(traced.begin(), traced.end(), 1));
+  if (2 * count > traced.size() || inputs.face_keys == nullptr) {
     DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, inputs.tracer_options));
-    inputs.traced.clear();
-    inputs.traced_part = Mesh{};
-    inputs.widened = true;
     return Status::Ok();
   }
+  inputs.traced_part = SculptWithinReach(inputs, *inputs.face_keys, traced);
+  inputs.traced = std::move(traced);
+  DISPEX_ASSIGN_OR_RETURN(
+      inputs.tracer,
+      MakeEmbreeTracer(inputs.traced_part.num_faces() > 0 ? inputs.traced_part : inputs.sculpt,
+                       inputs.tracer_options));
   return Status::Ok();
 }
 

@@ -30,7 +30,7 @@ struct ExtractInputs {
   // holds the whole sculpt.
   std::vector<std::uint8_t> traced;
   Mesh traced_part;      // the part of the sculpt that tracer reads, when it reads a part
-  bool widened = false;  // EnsureTraced replaced a part's tracer by the whole sculpt's
+  bool widened = false;  // EnsureTraced replaced a part's tracer by a larger one
   TracerOptions tracer_options;
   // The sculpt as the base refined (ExtractMethod, extract_mapping.h): samples are traced
   // through it, and `tracer` is built only for those it leaves undecided (TraceFallback), over
@@ -67,8 +67,18 @@ Status BuildTracer(const ExtractOptions& options, ExtractInputs& inputs, Extract
 Status BuildPartTracer(Mesh part, std::vector<std::uint8_t> traced, ExtractInputs& inputs,
                        ExtractReport& report);
 
-// Before `faces` are extracted: the whole sculpt's tracer if the current one does not hold
-// everything their rays can reach.
+// Faces the edge pass re-extracts lie near those whose first pass runs (it raises a ring of
+// faces per round, in at most 8 rounds, and most raises are beside the faces that changed):
+// a local tracer covers this many rings around them.
+inline constexpr int kLocalRings = 2;
+
+// Flags in `traced` the faces `rings` rings of neighbours around `ring` (faces already flagged).
+void AddRings(const std::vector<PtexFaceInfo>& faces, int rings, std::vector<int> ring,
+              std::vector<std::uint8_t>& traced);
+
+// Before `faces` are extracted: when the tracer holds a part of the sculpt that their rays may
+// reach beyond, a tracer of the part within reach of them, kLocalRings around them and the
+// faces it already served (the whole sculpt's when that is more than half the faces).
 Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces);
 
 // Frees the sculpt's arrays (its source stays) once a part's tracer holds all a run needs: a

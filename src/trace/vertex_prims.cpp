@@ -83,17 +83,17 @@ StatusOr<VertexPrims> BuildVertexPrims(const std::int32_t* quads, std::size_t nu
     out.prims[at] = p;
   });
   out.folded.assign(num_quads + num_triangles, 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, num_vertices, 1 << 14),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t v = range.begin(); v != range.end(); ++v) {
-                        const auto around = out.around(static_cast<std::int32_t>(v));
-                        if (!Folds(out, around, quads, triangles, positions)) continue;
-                        for (std::uint32_t g : around) {
-                          std::atomic_ref<std::uint8_t>(out.folded[g]).store(
-                              1, std::memory_order_relaxed);
-                        }
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, num_vertices, 1 << 14),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t v = range.begin(); v != range.end(); ++v) {
+          const auto around = out.around(static_cast<std::int32_t>(v));
+          if (!Folds(out, around, quads, triangles, positions)) continue;
+          for (std::uint32_t g : around) {
+            std::atomic_ref<std::uint8_t>(out.folded[g]).store(1, std::memory_order_relaxed);
+          }
+        }
+      });
   return out;
 }
 

@@ -28,8 +28,7 @@ Mesh BumpyField() {
   for (int j = 0; j <= kCells; ++j) {
     for (int i = 0; i <= kCells; ++i) {
       const float x = -1 + cell * static_cast<float>(i), y = -1 + cell * static_cast<float>(j);
-      positions.push_back(
-          {x, y, 0.2f * std::sin(3 * x) * std::cos(2 * y) + cell * noise(rng)});
+      positions.push_back({x, y, 0.2f * std::sin(3 * x) * std::cos(2 * y) + cell * noise(rng)});
     }
   }
   Mesh mesh = trace_test::NewMesh(std::move(positions));
@@ -176,14 +175,13 @@ TEST(Ties, AnswersAtSharedEdgesAndVerticesDoNotDependOnTheBvhOrTheRayMode) {
             use_part && a.prim[i].valid()
                 ? SculptPrimId(whole_face[static_cast<std::size_t>(a.prim[i].value)])
                 : a.prim[i];
-        const bool same = std::bit_cast<std::uint32_t>(a.t[i]) ==
-                              std::bit_cast<std::uint32_t>(reference.t[i]) &&
-                          a.flags[i] == reference.flags[i] && face == reference.prim[i];
+        const bool same =
+            std::bit_cast<std::uint32_t>(a.t[i]) == std::bit_cast<std::uint32_t>(reference.t[i]) &&
+            a.flags[i] == reference.flags[i] && face == reference.prim[i];
         if (!same && ++differ <= 3) {
-          ADD_FAILURE() << "query " << i << ": t " << a.t[i] << " face " << face.value
-                        << " flags " << int(a.flags[i]) << ", against t " << reference.t[i]
-                        << " face " << reference.prim[i].value << " flags "
-                        << int(reference.flags[i]);
+          ADD_FAILURE() << "query " << i << ": t " << a.t[i] << " face " << face.value << " flags "
+                        << int(a.flags[i]) << ", against t " << reference.t[i] << " face "
+                        << reference.prim[i].value << " flags " << int(reference.flags[i]);
         }
       }
       EXPECT_EQ(differ, 0);
