@@ -75,6 +75,13 @@ class CellGrid {
   }
 
   std::size_t num_cells() const { return static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2]; }
+  // Whether a point lies within `grow` of the grid (a box grown by at most that reaches it).
+  bool Near(const std::array<float, 3>& p, float grow) const {
+    for (int k = 0; k < 3; ++k) {
+      if (!(p[k] >= bounds_.lower[k] - grow && p[k] <= bounds_.upper[k] + grow)) return false;
+    }
+    return true;
+  }
   // The cell of a point; points outside the grid go to the nearest border cell.
   std::size_t CellOf(const std::array<float, 3>& p) const {
     return Index(Cell(p[0], 0), Cell(p[1], 1), Cell(p[2], 2));
@@ -295,7 +302,10 @@ Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
                       std::vector<float> corners;
                       for (std::size_t s = range.begin(); s != range.end(); ++s) {
                         Corners(sculpt, s, corners);
-                        keep[s] = marked[grid.CellOf(Bounds(corners).centre)];
+                        const std::array<float, 3> centre = Bounds(corners).centre;
+                        // Beyond the grid's reach a face is out of reach: not kept for the
+                        // border cell CellOf would give it.
+                        keep[s] = grid.Near(centre, half_extent) && marked[grid.CellOf(centre)];
                       }
                     });
   return SculptPart(sculpt, keep);

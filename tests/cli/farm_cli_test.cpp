@@ -114,6 +114,8 @@ TEST_F(Farm, ShardsThroughTheCommandLineMergeIntoTheMapExtractWrites) {
     const std::string part = dir_ / ("p" + i + ".ptx");
     std::string args = fmt("spot");
     args += " -o " + part + " --search-distance 1% --method rays --shard " + i + "/3";
+    // What a shard keeps of the sculpt is not an option of the map: parts of either kind merge.
+    if (i == "2") args += " --shard-sculpt part";
     auto r = RunDispex(args, dir_);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("shard " + i + "/3"), std::string::npos) << r.err;
@@ -138,15 +140,20 @@ TEST_F(Farm, ShardsThroughTheCommandLineMergeIntoTheMapExtractWrites) {
   r = RunDispex(fmt("spot") + " --out-dir " + (dir_ / "d") + " --shard 1/2", dir_);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("not made in shards"), std::string::npos) << r.err;
+  r = RunDispex(fmt("spot") + " -o " + (dir_ / "x.ptx") + " --shard 1/2 --shard-sculpt part", dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--shard-sculpt part: needs --method rays and a given --search-distance"),
+            std::string::npos)
+      << r.err;
 }
 
 // The scripts, run as Slurm runs them -- each array task with its SLURM_ARRAY_TASK_ID, then each
-// merge -- make the maps `extract` makes.
+// merge -- make the maps `extract` makes, the shards keeping only their part of the sculpt.
 TEST_F(Farm, SlurmScriptsRunAsSlurmWouldMakeTheMaps) {
   const fs::path work = dir_ / "work";
   auto r = RunDispex("farm slurm " + (dir_ / "batch.json") +
                          " --shards 3 --partition render --cpus 2 --mem 4G --time 1:00:00 "
-                         "--sbatch-arg=--account=fx --dry-run --work-dir " +
+                         "--sbatch-arg=--account=fx --shard-sculpt part --dry-run --work-dir " +
                          work.string(),
                      dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -154,7 +161,8 @@ TEST_F(Farm, SlurmScriptsRunAsSlurmWouldMakeTheMaps) {
   for (const std::string line :
        {"#SBATCH --array=0-5\n", "#SBATCH --partition=render\n", "#SBATCH --cpus-per-task=2\n",
         "#SBATCH --mem=4G\n", "#SBATCH --time=1:00:00\n", "#SBATCH --account=fx\n",
-        "#SBATCH --requeue\n", "assets=('spot' 'blub')\n", "shards=3\n"}) {
+        "#SBATCH --requeue\n", "assets=('spot' 'blub')\n", "shards=3\n",
+        " --shard-sculpt part "}) {
     EXPECT_NE(shards.find(line), std::string::npos) << line << " not in\n" << shards;
   }
   EXPECT_NE(shards.find(std::string("'") + DISPEX_EXE), std::string::npos)
