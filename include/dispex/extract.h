@@ -314,8 +314,9 @@ struct ExtractReport {
   std::uint64_t peak_rss_bytes = 0;
   std::string tracer;  // TracerStats::backend: Embree version, ISA, build
 
-  // A shard (ExtractOptions::shard_count > 0): the Ptex faces [shard_begin, shard_end) it
-  // extracted, and their estimated cost against the whole map's.
+  // A shard (ExtractOptions::shard_count > 0): the run [shard_begin, shard_end) of the shard
+  // order it extracted (the Ptex faces along a Z-order curve of their centres on the base:
+  // docs/FARM.md), and their estimated cost against the whole map's.
   std::int64_t shard_begin = 0, shard_end = 0;
   double shard_cost_fraction = 0;
   // A merge (MergeShards): the parts merged.

@@ -191,7 +191,7 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   if (merge) {
     DISPEX_RETURN_IF_ERROR(CheckPartsMatchInputs(*parts, report));
     report.parts_merged = static_cast<std::int64_t>(parts->size());
-    previous = PreviousMap::FromParts(std::move(*parts), num_faces);
+    previous = PreviousMap::FromParts(std::move(*parts), ShardOrder(inputs.base, inputs.surface));
   } else if (options.incremental) {
     // An up-to-date map is left as it is.
     previous = PreviousMap::Open(options.output_path, num_faces, options.vector.has_value());
@@ -235,13 +235,16 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   // A shard's faces: its first pass only, no stage that crosses faces (the merge runs those).
   std::vector<std::uint8_t> in_shard;
   if (shard) {
-    const ShardRange range = PlanShard(inputs.surface, settings.plan, face_keys,
+    const std::vector<std::int32_t> order = ShardOrder(inputs.base, inputs.surface);
+    const ShardRange range = PlanShard(inputs.surface, settings.plan, face_keys, order,
                                        options.shard_index, options.shard_count);
     report.shard_begin = range.begin;
     report.shard_end = range.end;
     report.shard_cost_fraction = range.cost_fraction;
     in_shard.assign(num_faces, 0);
-    std::fill(in_shard.begin() + range.begin, in_shard.begin() + range.end, 1);
+    for (auto i = range.begin; i < range.end; ++i) {
+      in_shard[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])] = 1;
+    }
   }
   if (local) {
     DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, in_shard, shard ? 0 : kLocalRings,
@@ -256,9 +259,9 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
                    options.progress, options.progress_counter, writer, in_shard));
   report.faces_copied = faces.faces_copied;
   if (shard) {
-    report.faces_extracted = report.shard_end - report.shard_begin - faces.faces_copied;
-    for (auto f = report.shard_begin; f < report.shard_end; ++f) {
-      report.faces_extracted -= inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
+    report.faces_extracted = -faces.faces_copied;
+    for (std::size_t f = 0; f < num_faces; ++f) {
+      report.faces_extracted += in_shard[f] && !inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
     }
     report.t_sample_trace = faces_clock.seconds();
     ShardInfo info;

@@ -157,9 +157,9 @@ std::string ExtractReportSummary(const ExtractReport& r) {
     std::string copied =
         r.faces_copied > 0 ? fmt::format(" ({} copied from the part there)", r.faces_copied) : "";
     return fmt::format(
-        "dispex: shard {}/{}: Ptex faces {}..{} ({:.1f}% of the estimated cost), {} extracted{} "
-        "-> {}\n  time {:.2f}s (read {:.2f}+{:.2f}, bvh {:.2f}, sample+trace {:.2f})  peak "
-        "{:.0f} MB\n",
+        "dispex: shard {}/{}: faces {}..{} in shard order ({:.1f}% of the estimated cost), {} "
+        "extracted{} -> {}\n  time {:.2f}s (read {:.2f}+{:.2f}, bvh {:.2f}, sample+trace {:.2f})  "
+        "peak {:.0f} MB\n",
         r.options.shard_index, r.options.shard_count, r.shard_begin, r.shard_end - 1,
         100 * r.shard_cost_fraction, r.faces_extracted, copied, r.output_path, r.t_total,
         r.t_read_base, r.t_read_sculpt, r.t_bvh, r.t_sample_trace, double(r.peak_rss_bytes) / 1e6);

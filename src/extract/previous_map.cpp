@@ -48,7 +48,9 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces, bo
   return out;
 }
 
-PreviousMap PreviousMap::FromParts(std::vector<ShardPart> parts, std::size_t num_faces) {
+PreviousMap PreviousMap::FromParts(std::vector<ShardPart> parts,
+                                   std::span<const std::int32_t> order) {
+  const std::size_t num_faces = order.size();
   PreviousMap out;
   out.keys_.resize(num_faces);
   out.records_.resize(num_faces);
@@ -60,8 +62,9 @@ PreviousMap PreviousMap::FromParts(std::vector<ShardPart> parts, std::size_t num
         *DecodeFaceKeys(part.file.FindMetaData(kFaceKeysMetaKey)->bytes, num_faces);
     const std::vector<FaceRecord> records =
         *DecodeFaceRecords(part.file.FindMetaData(kFaceRecordsMetaKey)->bytes, num_faces);
-    for (auto f = static_cast<std::size_t>(part.info.begin);
-         f < static_cast<std::size_t>(part.info.end); ++f) {
+    for (auto i = static_cast<std::size_t>(part.info.begin);
+         i < static_cast<std::size_t>(part.info.end); ++i) {
+      const auto f = static_cast<std::size_t>(order[i]);
       out.keys_[f] = keys[f];
       out.records_[f] = records[f];
       out.part_of_[f] = static_cast<std::uint32_t>(k);

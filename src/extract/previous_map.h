@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -23,8 +24,8 @@ class PreviousMap {
   // notice() says why in one line.
   static PreviousMap Open(const std::string& path, std::size_t num_faces, bool vector = false);
   // The parts of a sharded extraction (CheckShardParts' order) as one map: each face as the part
-  // of its shard holds it.
-  static PreviousMap FromParts(std::vector<ShardPart> parts, std::size_t num_faces);
+  // of its shard holds it, a part holding the faces order[begin..end) (ShardOrder).
+  static PreviousMap FromParts(std::vector<ShardPart> parts, std::span<const std::int32_t> order);
 
   bool usable() const { return !files_.empty(); }
   // Inflates every face's data (Open checks the structure only): corrupt data makes the map
