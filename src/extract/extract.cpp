@@ -261,7 +261,8 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   if (shard) {
     report.faces_extracted = -faces.faces_copied;
     for (std::size_t f = 0; f < num_faces; ++f) {
-      report.faces_extracted += in_shard[f] && !inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
+      report.faces_extracted +=
+          in_shard[f] && !inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
     }
     report.t_sample_trace = faces_clock.seconds();
     ShardInfo info;

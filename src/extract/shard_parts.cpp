@@ -149,15 +149,13 @@ StatusOr<std::vector<ShardPart>> CheckShardParts(std::vector<ShardPart> parts) {
       return Status::Error(fmt::format(
           "{}: shard {}/{} holds faces {}..{} of the shard order, but the shards before it end "
           "at {}",
-          part.path,
-          part.info.index, count, part.info.begin, part.info.end - 1, next - 1));
+          part.path, part.info.index, count, part.info.begin, part.info.end - 1, next - 1));
     }
     next = part.info.end;
   }
   if (next != parts[0].file.num_faces()) {
     return Status::Error(fmt::format("{}: the shards end at face {} of {} in shard order",
-                                     parts.back().path,
-                                     next - 1, parts[0].file.num_faces()));
+                                     parts.back().path, next - 1, parts[0].file.num_faces()));
   }
   return parts;
 }

@@ -41,8 +41,8 @@ std::vector<std::int32_t> ShardOrder(const Mesh& base, const LimitSurface& surfa
     }
     for (double& x : c) x /= static_cast<double>(corners.size());
     if (corners.size() != 4) {
-      const Float3& p = base.positions[static_cast<std::size_t>(corners[static_cast<std::size_t>(
-          surface.sub_face(face))])];
+      const Float3& p = base.positions[static_cast<std::size_t>(
+          corners[static_cast<std::size_t>(surface.sub_face(face))])];
       c = {(c[0] + p.x) / 2, (c[1] + p.y) / 2, (c[2] + p.z) / 2};
     }
     centres[f] = c;

@@ -121,11 +121,13 @@ inline HitTriangle TriangleOf(const GeometryView& g, unsigned prim, float u, flo
   return HitTriangle{{c[0], c[1], c[3]}, {1 - u - v, u, v}, false};
 }
 
-// Where the line o + t d meets the plane of triangle ids[], in double, rounded once (NaN when
-// degenerate or parallel), and whether d points along its right-hand normal (the back side).
+// Where the line o + t d meets the plane of triangle ids[], in double (`exact`) and rounded
+// once (NaN when degenerate or parallel), and whether d points along its right-hand normal
+// (the back side).
 struct PlaneHit {
   float t;
   bool back;
+  double exact = 0;
 };
 inline PlaneHit PlaneOf(const Float3* p, const std::int32_t ids[3], const Float3& o,
                         const Float3& d) {
@@ -135,8 +137,9 @@ inline PlaneHit PlaneOf(const Float3* p, const std::int32_t ids[3], const Float3
   const double den = n.x * d.x + n.y * d.y + n.z * d.z;
   const double t =
       (n.x * (double(fa.x) - o.x) + n.y * (double(fa.y) - o.y) + n.z * (double(fa.z) - o.z)) / den;
-  return PlaneHit{
-      std::isfinite(t) ? static_cast<float>(t) : std::numeric_limits<float>::quiet_NaN(), den > 0};
+  const bool finite = std::isfinite(t);
+  return PlaneHit{finite ? static_cast<float>(t) : std::numeric_limits<float>::quiet_NaN(), den > 0,
+                  finite ? t : std::numeric_limits<double>::quiet_NaN()};
 }
 
 // The hit's t as dispex reports it: the line o + t d (the query's own origin, even when Embree
@@ -147,7 +150,7 @@ inline PlaneHit ExactHit(const EmbreeScene& scene, unsigned geom, unsigned prim,
                          const Float3& o, const Float3& d, float fallback) {
   const PlaneHit hit =
       PlaneOf(scene.positions(), TriangleOf(scene.geometry(geom), prim, u, v).ids, o, d);
-  return std::isnan(hit.t) ? PlaneHit{fallback, hit.back} : hit;
+  return std::isnan(hit.t) ? PlaneHit{fallback, hit.back, fallback} : hit;
 }
 inline float ExactT(const EmbreeScene& scene, unsigned geom, unsigned prim, float u, float v,
                     const Float3& o, const Float3& d, float fallback) {
@@ -260,7 +263,7 @@ inline bool ResolveTie(const EmbreeScene& scene, const Float3& o, const Float3& 
     }
     const double weight = InsideWeight(positions, tri.ids, o, d);
     if (std::isnan(weight)) return;
-    const float t = PlaneOf(positions, tri.ids, o, d).t;
+    const double t = PlaneOf(positions, tri.ids, o, d).exact;
     const bool through = weight >= 0 && std::fabs(t - kept.t) <= margin;
     if (!through && !in_band) return;
     const Rank rank{!through, through ? t : -weight, scene.FaceOf(geom, prim), prim, second};

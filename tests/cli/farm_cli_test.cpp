@@ -161,8 +161,7 @@ TEST_F(Farm, SlurmScriptsRunAsSlurmWouldMakeTheMaps) {
   for (const std::string line :
        {"#SBATCH --array=0-5\n", "#SBATCH --partition=render\n", "#SBATCH --cpus-per-task=2\n",
         "#SBATCH --mem=4G\n", "#SBATCH --time=1:00:00\n", "#SBATCH --account=fx\n",
-        "#SBATCH --requeue\n", "assets=('spot' 'blub')\n", "shards=3\n",
-        " --shard-sculpt part "}) {
+        "#SBATCH --requeue\n", "assets=('spot' 'blub')\n", "shards=3\n", " --shard-sculpt part "}) {
     EXPECT_NE(shards.find(line), std::string::npos) << line << " not in\n" << shards;
   }
   EXPECT_NE(shards.find(std::string("'") + DISPEX_EXE), std::string::npos)

@@ -122,8 +122,8 @@ TEST_P(Shards, MergedPartsEqualOneExtractionForAnyCountAndOrder) {
         ASSERT_FALSE(part.empty()) << shard->tracer;
         // Spot's faces are large, each reaching far: only five shards stay clear of the whole.
         if (n == 5) {
-          EXPECT_LT(std::stoll(part[1]), std::stoll(part[2])) << i << "/" << n << ": "
-                                                              << shard->tracer;
+          EXPECT_LT(std::stoll(part[1]), std::stoll(part[2]))
+              << i << "/" << n << ": " << shard->tracer;
         }
       }
       next = shard->shard_end;
