@@ -18,27 +18,43 @@ Float3 Normal(const Float3* p, std::int32_t a, std::int32_t b, std::int32_t c) {
   return {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
 }
 
-// Whether two of the triangles of the primitives around a vertex face against each other.
-bool Folds(const VertexPrims& vp, std::span<const std::uint32_t> around, const std::int32_t* quads,
-           const std::int32_t* triangles, const Float3* p) {
+float Dot(const Float3& a, const Float3& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+// Whether two of the triangles around vertex v (of the primitives `around` it, the triangles
+// that hold v) face against each other.
+bool Folds(const VertexPrims& vp, std::int32_t v, std::span<const std::uint32_t> around,
+           const std::int32_t* quads, const std::int32_t* triangles, const Float3* p) {
   constexpr std::size_t kMost = 64;  // triangles compared around one vertex
   Float3 normals[kMost];
   std::size_t count = 0;
   for (std::uint32_t g : around) {
     if (count + 2 > kMost) break;
     if (g < vp.num_quads) {
+      // A quad's triangles (c0 c1 c3) and (c2 c3 c1): v is in the first unless it is c2, in
+      // the second unless it is c0.
       const std::int32_t* c = quads + 4 * static_cast<std::size_t>(g);
-      normals[count++] = Normal(p, c[0], c[1], c[3]);
-      normals[count++] = Normal(p, c[2], c[3], c[1]);
+      if (c[2] != v) normals[count++] = Normal(p, c[0], c[1], c[3]);
+      if (c[0] != v) normals[count++] = Normal(p, c[2], c[3], c[1]);
     } else {
       const std::int32_t* c = triangles + 3 * (g - vp.num_quads);
       normals[count++] = Normal(p, c[0], c[1], c[2]);
     }
   }
+  if (count < 2) return false;
+  // Usually every normal is within 45 degrees of the first, so no two are 90 degrees apart.
+  const Float3& first = normals[0];
+  const float first_length2 = Dot(first, first);
+  bool near = true;
+  for (std::size_t i = 1; i < count && near; ++i) {
+    const float d = Dot(normals[i], first);
+    near = d > 0 && d * d > 0.5f * Dot(normals[i], normals[i]) * first_length2;
+  }
+  if (near) return false;
   for (std::size_t i = 0; i < count; ++i) {
     for (std::size_t j = i + 1; j < count; ++j) {
-      const Float3 &a = normals[i], &b = normals[j];
-      if (a.x * b.x + a.y * b.y + a.z * b.z < 0) return true;
+      if (Dot(normals[i], normals[j]) < 0) return true;
     }
   }
   return false;
@@ -87,8 +103,9 @@ StatusOr<VertexPrims> BuildVertexPrims(const std::int32_t* quads, std::size_t nu
       tbb::blocked_range<std::size_t>(0, num_vertices, 1 << 14),
       [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t v = range.begin(); v != range.end(); ++v) {
-          const auto around = out.around(static_cast<std::int32_t>(v));
-          if (!Folds(out, around, quads, triangles, positions)) continue;
+          const auto vertex = static_cast<std::int32_t>(v);
+          const auto around = out.around(vertex);
+          if (!Folds(out, vertex, around, quads, triangles, positions)) continue;
           for (std::uint32_t g : around) {
             std::atomic_ref<std::uint8_t>(out.folded[g]).store(1, std::memory_order_relaxed);
           }
