@@ -68,6 +68,10 @@ struct TracerOptions {
   // surface there is resolved again from sideways. Exact at vertices, at the cost of one more
   // ray per hit (measured: 24-28% fewer queries per second; docs/bench-notes/trace.md).
   bool verify_hits = false;
+  // Build the table the tie rule of normal queries reads (the hit contract below) with the BVH,
+  // in parallel. False for a scene that answers only Intersect and ClosestPoints queries; its
+  // first normal query, if one comes, builds the table then, on that query's thread.
+  bool normal_queries = true;
   // RTC_SCENE_FLAG_COMPACT: a smaller BVH (with medium quality about half the memory), rays
   // ~8% slower.
   bool compact = false;
@@ -182,11 +186,8 @@ struct TracerStats {
   std::int64_t backend_bytes = 0;       // bytes the backend holds now (BVH, its buffers)
   std::int64_t backend_peak_bytes = 0;  // peak during the build
   std::size_t copied_bytes = 0;         // bytes dispex copied from the mesh (0 when all shared)
-  // The primitives around each vertex, for the tie rule at shared edges and vertices (the hit
-  // contract below): 4 bytes per vertex and per face corner.
-  std::size_t vertex_table_bytes = 0;
-  bool shared_vertices = false;  // Embree reads mesh.positions in place
-  bool shared_indices = false;   // Embree reads mesh.face_indices in place
+  bool shared_vertices = false;         // Embree reads mesh.positions in place
+  bool shared_indices = false;          // Embree reads mesh.face_indices in place
   // TracerOptions::scale as used (the scene's largest |coordinate| when it was 0): the rounding
   // margins and sideways steps of the queries scale with it, so hits depend on it in rare cases.
   float scale = 0;
@@ -211,10 +212,13 @@ struct TracerStats {
 //    move a point on the ray by less than float rounding (and Embree's coherent 8-wide packets
 //    lose rays that carry them).
 //  - Ties: a normal query's hit within 2^-12 (of its triangle's barycentrics) of an edge or a
-//    vertex is taken on the triangle around that edge or vertex whose plane gives the least
-//    t (within the window margin), then the lowest sculpt face: whichever face Embree
-//    reported there, under any ISA, ray mode or BVH, even one of part of the sculpt. The back
-//    side flag is that triangle's.
+//    vertex, or on a face where the sculpt folds back over itself, is answered again in double
+//    precision from the triangles around that edge, vertex or face: of those the line passes
+//    through within the window margin of t, the nearest, then the lowest sculpt face (near an
+//    edge or vertex with none passed through, the one passed closest). So the answer is the
+//    same whichever face Embree reported, under any ISA, ray mode or BVH, even one of part of
+//    the sculpt; only sheets that share no vertex and cross within rounding on the line stay
+//    Embree's call. The back side flag is that triangle's.
 //  - Of two surfaces closer together along the ray than Embree's rounding (~1e-7 of the
 //    scale) and not sharing an edge or vertex, which one is nearest is Embree's call (and
 //    for Intersect, at shared edges too: then t differs by rounding).

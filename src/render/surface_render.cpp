@@ -139,7 +139,10 @@ StatusOr<Image> Cast(const render::ShadedMesh& mesh, std::span<const Float3> fra
                      const SurfaceRenderOptions& o, int width, int height) {
   DISPEX_ASSIGN_OR_RETURN(Camera camera, FrameCamera(frame, o.view, width, height));
   if (mesh.mesh.num_faces() == 0) return Image(width, height, render::kPanelBackground);
-  DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer, MakeEmbreeTracer(mesh.mesh));
+  TracerOptions tracer_options;
+  tracer_options.normal_queries = false;  // camera rays only
+  DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer,
+                          MakeEmbreeTracer(mesh.mesh, tracer_options));
   return render::CastPanel(mesh, *tracer, camera, Shading(o, frame));
 }
 

@@ -56,8 +56,8 @@ struct Candidate {
   float t = 0;
   unsigned geom = RTC_INVALID_GEOMETRY_ID;
   unsigned prim = 0;
-  bool back = false;   // dot(ray direction, Ng) > 0
-  Float3 ng;           // Embree's unnormalised geometric normal
+  bool back = false;   // the triangle's back side met (ExactHit)
+  Float3 ng;           // Embree's unnormalised geometric normal (Intersect reports it)
   float u = 0, v = 0;  // Embree's (u, v) on the primitive (the tie rule's)
   bool hit() const { return geom != RTC_INVALID_GEOMETRY_ID; }
 };
@@ -106,19 +106,29 @@ template <class Caster>
   return shift;
 }
 
-// The triangle of primitive `prim` that Embree's (u, v) fall in, its corners in ExactT's order,
-// and (u, v)'s barycentric weights of those corners. Of a quad's two triangles (v0 v1 v3) and
-// (v2 v3 v1) Embree reports the second with u + v > 1 (and (u, v) over the whole quad).
+// The corners of a primitive's triangle, in ExactT's order: a quad's two triangles are
+// (v0 v1 v3) and, `second`, (v2 v3 v1), as Embree splits it; a triangle is itself.
+struct TriangleCorners {
+  std::int32_t ids[3];
+};
+inline TriangleCorners CornersOf(const GeometryView& g, unsigned prim, bool second) {
+  const std::int32_t* c = g.indices + static_cast<std::size_t>(g.corners) * prim;
+  if (g.corners == 3) return {{c[0], c[1], c[2]}};
+  return second ? TriangleCorners{{c[2], c[3], c[1]}} : TriangleCorners{{c[0], c[1], c[3]}};
+}
+
+// The triangle of primitive `prim` that Embree's (u, v) fall in (for a quad, the second when
+// u + v > 1: Embree reports (u, v) over the whole quad), and (u, v)'s barycentric weights of
+// its corners.
 struct HitTriangle {
   std::int32_t ids[3];
   float weights[3];
-  bool second = false;
 };
 inline HitTriangle TriangleOf(const GeometryView& g, unsigned prim, float u, float v) {
-  const std::int32_t* c = g.indices + static_cast<std::size_t>(g.corners) * prim;
-  if (g.corners == 3) return HitTriangle{{c[0], c[1], c[2]}, {1 - u - v, u, v}, false};
-  if (u + v > 1) return HitTriangle{{c[2], c[3], c[1]}, {u + v - 1, 1 - u, 1 - v}, true};
-  return HitTriangle{{c[0], c[1], c[3]}, {1 - u - v, u, v}, false};
+  const bool second = g.corners == 4 && u + v > 1;
+  const TriangleCorners c = CornersOf(g, prim, second);
+  if (second) return HitTriangle{{c.ids[0], c.ids[1], c.ids[2]}, {u + v - 1, 1 - u, 1 - v}};
+  return HitTriangle{{c.ids[0], c.ids[1], c.ids[2]}, {1 - u - v, u, v}};
 }
 
 // Where the line o + t d meets the plane of triangle ids[], in double (`exact`) and rounded
@@ -249,11 +259,9 @@ inline bool ResolveTie(const EmbreeScene& scene, const Float3& o, const Float3& 
   };
   std::optional<Rank> best;
   unsigned best_geom = 0;
-  std::int32_t best_ids[3] = {0, 0, 0};
+  PlaneHit best_plane{};
   const auto consider = [&](unsigned geom, unsigned prim, int second) {
-    // A (u, v) inside the triangle wanted names it (u + v > 1: a quad's second).
-    const float inside = second ? 0.75f : 0.25f;
-    const HitTriangle tri = TriangleOf(scene.geometry(geom), prim, inside, inside);
+    const TriangleCorners tri = CornersOf(scene.geometry(geom), prim, second != 0);
     if (in_band) {
       for (int k = 0; k < count; ++k) {
         if (tri.ids[0] != feature[k] && tri.ids[1] != feature[k] && tri.ids[2] != feature[k]) {
@@ -263,14 +271,15 @@ inline bool ResolveTie(const EmbreeScene& scene, const Float3& o, const Float3& 
     }
     const double weight = InsideWeight(positions, tri.ids, o, d);
     if (std::isnan(weight)) return;
-    const double t = PlaneOf(positions, tri.ids, o, d).exact;
-    const bool through = weight >= 0 && std::fabs(t - kept.t) <= margin;
+    const PlaneHit plane = PlaneOf(positions, tri.ids, o, d);
+    const bool through = weight >= 0 && std::fabs(plane.exact - kept.t) <= margin;
     if (!through && !in_band) return;
-    const Rank rank{!through, through ? t : -weight, scene.FaceOf(geom, prim), prim, second};
+    const Rank rank{!through, through ? plane.exact : -weight, scene.FaceOf(geom, prim), prim,
+                    second};
     if (best && best->key() <= rank.key()) return;
     best = rank;
     best_geom = geom;
-    std::copy(tri.ids, tri.ids + 3, best_ids);
+    best_plane = plane;
   };
   const auto consider_around = [&](std::int32_t vertex) {
     for (std::uint32_t global : scene.vertex_prims().around(vertex)) {
@@ -292,11 +301,9 @@ inline bool ResolveTie(const EmbreeScene& scene, const Float3& o, const Float3& 
   } else {
     for (std::int32_t corner : hit.ids) consider_around(corner);
   }
-  if (!best) return true;
-  const PlaneHit plane = PlaneOf(positions, best_ids, o, d);
-  if (std::isnan(plane.t)) return true;
-  kept.t = plane.t;
-  kept.back = plane.back;
+  if (!best || std::isnan(best_plane.t)) return true;
+  kept.t = best_plane.t;
+  kept.back = best_plane.back;
   kept.geom = best_geom;
   kept.prim = best->prim;
   return true;

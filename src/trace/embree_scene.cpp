@@ -175,10 +175,10 @@ Status EmbreeScene::Setup(const Mesh& mesh, const TracerOptions& options) {
       geometries_[kTriangleGeometry].face_of_prim = triangle_faces_.data();
     }
   }
-  DISPEX_ASSIGN_OR_RETURN(vertex_prims_,
-                          BuildVertexPrims(quad_indices, counts.quads, triangle_indices,
-                                           counts.triangles, positions_, num_vertices));
-  stats_.vertex_table_bytes = vertex_prims_.bytes();
+  DISPEX_RETURN_IF_ERROR(CheckVertexPrimsFit(counts.quads, counts.triangles));
+  num_quads_ = counts.quads;
+  num_vertices_ = num_vertices;
+  if (options.normal_queries) vertex_prims();
   stats_.setup_seconds = Seconds(setup_start);
 
   const auto build_start = Clock::now();
@@ -218,6 +218,20 @@ Status EmbreeScene::Setup(const Mesh& mesh, const TracerOptions& options) {
       options.robust ? ", robust" : "", options.compact ? ", compact" : "",
       options.retry_misses ? ", retry misses" : "", options.verify_hits ? ", verify hits" : "");
   return Status::Ok();
+}
+
+const VertexPrims& EmbreeScene::vertex_prims() const {
+  std::call_once(vertex_prims_once_, [&] {
+    // Isolated: a thread waiting in the build's parallel loops must not pick up another batch
+    // of queries, which would wait on this very call.
+    tbb::this_task_arena::isolate([&] {
+      const GeometryView& q = geometries_[kQuadGeometry];
+      const GeometryView& t = geometries_[kTriangleGeometry];
+      vertex_prims_ =
+          BuildVertexPrims(q.indices, q.count, t.indices, t.count, positions_, num_vertices_);
+    });
+  });
+  return vertex_prims_;
 }
 
 }  // namespace dispex::trace

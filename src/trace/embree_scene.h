@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "dispex/mesh.h"
@@ -57,18 +58,19 @@ class EmbreeScene {
     return g.face_of_prim != nullptr ? g.face_of_prim[prim_id] : static_cast<std::int32_t>(prim_id);
   }
 
-  // The primitives around each vertex (the tie rule, batch_kernels.h).
-  const VertexPrims& vertex_prims() const { return vertex_prims_; }
-  // Global primitive `p` of VertexPrims as (geometry, primitive).
+  // The primitives around each vertex (the tie rule of normal queries, batch_kernels.h), built
+  // on first use: scenes that only answer other queries (render, verify) never build them.
+  // Thread-safe.
+  const VertexPrims& vertex_prims() const;
+  // Global primitive `p` of VertexPrims as (geometry, primitive), and back.
   unsigned GeomOf(std::uint32_t p) const {
-    return p < vertex_prims_.num_quads ? kQuadGeometry : kTriangleGeometry;
+    return p < num_quads_ ? kQuadGeometry : kTriangleGeometry;
   }
   std::uint32_t GlobalOf(unsigned geom, unsigned prim) const {
-    return geom == kQuadGeometry ? prim
-                                 : static_cast<std::uint32_t>(vertex_prims_.num_quads + prim);
+    return geom == kQuadGeometry ? prim : static_cast<std::uint32_t>(num_quads_ + prim);
   }
   unsigned PrimOf(std::uint32_t p) const {
-    return p < vertex_prims_.num_quads ? p : static_cast<unsigned>(p - vertex_prims_.num_quads);
+    return p < num_quads_ ? p : static_cast<unsigned>(p - num_quads_);
   }
 
   const TracerStats& stats() const { return stats_; }
@@ -93,7 +95,9 @@ class EmbreeScene {
   std::vector<std::int32_t> quad_indices_, quad_faces_;          // mixed meshes only
   std::vector<std::int32_t> triangle_indices_, triangle_faces_;  // n-gons or mixed meshes
   GeometryView geometries_[kNumGeometries];
-  VertexPrims vertex_prims_;
+  std::size_t num_quads_ = 0, num_vertices_ = 0;
+  mutable std::once_flag vertex_prims_once_;
+  mutable VertexPrims vertex_prims_;
   TracerStats stats_;
   bool retry_misses_ = true;
   bool verify_hits_ = false;

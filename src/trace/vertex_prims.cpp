@@ -62,14 +62,17 @@ bool Folds(const VertexPrims& vp, std::int32_t v, std::span<const std::uint32_t>
 
 }  // namespace
 
-StatusOr<VertexPrims> BuildVertexPrims(const std::int32_t* quads, std::size_t num_quads,
-                                       const std::int32_t* triangles, std::size_t num_triangles,
-                                       const Float3* positions, std::size_t num_vertices) {
+Status CheckVertexPrimsFit(std::size_t num_quads, std::size_t num_triangles) {
   const std::size_t corners = 4 * num_quads + 3 * num_triangles;
-  if (corners >= std::numeric_limits<std::uint32_t>::max()) {
-    return Status::Error(fmt::format(
-        "the sculpt's {} face corners are too many for the ray tracer's vertex table", corners));
-  }
+  if (corners < std::numeric_limits<std::uint32_t>::max()) return Status::Ok();
+  return Status::Error(fmt::format(
+      "the sculpt's {} face corners are too many for the ray tracer's vertex table", corners));
+}
+
+VertexPrims BuildVertexPrims(const std::int32_t* quads, std::size_t num_quads,
+                             const std::int32_t* triangles, std::size_t num_triangles,
+                             const Float3* positions, std::size_t num_vertices) {
+  const std::size_t corners = 4 * num_quads + 3 * num_triangles;
   VertexPrims out;
   out.num_quads = num_quads;
   out.offsets.assign(num_vertices + 1, 0);

@@ -28,15 +28,15 @@ struct VertexPrims {
     const auto v = static_cast<std::size_t>(vertex);
     return {prims.data() + offsets[v], prims.data() + offsets[v + 1]};
   }
-  std::size_t bytes() const {
-    return (offsets.capacity() + prims.capacity()) * sizeof(std::uint32_t) + folded.capacity();
-  }
 };
 
+// Whether a table of these primitives fits (fewer than 2^32 corners), else why not.
+Status CheckVertexPrimsFit(std::size_t num_quads, std::size_t num_triangles);
+
 // From the index arrays the scene holds (4 ids per quad, 3 per triangle; either may be empty),
-// every id below num_vertices, and the positions. Fails when the corners number 2^32 or more.
-StatusOr<VertexPrims> BuildVertexPrims(const std::int32_t* quads, std::size_t num_quads,
-                                       const std::int32_t* triangles, std::size_t num_triangles,
-                                       const Float3* positions, std::size_t num_vertices);
+// every id below num_vertices, and the positions. Precondition: CheckVertexPrimsFit.
+VertexPrims BuildVertexPrims(const std::int32_t* quads, std::size_t num_quads,
+                             const std::int32_t* triangles, std::size_t num_triangles,
+                             const Float3* positions, std::size_t num_vertices);
 
 }  // namespace dispex::trace

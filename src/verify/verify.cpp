@@ -239,6 +239,13 @@ StatusOr<DisplacedSurface> Displace(const LimitSurface& surface, const MapReader
   return d;
 }
 
+// A tracer for ClosestDistances: no normal queries, so no tie-rule table.
+StatusOr<std::unique_ptr<Tracer>> ClosestPointTracer(const Mesh& mesh) {
+  TracerOptions options;
+  options.normal_queries = false;
+  return MakeEmbreeTracer(mesh, options);
+}
+
 std::vector<float> ClosestDistances(const Tracer& tracer, std::span<const Float3> points) {
   std::vector<float> distances(points.size());
   constexpr std::size_t kBatch = 4096;
@@ -385,7 +392,7 @@ std::vector<Float3> SculptPoints(const Mesh& sculpt, std::size_t max_points) {
 
 // The sculpt's vertices (at most max_points of them) to `mesh`: the sculpt->map direction.
 StatusOr<ErrorStats> SculptToMesh(const Mesh& sculpt, const Mesh& mesh, std::size_t max_points) {
-  DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer, MakeEmbreeTracer(mesh));
+  DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer, ClosestPointTracer(mesh));
   std::vector<float> d = ClosestDistances(*tracer, SculptPoints(sculpt, max_points));
   return Summarise(d);
 }
@@ -413,7 +420,7 @@ StatusOr<VerifyReport> VerifyDisplacedMesh(const VerifyOptions& options) {
   r.displaced_mesh = true;
   r.diagonal = ComputeBounds(displaced).diagonal();
   {
-    DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> sculpt_tracer, MakeEmbreeTracer(sculpt));
+    DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> sculpt_tracer, ClosestPointTracer(sculpt));
     std::vector<float> d = ClosestDistances(*sculpt_tracer, displaced.positions);
     r.map_to_sculpt = Summarise(d);
   }
@@ -791,7 +798,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     }
     if (displaced.samples.empty()) return Status::Error(options.base_path + ": no surface");
     {
-      DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> sculpt_tracer, MakeEmbreeTracer(sculpt));
+      DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> sculpt_tracer, ClosestPointTracer(sculpt));
       std::vector<float> d = ClosestDistances(*sculpt_tracer, displaced.samples);
       std::vector<double> face_max(r.ptex_faces, 0.0);
       for (std::size_t i = 0; i < d.size(); ++i) {
