@@ -1,7 +1,9 @@
 // MatchRefinedSculpt (dispex/correspondence.h). The steps, in the order Run calls them:
 //  1. the sculpt's faces are quads, and its face and vertex counts name the level;
 //  2. its half-edge adjacency (quad_adjacency.h) and components, which must match the base's
-//     (the Ptex faces with a surface, connected through their edges) by size;
+//     (the Ptex faces with a surface, connected through their edges) by size; against a base
+//     of one component they are compared only when a later step fails, since step 5 proves
+//     a sculpt that passes it connected;
 //  3. per base component, a seed: a base vertex of the rarest (valence, boundary) class, the
 //     sculpt vertices of that class nearest its limit point, and for each quad around them
 //     the labelling that puts it in the corner cell of a Ptex face there. A breadth-first walk
@@ -114,6 +116,28 @@ class Matcher {
 
   StatusOr<SculptCorrespondence> Run() {
     Stopwatch clock;
+    Status status = RunSteps();
+    // One base component: the sculpt's components were taken on trust (MatchComponents);
+    // where a later step failed, a sculpt of other components is named as such.
+    if (!status.ok() && components_trusted_) {
+      Status components = CompareComponents();
+      if (!components.ok()) {
+        labelling_ = false;
+        return components;
+      }
+    }
+    DISPEX_RETURN_IF_ERROR(status);
+    out_.components = components_.size();
+    out_.seconds = clock.seconds();
+    return std::move(out_);
+  }
+
+  // Whether Run got as far as labelling the quads: then a failure may be a sculpt whose faces
+  // all wind the other way, which the counts, edges and components cannot tell.
+  bool labelling() const { return labelling_; }
+
+ private:
+  Status RunSteps() {
     DISPEX_RETURN_IF_ERROR(CheckInputs());
     DISPEX_RETURN_IF_ERROR(FindLevel());
     DISPEX_ASSIGN_OR_RETURN(adjacency_, subdiv::BuildQuadAdjacency(sculpt_));
@@ -131,17 +155,9 @@ class Matcher {
     DISPEX_RETURN_IF_ERROR(CheckFaces());
     DISPEX_RETURN_IF_ERROR(CheckSeams());
     DISPEX_RETURN_IF_ERROR(FindHomes());
-    DISPEX_RETURN_IF_ERROR(CheckPositions());
-    out_.components = components_.size();
-    out_.seconds = clock.seconds();
-    return std::move(out_);
+    return CheckPositions();
   }
 
-  // Whether Run got as far as labelling the quads: then a failure may be a sculpt whose faces
-  // all wind the other way, which the counts, edges and components cannot tell.
-  bool labelling() const { return labelling_; }
-
- private:
   // ---- 1. Inputs and level ------------------------------------------------------------------
 
   Status CheckInputs() {
@@ -258,7 +274,22 @@ class Matcher {
                                component.vertices.end());
     }
     ptex_component_ = std::move(component_of);
+    // With one base component, every quad of a sculpt of the right count must lie in its
+    // grids, which the fill and face checks prove: the sculpt's components are compared only
+    // where a step fails (Run), sparing a pass over the quads.
+    if (components_.size() == 1) {
+      components_trusted_ = true;
+      return Status::Ok();
+    }
+    return CompareComponents();
+  }
 
+  // The sculpt's connected components against the base's, by size. Needs adjacency_, which
+  // it builds again once FillGrids released it.
+  Status CompareComponents() {
+    if (adjacency_.opposite.empty()) {
+      DISPEX_ASSIGN_OR_RETURN(adjacency_, subdiv::BuildQuadAdjacency(sculpt_));
+    }
     std::uint32_t count = 0;
     sculpt_component_ = subdiv::QuadComponents(adjacency_, count);
     sculpt_component_faces_.assign(count, 0);
@@ -587,11 +618,13 @@ class Matcher {
                         for (std::size_t k = r.begin(); k < r.end(); ++k) {
                           const auto x = bucketed ? begin[k] : static_cast<std::uint32_t>(k);
                           if (!bucketed && SculptClass(x) != vertex_class) continue;
-                          const std::uint32_t component =
-                              sculpt_component_[adjacency_.first_half_edge[x] / 4];
-                          if (sculpt_component_matched_[component] ||
-                              sculpt_component_faces_[component] != cells) {
-                            continue;
+                          if (!components_trusted_) {
+                            const std::uint32_t component =
+                                sculpt_component_[adjacency_.first_half_edge[x] / 4];
+                            if (sculpt_component_matched_[component] ||
+                                sculpt_component_faces_[component] != cells) {
+                              continue;
+                            }
                           }
                           const auto vertex = static_cast<std::int32_t>(x);
                           const double d2 = Distance2(Position(vertex), base_limit_[w]);
@@ -678,7 +711,7 @@ class Matcher {
     for (std::size_t k = 0; k < component.faces.size(); ++k) {
       seeds_[component.faces[k]] = best_seeds[k];
     }
-    sculpt_component_matched_[sculpt_component_[best_seeds[0] / 4]] = 1;
+    if (!components_trusted_) sculpt_component_matched_[sculpt_component_[best_seeds[0] / 4]] = 1;
     return Status::Ok();
   }
 
@@ -1030,6 +1063,7 @@ class Matcher {
   QuadAdjacency adjacency_;
   std::vector<BaseComponent> components_;
   std::vector<int> ptex_component_;              // per Ptex face, -1 for holes
+  bool components_trusted_ = false;              // see MatchComponents
   std::vector<std::uint32_t> sculpt_component_;  // per sculpt quad
   std::vector<std::uint64_t> sculpt_component_faces_;
   std::vector<std::uint8_t> sculpt_component_matched_;

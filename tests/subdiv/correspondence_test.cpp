@@ -532,6 +532,40 @@ TEST(MatchRefinedSculpt, ComponentsMustMatch) {
       << matched.status().message();
 }
 
+// A base of one component trusts the sculpt to be connected until a step fails: a sculpt of
+// the right counts in two pieces must still be named as such, not by the step that stumbled.
+TEST(MatchRefinedSculpt, ComponentsMustMatchForOneBaseComponent) {
+  TempDir dir;
+  // A strip of two quads: level 1 has 15 vertices and 8 faces. So has a 2 x 2 grid beside a
+  // closed sphere of four quads (two poles, four vertices around).
+  std::ofstream(dir / "strip.obj") << "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\n"
+                                      "f 1 2 5 4\nf 2 3 6 5\n";
+  std::ofstream pieces(dir / "pieces.obj");
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 3; ++x) pieces << "v " << x * 0.5 << " " << y * 0.5 << " 0\n";
+  }
+  pieces << "v 1.5 0.5 1\nv 1.5 0.5 -1\nv 2 0.5 0\nv 1.5 1 0\nv 1 0.5 0\nv 1.5 0 0\n";
+  for (int y = 0; y < 2; ++y) {
+    for (int x = 0; x < 2; ++x) {
+      const int a = 1 + y * 3 + x;
+      pieces << "f " << a << " " << a + 1 << " " << a + 4 << " " << a + 3 << "\n";
+    }
+  }
+  for (int i = 0; i < 4; ++i) {
+    pieces << "f 10 " << 12 + i << " 11 " << 12 + (i + 1) % 4 << "\n";
+  }
+  pieces.close();
+  const LimitSurface strip = Surface(dir / "strip.obj");
+  auto sculpt = ReadMesh(dir / "pieces.obj");
+  ASSERT_TRUE(sculpt.ok()) << sculpt.status().message();
+  auto matched = MatchRefinedSculpt(strip, *sculpt);
+  ASSERT_FALSE(matched.ok());
+  EXPECT_NE(matched.status().message().find(
+                "the components differ: the sculpt has 2 connected components of 4, 4 faces"),
+            std::string::npos)
+      << matched.status().message();
+}
+
 // catmark_fan: three faces on one edge.
 TEST(MatchRefinedSculpt, NonManifoldCageIsRefused) {
   TempDir dir;
