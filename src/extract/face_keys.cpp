@@ -117,7 +117,9 @@ class CellGrid {
 
 struct FaceBounds {
   std::array<float, 3> centre;
-  float half_extent = 0;  // rounded up: the centre may sit an ulp off the middle
+  // The larger distance from the centre to the box's sides, not yet rounded up by an ulp for
+  // a centre an ulp off the middle (SculptReachKeys rounds the largest of all faces').
+  float half_extent = 0;
 };
 
 // The corners of sculpt face `s`, xyz after xyz, into `xyz`.
@@ -141,9 +143,8 @@ FaceBounds Bounds(std::span<const float> xyz) {
   FaceBounds b;
   for (int k = 0; k < 3; ++k) {
     b.centre[k] = 0.5f * (lower[k] + upper[k]);
-    b.half_extent = std::max(
-        b.half_extent,
-        std::nextafter(std::max(upper[k] - b.centre[k], b.centre[k] - lower[k]), INFINITY));
+    b.half_extent =
+        std::max(b.half_extent, std::max(upper[k] - b.centre[k], b.centre[k] - lower[k]));
   }
   return b;
 }
@@ -196,6 +197,8 @@ std::vector<Hash128> SculptReachKeys(const Mesh& sculpt, const std::vector<Box>&
     }
     half_extent = std::max(half_extent, part.half_extent);
   });
+  // Rounding up the largest is rounding up each: nextafter is monotonic.
+  half_extent = std::nextafter(half_extent, INFINITY);
   std::vector<Hash128> keys(boxes.size());
   reach_faces.assign(boxes.size(), 0);
   tbb::parallel_for(std::size_t{0}, boxes.size(), [&](std::size_t f) {
