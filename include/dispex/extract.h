@@ -338,7 +338,8 @@ struct MergeOptions {
   std::string output_path;
   int threads = 0;
   bool progress = false;
-  std::uint64_t max_memory = 0;  // as ExtractOptions::max_memory
+  ProgressCounter* progress_counter = nullptr;  // as ExtractOptions::progress_counter
+  std::uint64_t max_memory = 0;                 // as ExtractOptions::max_memory
 };
 
 // The map the extraction without shards writes, byte for byte, from the parts of all its

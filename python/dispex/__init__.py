@@ -17,8 +17,8 @@ import os
 from ._dispex import Error, Map, Mesh, __version__, read_mesh as _read_mesh
 from . import _dispex
 
-__all__ = ["Error", "Map", "Mesh", "__version__", "extract", "info", "make_sculpt", "read_mesh",
-           "verify"]
+__all__ = ["Error", "Map", "Mesh", "__version__", "extract", "info", "make_sculpt", "merge",
+           "read_mesh", "verify"]
 
 
 def _path(value, argument):
@@ -59,15 +59,34 @@ def extract(base, sculpt, output, *, progress=None, **options):
     by the library's names (oversample, max_oversample, min_oversample, search_distance,
     ray_policy, tolerance, tolerance_fraction, resolution_rule, fixed_resolution,
     nonzero_threshold, data_type, compression_level, holes, watertight, max_miss_fraction,
-    bvh_quality, method, vector, threads, max_memory, incremental). progress: called as
+    bvh_quality, method, vector, threads, max_memory, incremental, shard="I/N",
+    shard_sculpt="whole"|"part": a farm shard's part, docs/FARM.md). progress: called as
     progress(done, total) (Ptex faces) at most ten times a second. Returns the report (the
     JSON report as a dict). Ctrl-C (KeyboardInterrupt) or an exception raised by `progress`
     cancels the extraction; nothing is written then. The GIL is released while it runs.
     """
     if progress is not None and not callable(progress):
         raise ValueError(f"progress: {progress!r} is not callable")
-    return _dispex._extract(_mesh_or_path(base, "base"), _mesh_or_path(sculpt, "sculpt"),
-                            _path(output, "output"), progress, options)
+    base, sculpt = _mesh_or_path(base, "base"), _mesh_or_path(sculpt, "sculpt")
+    if "shard" in options and (isinstance(base, Mesh) or isinstance(sculpt, Mesh)):
+        raise ValueError("shard: base and sculpt must be paths (the merge reads them again)")
+    return _dispex._extract(base, sculpt, _path(output, "output"), progress, options)
+
+
+def merge(parts, output, *, progress=None, threads=0, max_memory=0):
+    """Merges the parts of all shards of one extraction (extract(..., shard="I/N")) into
+    `output`: byte for byte the map the extraction without shards writes. parts: paths, in any
+    order. Raises dispex.Error naming the part when one is missing, given twice, or made from
+    other inputs, options or version; nothing is written then. Returns the report (a dict).
+    progress, Ctrl-C: as for extract.
+    """
+    if progress is not None and not callable(progress):
+        raise ValueError(f"progress: {progress!r} is not callable")
+    if isinstance(parts, (str, bytes, os.PathLike)):
+        raise ValueError(f"parts: {parts!r} is one path, not a list of parts")
+    paths = [_path(part, f"parts[{i}]") for i, part in enumerate(parts)]
+    return _dispex._merge(paths, _path(output, "output"), progress,
+                          {"threads": threads, "max_memory": max_memory})
 
 
 def verify(base, sculpt, map, *, check=True, **options):

@@ -1,8 +1,12 @@
 // dispex._extract: Extract with meshes given as paths or dispex.Mesh, options by name, the
-// report as a dict (the JSON report the command line writes with --report).
+// report as a dict (the JSON report the command line writes with --report). dispex._merge:
+// MergeShards of the parts farm shards wrote, the report likewise.
 #include <pybind11/stl.h>
 
+#include <functional>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "bindings.h"
 #include "cancellable.h"
@@ -29,6 +33,15 @@ void SetInput(const py::handle& value, const char* argument, std::string& path,
   }
 }
 
+// Runs `run` (which fills `counter`) as RunCancellable does; its report as a dict.
+py::object ReportOf(const std::function<StatusOr<ExtractReport>()>& run,
+                    const ProgressCounter& counter, const py::object& progress) {
+  std::optional<StatusOr<ExtractReport>> report;
+  RunCancellable([&] { report.emplace(run()); }, counter, progress);
+  const ExtractReport done = ValueOrRaise(std::move(*report));
+  return py::module_::import("json").attr("loads")(ExtractReportJson(done));
+}
+
 py::object Extract(const py::handle& base, const py::handle& sculpt, const std::string& output,
                    const py::object& progress, const py::dict& kwargs) {
   ExtractOptions options;
@@ -39,10 +52,22 @@ py::object Extract(const py::handle& base, const py::handle& sculpt, const std::
   CheckArgument(ValidateExtractOptions(options));
   ProgressCounter counter;
   options.progress_counter = &counter;
-  std::optional<StatusOr<ExtractReport>> report;
-  RunCancellable([&] { report.emplace(dispex::Extract(options)); }, counter, progress);
-  const ExtractReport done = ValueOrRaise(std::move(*report));
-  return py::module_::import("json").attr("loads")(ExtractReportJson(done));
+  return ReportOf([&] { return dispex::Extract(options); }, counter, progress);
+}
+
+// `limits`: threads and max_memory, checked as extract's.
+py::object Merge(const std::vector<std::string>& parts, const std::string& output,
+                 const py::object& progress, const py::dict& limits) {
+  ExtractOptions checked;
+  SetExtractOptions(checked, limits);
+  MergeOptions options;
+  options.parts = parts;
+  options.output_path = output;
+  options.threads = checked.threads;
+  options.max_memory = checked.max_memory;
+  ProgressCounter counter;
+  options.progress_counter = &counter;
+  return ReportOf([&] { return dispex::MergeShards(options); }, counter, progress);
 }
 
 }  // namespace
@@ -50,6 +75,8 @@ py::object Extract(const py::handle& base, const py::handle& sculpt, const std::
 void AddExtract(py::module_& module) {
   module.def("_extract", &Extract, py::arg("base"), py::arg("sculpt"), py::arg("output"),
              py::arg("progress"), py::arg("options"));
+  module.def("_merge", &Merge, py::arg("parts"), py::arg("output"), py::arg("progress"),
+             py::arg("limits"));
 }
 
 }  // namespace dispex::python

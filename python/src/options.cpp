@@ -41,6 +41,21 @@ void SetExtractOptions(ExtractOptions& options, const py::dict& kwargs) {
                                           py::repr(value).cast<std::string>()));
       }
       options.incremental = value.cast<bool>();
+    } else if (name == "shard") {
+      if (!py::isinstance<py::str>(value)) {
+        throw py::value_error(
+            fmt::format("shard: {} is not a string \"I/N\"", py::repr(value).cast<std::string>()));
+      }
+      CheckArgument(ParseShard(value.cast<std::string>(), options.shard_index, options.shard_count)
+                        .WithPrefix("shard"));
+    } else if (name == "shard_sculpt") {
+      if (!py::isinstance<py::str>(value)) {
+        throw py::value_error(fmt::format("shard_sculpt: {} is not \"whole\" or \"part\"",
+                                          py::repr(value).cast<std::string>()));
+      }
+      StatusOr<ShardSculpt> kind = ParseShardSculpt(value.cast<std::string>());
+      CheckArgument(kind.status().WithPrefix("shard_sculpt"));
+      options.shard_sculpt = *kind;
     } else {
       std::string json;
       try {

@@ -341,6 +341,7 @@ StatusOr<ExtractReport> MergeShards(const MergeOptions& merge) {
   options.output_path = merge.output_path;
   options.threads = merge.threads;
   options.progress = merge.progress;
+  options.progress_counter = merge.progress_counter;
   options.max_memory = merge.max_memory;
   Status valid = ValidateExtractOptions(options);
   if (!valid.ok()) return valid.WithPrefix(parts.front().path);
