@@ -46,6 +46,11 @@ def _mesh_or_path(value, argument):
     return _path(value, argument)
 
 
+def _check_progress(progress):
+    if progress is not None and not callable(progress):
+        raise ValueError(f"progress: {progress!r} is not callable")
+
+
 def read_mesh(path):
     """Reads an OBJ or PLY file into a dispex.Mesh (named by its path)."""
     return _read_mesh(_path(path, "path"))
@@ -65,8 +70,7 @@ def extract(base, sculpt, output, *, progress=None, **options):
     JSON report as a dict). Ctrl-C (KeyboardInterrupt) or an exception raised by `progress`
     cancels the extraction; nothing is written then. The GIL is released while it runs.
     """
-    if progress is not None and not callable(progress):
-        raise ValueError(f"progress: {progress!r} is not callable")
+    _check_progress(progress)
     base, sculpt = _mesh_or_path(base, "base"), _mesh_or_path(sculpt, "sculpt")
     if "shard" in options and (isinstance(base, Mesh) or isinstance(sculpt, Mesh)):
         raise ValueError("shard: base and sculpt must be paths (the merge reads them again)")
@@ -80,8 +84,7 @@ def merge(parts, output, *, progress=None, threads=0, max_memory=0):
     other inputs, options or version; nothing is written then. Returns the report (a dict).
     progress, Ctrl-C: as for extract.
     """
-    if progress is not None and not callable(progress):
-        raise ValueError(f"progress: {progress!r} is not callable")
+    _check_progress(progress)
     if isinstance(parts, (str, bytes, os.PathLike)):
         raise ValueError(f"parts: {parts!r} is one path, not a list of parts")
     paths = [_path(part, f"parts[{i}]") for i, part in enumerate(parts)]

@@ -206,19 +206,18 @@ TEST(Ties, AtAFoldTheNearerSheetIsKeptWhateverTheBvhOrTheRayMode) {
     positions.insert(positions.end(),
                      {{x, 0, 0}, {x + 1, 0, 0}, {x + 0.5f, 1, 0}, {x + 0.5f, 1, 2e-8f}});
   }
-  Mesh folds = trace_test::NewMesh(positions);
-  for (int k = 0; k < kPairs; ++k) {
-    const int a = 4 * k;
-    trace_test::AddFace(folds, {a, a + 1, a + 2});  // faces +z
-    trace_test::AddFace(folds, {a + 1, a, a + 3});  // turned back: faces -z
-  }
-  // The part: the first half of the pairs.
-  Mesh part = trace_test::NewMesh({positions.begin(), positions.begin() + 2 * kPairs});
-  for (int k = 0; k < kPairs / 2; ++k) {
-    const int a = 4 * k;
-    trace_test::AddFace(part, {a, a + 1, a + 2});
-    trace_test::AddFace(part, {a + 1, a, a + 3});
-  }
+  // The first `pairs` pairs as a mesh.
+  const auto pairs_mesh = [&](int pairs) {
+    Mesh mesh = trace_test::NewMesh({positions.begin(), positions.begin() + 4 * pairs});
+    for (int k = 0; k < pairs; ++k) {
+      const int a = 4 * k;
+      trace_test::AddFace(mesh, {a, a + 1, a + 2});  // faces +z
+      trace_test::AddFace(mesh, {a + 1, a, a + 3});  // turned back: faces -z
+    }
+    return mesh;
+  };
+  const Mesh folds = pairs_mesh(kPairs);
+  const Mesh part = pairs_mesh(kPairs / 2);  // the part: the first half of the pairs
   std::vector<Float3> origins, normals;
   for (int k = 0; k < kPairs / 2; ++k) {
     for (int j = 1; j <= 9; ++j) {
