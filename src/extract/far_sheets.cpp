@@ -1,18 +1,20 @@
 #include "extract/far_sheets.h"
 
+#include <emmintrin.h>
+
 #include <algorithm>
-#include <bit>
+#include <cfloat>
 #include <cmath>
+#include <optional>
 
 namespace dispex::extract {
 
 namespace {
 
-// How far sample k's window reaches each way: up to its hit under the nearest policy (nothing
-// nearer may exist), else the query's whole distance.
-float Window(std::size_t k, const NormalQuery& query, const NormalHits& out) {
-  const bool hit = out.flags[k] & HitFlags::kHit;
-  return hit && query.policy == HitPolicy::kNearest ? std::fabs(out.t[k]) : query.distance;
+// How far sample k's window reaches each way: up to its hit under the nearest policy
+// (`nearest`: nothing nearer may exist), else the query's whole distance.
+float Window(std::size_t k, const NormalQuery& query, bool nearest, const NormalHits& out) {
+  return nearest && (out.flags[k] & HitFlags::kHit) ? std::fabs(out.t[k]) : query.distance;
 }
 
 // Each bound of the window o -+ w |n| is within a few roundings of the exact one; 2^-20 of the
@@ -22,50 +24,26 @@ float RoundingMargin(const Float3& o, float w) {
   return scale * 0x1p-20f + 0x1p-126f;
 }
 
-// The box of sample k's window, or false when it has none to check (a sample not decided, or
-// one with no valid line: a miss by rule).
+// The box of sample k's window into `box`, or false when it has none to check (a sample not
+// decided, or one with no valid line: a miss by rule). `nearest`: the query's policy is
+// HitPolicy::kNearest.
 bool WindowBox(std::size_t k, std::span<const Float3> origins, std::span<const Float3> normals,
-               const NormalQuery& query, const NormalHits& out,
+               const NormalQuery& query, bool nearest, const NormalHits& out,
                std::span<const std::uint8_t> undecided, Box& box) {
-  if (undecided[k]) return false;
   const Float3& o = origins[k];
   const Float3& d = normals[k];
-  const float c[3] = {o.x, o.y, o.z}, n[3] = {d.x, d.y, d.z};
-  for (int a = 0; a < 3; ++a) {
-    if (!std::isfinite(c[a]) || !std::isfinite(n[a])) return false;
-  }
-  if (n[0] == 0 && n[1] == 0 && n[2] == 0) return false;
-  const float w = Window(k, query, out);
-  if (!std::isfinite(w)) return false;
+  const float w = Window(k, query, nearest, out);
+  // Evaluated whole, without branches: most samples pass.
+  const bool valid = !undecided[k] & std::isfinite(o.x) & std::isfinite(o.y) & std::isfinite(o.z) &
+                     std::isfinite(d.x) & std::isfinite(d.y) & std::isfinite(d.z) &
+                     ((d.x != 0) | (d.y != 0) | (d.z != 0)) & std::isfinite(w);
+  if (!valid) return false;
   const float e = RoundingMargin(o, w);
+  const float c[3] = {o.x, o.y, o.z}, n[3] = {d.x, d.y, d.z};
   for (int a = 0; a < 3; ++a) {
     const float r = w * std::fabs(n[a]);
     box.lower[a] = c[a] - r - e;
     box.upper[a] = c[a] + r + e;
-  }
-  return true;
-}
-
-// Whether sample k's window, the segment o + t n for |t| <= w, meets `box` widened by its
-// rounding margin (in double: a slab test, far tighter than the window's box where n is
-// oblique to the axes).
-bool SegmentMeets(const Float3& o, const Float3& d, double w, const Box& box) {
-  const double c[3] = {o.x, o.y, o.z}, n[3] = {d.x, d.y, d.z};
-  double t0 = -w, t1 = w;
-  for (int a = 0; a < 3; ++a) {
-    const double e = (std::max(std::fabs(double(box.lower[a])), std::fabs(double(box.upper[a]))) +
-                      std::fabs(c[a]) + w) *
-                         0x1p-20 +
-                     0x1p-126;
-    const double lo = double(box.lower[a]) - e, hi = double(box.upper[a]) + e;
-    if (n[a] == 0) {
-      if (c[a] < lo || c[a] > hi) return false;
-      continue;
-    }
-    const double ta = (lo - c[a]) / n[a], tb = (hi - c[a]) / n[a];
-    t0 = std::max(t0, std::min(ta, tb));
-    t1 = std::min(t1, std::max(ta, tb));
-    if (t0 > t1) return false;
   }
   return true;
 }
@@ -76,6 +54,117 @@ void Grow(Box& into, const Box& box) {
     into.upper[a] = std::max(into.upper[a], box.upper[a]);
   }
 }
+
+// The box of the windows of samples `ks` that have one (WindowBox), empty (lower > upper) when
+// none has: the same bounds as WindowBox's, four samples at a time (SSE2, in every x86-64).
+Box WindowsBox(std::span<const std::int32_t> ks, std::span<const Float3> origins,
+               std::span<const Float3> normals, const NormalQuery& query, bool nearest,
+               const NormalHits& out, std::span<const std::uint8_t> undecided) {
+  __m128 lower[3], upper[3];
+  for (int a = 0; a < 3; ++a) {
+    lower[a] = _mm_set1_ps(INFINITY);
+    upper[a] = _mm_set1_ps(-INFINITY);
+  }
+  const __m128 sign = _mm_set1_ps(-0.0f), largest = _mm_set1_ps(FLT_MAX), zero = _mm_setzero_ps();
+  const __m128 scale = _mm_set1_ps(0x1p-20f), tiny = _mm_set1_ps(0x1p-126f);
+  auto finite = [&](__m128 v) { return _mm_cmple_ps(_mm_andnot_ps(sign, v), largest); };
+  std::size_t s = 0;
+  for (; s + 4 <= ks.size(); s += 4) {
+    const std::size_t k[4] = {static_cast<std::size_t>(ks[s]), static_cast<std::size_t>(ks[s + 1]),
+                              static_cast<std::size_t>(ks[s + 2]),
+                              static_cast<std::size_t>(ks[s + 3])};
+    const Float3 *o[4], *d[4];
+    for (int l = 0; l < 4; ++l) {
+      o[l] = &origins[k[l]];
+      d[l] = &normals[k[l]];
+    }
+    // Built in registers: four scalar stores read back as one vector stall the load.
+    const __m128 cv[3] = {_mm_setr_ps(o[0]->x, o[1]->x, o[2]->x, o[3]->x),
+                          _mm_setr_ps(o[0]->y, o[1]->y, o[2]->y, o[3]->y),
+                          _mm_setr_ps(o[0]->z, o[1]->z, o[2]->z, o[3]->z)};
+    const __m128 nv[3] = {_mm_setr_ps(d[0]->x, d[1]->x, d[2]->x, d[3]->x),
+                          _mm_setr_ps(d[0]->y, d[1]->y, d[2]->y, d[3]->y),
+                          _mm_setr_ps(d[0]->z, d[1]->z, d[2]->z, d[3]->z)};
+    const __m128 w =
+        _mm_setr_ps(Window(k[0], query, nearest, out), Window(k[1], query, nearest, out),
+                    Window(k[2], query, nearest, out), Window(k[3], query, nearest, out));
+    __m128 valid =
+        _mm_castsi128_ps(_mm_setr_epi32(undecided[k[0]] ? 0 : -1, undecided[k[1]] ? 0 : -1,
+                                        undecided[k[2]] ? 0 : -1, undecided[k[3]] ? 0 : -1));
+    __m128 nonzero = _mm_setzero_ps(), magnitude = _mm_setzero_ps();
+    for (int a = 0; a < 3; ++a) {
+      valid = _mm_and_ps(valid, _mm_and_ps(finite(cv[a]), finite(nv[a])));
+      nonzero = _mm_or_ps(nonzero, _mm_cmpneq_ps(nv[a], zero));
+      magnitude = _mm_max_ps(magnitude, _mm_andnot_ps(sign, cv[a]));
+    }
+    valid = _mm_and_ps(valid, _mm_and_ps(nonzero, finite(w)));
+    // RoundingMargin: (the largest |coordinate| + w) 2^-20 + 2^-126.
+    const __m128 e = _mm_add_ps(_mm_mul_ps(_mm_add_ps(magnitude, w), scale), tiny);
+    for (int a = 0; a < 3; ++a) {
+      const __m128 r = _mm_mul_ps(w, _mm_andnot_ps(sign, nv[a]));
+      const __m128 lo = _mm_sub_ps(_mm_sub_ps(cv[a], r), e);
+      const __m128 hi = _mm_add_ps(_mm_add_ps(cv[a], r), e);
+      lower[a] =
+          _mm_or_ps(_mm_and_ps(valid, _mm_min_ps(lo, lower[a])), _mm_andnot_ps(valid, lower[a]));
+      upper[a] =
+          _mm_or_ps(_mm_and_ps(valid, _mm_max_ps(hi, upper[a])), _mm_andnot_ps(valid, upper[a]));
+    }
+  }
+  Box all;
+  for (int a = 0; a < 3; ++a) {
+    alignas(16) float lo[4], hi[4];
+    _mm_store_ps(lo, lower[a]);
+    _mm_store_ps(hi, upper[a]);
+    all.lower[a] = std::min({lo[0], lo[1], lo[2], lo[3]});
+    all.upper[a] = std::max({hi[0], hi[1], hi[2], hi[3]});
+  }
+  Box box;
+  for (; s < ks.size(); ++s) {
+    const auto k = static_cast<std::size_t>(ks[s]);
+    if (WindowBox(k, origins, normals, query, nearest, out, undecided, box)) Grow(all, box);
+  }
+  return all;
+}
+
+// Sample k's window, the segment o + t n for |t| <= w, prepared once for its tests: its
+// origin, the reciprocals of its direction (a slab bound is a product, within an ulp of the
+// quotient: far inside the margins below) and each axis's margin but the box's own share.
+struct Segment {
+  double c[3], inv[3], margin[3], w;
+  bool parallel[3];
+
+  Segment(const Float3& o, const Float3& d, double window) : w(window) {
+    const double n[3] = {d.x, d.y, d.z};
+    c[0] = o.x;
+    c[1] = o.y;
+    c[2] = o.z;
+    for (int a = 0; a < 3; ++a) {
+      parallel[a] = n[a] == 0;
+      inv[a] = parallel[a] ? 0 : 1 / n[a];
+      margin[a] = (std::fabs(c[a]) + w) * 0x1p-20 + 0x1p-126;
+    }
+  }
+
+  // Whether it meets `box` widened by its rounding margin (a slab test in double, far tighter
+  // than the window's box where n is oblique to the axes).
+  bool Meets(const Box& box) const {
+    double t0 = -w, t1 = w;
+    for (int a = 0; a < 3; ++a) {
+      const double lower = box.lower[a], upper = box.upper[a];
+      const double e = std::max(std::fabs(lower), std::fabs(upper)) * 0x1p-20 + margin[a];
+      const double lo = lower - e, hi = upper + e;
+      if (parallel[a]) {
+        if (c[a] < lo || c[a] > hi) return false;
+        continue;
+      }
+      const double ta = (lo - c[a]) * inv[a], tb = (hi - c[a]) * inv[a];
+      t0 = std::max(t0, std::min(ta, tb));
+      t1 = std::min(t1, std::max(ta, tb));
+      if (t0 > t1) return false;
+    }
+    return true;
+  }
+};
 
 }  // namespace
 
@@ -90,96 +179,111 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, i
   const int per = blocks.blocks_per_side(face);
   if (per == 0) return 0;
   if (w.near_face != face) LayOutNearBlocks(mapping, face, w);
-  const std::size_t count = samples.empty() ? static_cast<std::size_t>(n) * n : samples.size();
-  auto index = [&](std::size_t s) {
-    return samples.empty() ? s : static_cast<std::size_t>(samples[s]);
-  };
-  // The block of cells under each column (row) of samples, and the block of sample k (on a
-  // texel grid, n a power of two, k's row and column are a shift and a mask).
-  w.sample_block_of.resize(static_cast<std::size_t>(n));
+  // The block of cells under each column (row) of samples; the samples of each block of them
+  // at block_samples[block_first[at] .. block_first[at + 1]).
+  const auto un = static_cast<std::size_t>(n);
+  w.sample_block_of.resize(un);
   for (int i = 0; i < n; ++i) {
     const auto cell = static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));
     w.sample_block_of[static_cast<std::size_t>(i)] = cell / b;
   }
-  const auto un = static_cast<std::size_t>(n);
-  const bool power_of_two = std::has_single_bit(un);
-  const int shift = std::countr_zero(un);
-  auto block_of = [&](std::size_t k) {
-    const std::size_t i = power_of_two ? k & (un - 1) : k % un;
-    const std::size_t j = power_of_two ? k >> shift : k / un;
-    return static_cast<std::size_t>(w.sample_block_of[j]) * static_cast<std::size_t>(per) +
-           static_cast<std::size_t>(w.sample_block_of[i]);
-  };
-  // Per block of samples, the box of their windows.
-  const auto num_blocks = static_cast<std::size_t>(per) * static_cast<std::size_t>(per);
-  w.sample_boxes.resize(num_blocks);
-  w.sample_box_used.assign(num_blocks, 0);
-  Box box;
-  for (std::size_t s = 0; s < count; ++s) {
-    const std::size_t k = index(s);
-    if (!WindowBox(k, origins, normals, query, out, undecided, box)) continue;
-    const std::size_t at = block_of(k);
-    if (w.sample_box_used[at]) {
-      Grow(w.sample_boxes[at], box);
-    } else {
-      w.sample_boxes[at] = box;
-      w.sample_box_used[at] = 1;
+  const auto uper = static_cast<std::size_t>(per);
+  const std::size_t num_blocks = uper * uper;
+  w.block_first.assign(num_blocks + 1, 0);
+  if (samples.empty()) {
+    // Rows and columns of a block are runs (the cells rise with i): its samples in row order.
+    w.block_samples.resize(un * un);
+    std::size_t next = 0;
+    std::size_t j0 = 0;
+    for (std::size_t bj = 0; bj < uper; ++bj) {
+      std::size_t j1 = j0;
+      while (j1 < un && static_cast<std::size_t>(w.sample_block_of[j1]) == bj) ++j1;
+      std::size_t i0 = 0;
+      for (std::size_t bi = 0; bi < uper; ++bi) {
+        std::size_t i1 = i0;
+        while (i1 < un && static_cast<std::size_t>(w.sample_block_of[i1]) == bi) ++i1;
+        for (std::size_t j = j0; j < j1; ++j) {
+          for (std::size_t i = i0; i < i1; ++i) {
+            w.block_samples[next++] = static_cast<std::int32_t>(j * un + i);
+          }
+        }
+        w.block_first[bj * uper + bi + 1] = static_cast<std::int32_t>(next);
+        i0 = i1;
+      }
+      j0 = j1;
+    }
+  } else {
+    auto block_of = [&](std::int32_t k) {
+      const auto uk = static_cast<std::size_t>(k);
+      return static_cast<std::size_t>(w.sample_block_of[uk / un]) * uper +
+             static_cast<std::size_t>(w.sample_block_of[uk % un]);
+    };
+    for (std::int32_t k : samples) ++w.block_first[block_of(k) + 1];
+    for (std::size_t at = 0; at < num_blocks; ++at) w.block_first[at + 1] += w.block_first[at];
+    w.block_samples.resize(samples.size());
+    w.block_fill.assign(w.block_first.begin(), w.block_first.end() - 1);
+    for (std::int32_t k : samples) {
+      w.block_samples[static_cast<std::size_t>(w.block_fill[block_of(k)]++)] = k;
     }
   }
-  // Its candidates: the sculpt blocks the box meets that are not near.
-  const int width = per + 2;
-  w.candidate_starts.assign(1, 0);
-  w.candidate_ids.clear();
   // The near blocks of a block of samples are stamped in near_stamp (one entry per sculpt
   // block, kept by the thread), so each block met is looked up once.
   if (w.near_stamp.size() != static_cast<std::size_t>(blocks.num_blocks())) {
     w.near_stamp.assign(static_cast<std::size_t>(blocks.num_blocks()), 0);
     w.stamp = 0;
   }
+  const int width = per + 2;
+  const bool nearest = query.policy == HitPolicy::kNearest;
+  std::uint64_t sent = 0;
   for (int bj = 0; bj < per; ++bj) {
     for (int bi = 0; bi < per; ++bi) {
-      const std::size_t at = static_cast<std::size_t>(bj) * per + bi;
-      if (w.sample_box_used[at]) {
-        if (++w.stamp == 0) {
-          std::fill(w.near_stamp.begin(), w.near_stamp.end(), 0);
-          w.stamp = 1;
-        }
-        for (int dj = 0; dj <= 2; ++dj) {
-          for (int di = 0; di <= 2; ++di) {
-            const auto slot = static_cast<std::size_t>((bj + dj) * width + bi + di);
-            for (std::int32_t k = w.near_starts[slot]; k < w.near_starts[slot + 1]; ++k) {
-              w.near_stamp[static_cast<std::size_t>(w.near_ids[static_cast<std::size_t>(k)])] =
-                  w.stamp;
-            }
+      const std::size_t at = static_cast<std::size_t>(bj) * uper + static_cast<std::size_t>(bi);
+      // The box of the block's windows.
+      const std::span<const std::int32_t> block_samples(
+          w.block_samples.data() + w.block_first[at],
+          static_cast<std::size_t>(w.block_first[at + 1] - w.block_first[at]));
+      const Box all = WindowsBox(block_samples, origins, normals, query, nearest, out, undecided);
+      if (!(all.lower[0] <= all.upper[0])) continue;
+      // Its candidates: the sculpt blocks the box meets that are not near.
+      if (++w.stamp == 0) {
+        std::fill(w.near_stamp.begin(), w.near_stamp.end(), 0);
+        w.stamp = 1;
+      }
+      for (int dj = 0; dj <= 2; ++dj) {
+        for (int di = 0; di <= 2; ++di) {
+          const auto slot = static_cast<std::size_t>((bj + dj) * width + bi + di);
+          for (std::int32_t k = w.near_starts[slot]; k < w.near_starts[slot + 1]; ++k) {
+            w.near_stamp[static_cast<std::size_t>(w.near_ids[static_cast<std::size_t>(k)])] =
+                w.stamp;
           }
         }
-        blocks.ForEachMeeting(w.sample_boxes[at], [&](std::int64_t id) {
-          if (w.near_stamp[static_cast<std::size_t>(id)] != w.stamp) w.candidate_ids.push_back(id);
-        });
       }
-      w.candidate_starts.push_back(static_cast<std::int32_t>(w.candidate_ids.size()));
-    }
-  }
-  if (w.candidate_ids.empty()) return 0;
-  // The samples of blocks with candidates, one by one.
-  std::uint64_t sent = 0;
-  for (std::size_t s = 0; s < count; ++s) {
-    const std::size_t k = index(s);
-    const std::size_t at = block_of(k);
-    if (w.candidate_starts[at] == w.candidate_starts[at + 1]) continue;
-    if (!WindowBox(k, origins, normals, query, out, undecided, box)) continue;
-    const float window = Window(k, query, out);
-    // A crossing within rounding beyond the window's end counts: the ray path may find it inside.
-    const Float3& o = origins[k];
-    const float reach = window + RoundingMargin(o, window);
-    for (std::int32_t c = w.candidate_starts[at]; c < w.candidate_starts[at + 1]; ++c) {
-      const std::int64_t id = w.candidate_ids[static_cast<std::size_t>(c)];
-      const Box& candidate = blocks.box(id);
-      if (candidate.Meets(box) && SegmentMeets(o, normals[k], window, candidate) &&
-          WindowCrossesBlock(mapping, sculpt, id, o, normals[k], reach)) {
-        undecided[k] = 1;
-        ++sent;
-        break;
+      w.candidate_ids.clear();
+      blocks.ForEachMeeting(all, [&](std::int64_t id) {
+        if (w.near_stamp[static_cast<std::size_t>(id)] != w.stamp) w.candidate_ids.push_back(id);
+      });
+      if (w.candidate_ids.empty()) continue;
+      // Its samples, one by one.
+      Box window_box;
+      for (const std::int32_t sample : block_samples) {
+        const auto k = static_cast<std::size_t>(sample);
+        if (!WindowBox(k, origins, normals, query, nearest, out, undecided, window_box)) continue;
+        std::optional<Segment> segment;
+        for (const std::int64_t id : w.candidate_ids) {
+          const Box& candidate = blocks.box(id);
+          if (!candidate.Meets(window_box)) continue;
+          const float window = Window(k, query, nearest, out);
+          if (!segment) segment.emplace(origins[k], normals[k], window);
+          if (!segment->Meets(candidate)) continue;
+          // A crossing within rounding beyond the window's end counts: the ray path may find
+          // it inside.
+          const float reach = window + RoundingMargin(origins[k], window);
+          if (WindowCrossesBlock(mapping, sculpt, id, origins[k], normals[k], reach)) {
+            undecided[k] = 1;
+            ++sent;
+            break;
+          }
+        }
       }
     }
   }

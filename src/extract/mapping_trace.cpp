@@ -640,18 +640,16 @@ struct Crossings {
   }
 };
 
-void TestQuad(const Line& line, const Mesh& sculpt, std::int32_t face, int ring, Crossings& x) {
+// TestQuad with its corners' projections given: (x_k, y_k) that of the face's corner k.
+void TestProjectedQuad(const Line& line, const Mesh& sculpt, std::int32_t face, int ring, double x0,
+                       double y0, double x1, double y1, double x2, double y2, double x3, double y3,
+                       Crossings& x) {
   const std::int32_t* ids = sculpt.face_indices.data() + 4 * static_cast<std::size_t>(face);
   const Float3* p = sculpt.positions.data();
   const Float3& v0 = p[ids[0]];
   const Float3& v1 = p[ids[1]];
   const Float3& v2 = p[ids[2]];
   const Float3& v3 = p[ids[3]];
-  double x0, y0, x1, y1, x2, y2, x3, y3;
-  line.Project(v0, x0, y0);
-  line.Project(v1, x1, y1);
-  line.Project(v2, x2, y2);
-  line.Project(v3, x3, y3);
   const double e01 = EdgeValue(x0, y0, x1, y1), e13 = EdgeValue(x1, y1, x3, y3);
   const double e30 = EdgeValue(x3, y3, x0, y0), e23 = EdgeValue(x2, y2, x3, y3);
   const double e12 = EdgeValue(x1, y1, x2, y2);
@@ -673,6 +671,15 @@ void TestQuad(const Line& line, const Mesh& sculpt, std::int32_t face, int ring,
       x.Add(static_cast<float>(t), den, ring, face);
     }
   }
+}
+
+void TestQuad(const Line& line, const Mesh& sculpt, std::int32_t face, int ring, Crossings& x) {
+  const std::int32_t* ids = sculpt.face_indices.data() + 4 * static_cast<std::size_t>(face);
+  const Float3* p = sculpt.positions.data();
+  double px[4], py[4];
+  for (int k = 0; k < 4; ++k) line.Project(p[ids[k]], px[k], py[k]);
+  TestProjectedQuad(line, sculpt, face, ring, px[0], py[0], px[1], py[1], px[2], py[2], px[3],
+                    py[3], x);
 }
 
 // The hit `policy` keeps (TraceNormals' choice between the two rays), and whether it is -n's.
@@ -1056,9 +1063,36 @@ bool WindowCrossesBlock(const SculptMapping& mapping, const Mesh& sculpt, std::i
   const Line line(origin, FlushTiny(normal));
   Crossings x;
   x.distance = window;
-  for (int j = at.bj * b; j < (at.bj + 1) * b; ++j) {
-    for (int i = at.bi * b; i < (at.bi + 1) * b; ++i) {
-      TestQuad(line, sculpt, SculptMapping::FaceOf(mapping.cell(at.face, i, j)), 0, x);
+  // The block's lattice points, each vertex projected once (the same doubles as TestQuad's):
+  // cell (i, j)'s face has corner RotationOf + k at the cell's corner k, (i, j), (i + 1, j),
+  // (i + 1, j + 1), (i, j + 1).
+  constexpr int kSide = SculptBlocks::kBlock + 1;
+  static constexpr int kDx[4] = {0, 1, 1, 0}, kDy[4] = {0, 0, 1, 1};
+  double px[kSide][kSide], py[kSide][kSide];
+  std::int32_t vertex[kSide][kSide];
+  for (auto& row : vertex) std::fill(std::begin(row), std::end(row), -1);
+  const Float3* p = sculpt.positions.data();
+  for (int j = 0; j < b; ++j) {
+    for (int i = 0; i < b; ++i) {
+      const std::uint32_t cell = mapping.cell(at.face, at.bi * b + i, at.bj * b + j);
+      const std::int32_t face = SculptMapping::FaceOf(cell);
+      const int rotation = SculptMapping::RotationOf(cell);
+      const std::int32_t* ids = sculpt.face_indices.data() + 4 * static_cast<std::size_t>(face);
+      double cx[4], cy[4];  // per corner of the face
+      for (int k = 0; k < 4; ++k) {
+        const int a = i + kDx[k], c = j + kDy[k], corner = (rotation + k) & 3;
+        if (vertex[c][a] == ids[corner]) {
+          cx[corner] = px[c][a];
+          cy[corner] = py[c][a];
+        } else {
+          line.Project(p[ids[corner]], cx[corner], cy[corner]);
+          vertex[c][a] = ids[corner];
+          px[c][a] = cx[corner];
+          py[c][a] = cy[corner];
+        }
+      }
+      TestProjectedQuad(line, sculpt, face, 0, cx[0], cy[0], cx[1], cy[1], cx[2], cy[2], cx[3],
+                        cy[3], x);
     }
   }
   return x.degenerate || x.plus.found() || x.minus.found();

@@ -164,12 +164,10 @@ struct MappingScratch {
   int near_face = -1;
   std::vector<std::int32_t> near_starts;
   std::vector<std::int64_t> near_ids;
-  // The check's buffers: per block of the face its samples' box and its candidates.
-  std::vector<Box> sample_boxes;
-  std::vector<std::uint8_t> sample_box_used;
-  std::vector<std::int32_t> candidate_starts;
-  std::vector<std::int64_t> candidate_ids;
+  // The check's buffers: the samples grouped by block of the face, and a block's candidates.
   std::vector<std::int32_t> sample_block_of;  // per sample column (row): its block of cells
+  std::vector<std::int32_t> block_first, block_fill, block_samples;
+  std::vector<std::int64_t> candidate_ids;
   std::vector<std::uint32_t> near_stamp;  // per sculpt block: the stamp of the last block near it
   std::uint32_t stamp = 0;
 };

@@ -78,6 +78,7 @@ SculptBlocks SculptBlocks::Build(const SculptMapping& mapping, const Mesh& sculp
     side *= 1.25;
   }
   out.cell_ = static_cast<float>(side);
+  out.inverse_cell_ = 1 / out.cell_;
   for (int a = 0; a < 3; ++a) {
     out.origin_[a] = static_cast<float>(lower[a]);
     out.dims_[a] = static_cast<int>(std::floor((upper[a] - lower[a]) / side)) + 1;
@@ -102,11 +103,12 @@ SculptBlocks SculptBlocks::Build(const SculptMapping& mapping, const Mesh& sculp
   for (const Box& box : out.boxes_)
     for_each_cell(box, [&](std::size_t c) { ++out.starts_[c + 1]; });
   for (std::size_t c = 0; c < num_cells; ++c) out.starts_[c + 1] += out.starts_[c];
-  out.ids_.resize(static_cast<std::size_t>(out.starts_.back()));
+  out.entries_.resize(static_cast<std::size_t>(out.starts_.back()));
   std::vector<std::int64_t> fill(out.starts_.begin(), out.starts_.end() - 1);
   for (std::size_t b = 0; b < out.boxes_.size(); ++b) {
     for_each_cell(out.boxes_[b], [&](std::size_t c) {
-      out.ids_[static_cast<std::size_t>(fill[c]++)] = static_cast<std::int32_t>(b);
+      out.entries_[static_cast<std::size_t>(fill[c]++)] = {out.boxes_[b],
+                                                           static_cast<std::int32_t>(b)};
     });
   }
   return out;
@@ -122,16 +124,10 @@ SculptBlocks::Place SculptBlocks::block(std::int64_t id) const {
   return Place{face, static_cast<int>(k % per), static_cast<int>(k / per)};
 }
 
-int SculptBlocks::Cell(int axis, float v) const {
-  const float x = std::floor((v - origin_[axis]) / cell_);
-  if (!(x >= 0)) return 0;  // below the grid, or NaN
-  return x >= float(dims_[axis] - 1) ? dims_[axis] - 1 : static_cast<int>(x);
-}
-
 std::size_t SculptBlocks::bytes() const {
   return (sizes_.capacity() + per_side_.capacity()) * sizeof(std::int32_t) +
          (offsets_.capacity() + starts_.capacity()) * sizeof(std::int64_t) +
-         ids_.capacity() * sizeof(std::int32_t) + boxes_.capacity() * sizeof(Box);
+         entries_.capacity() * sizeof(Entry) + boxes_.capacity() * sizeof(Box);
 }
 
 }  // namespace dispex::extract

@@ -4,6 +4,8 @@
 // box of its quads' corners (the sculpt's floats, exactly), and a uniform grid over the boxes.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -55,17 +57,16 @@ class SculptBlocks {
       for (int y = lo[1]; y <= hi[1]; ++y) {
         for (int x = lo[0]; x <= hi[0]; ++x) {
           const std::size_t c = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0] + x;
-          for (std::int64_t k = starts_[c]; k < starts_[c + 1]; ++k) {
-            const std::int64_t b = ids_[static_cast<std::size_t>(k)];
-            const Box& box = boxes_[static_cast<std::size_t>(b)];
-            if (!box.Meets(query)) continue;
+          const Entry* end = entries_.data() + starts_[c + 1];
+          for (const Entry* e = entries_.data() + starts_[c]; e != end; ++e) {
+            if (!e->box.Meets(query)) continue;
             // Once: in the grid cell of the lower corner of the boxes' overlap.
             bool first = true;
             const int at[3] = {x, y, z};
             for (int a = 0; a < 3 && first; ++a) {
-              first = Cell(a, std::max(box.lower[a], query.lower[a])) == at[a];
+              first = Cell(a, std::max(e->box.lower[a], query.lower[a])) == at[a];
             }
-            if (first) fn(b);
+            if (first) fn(std::int64_t{e->id});
           }
         }
       }
@@ -73,18 +74,29 @@ class SculptBlocks {
   }
 
  private:
-  int Cell(int axis, float v) const;
+  // The grid cell along `axis` of coordinate v, clamped to the grid.
+  int Cell(int axis, float v) const {
+    const float x = std::floor((v - origin_[axis]) * inverse_cell_);
+    if (!(x >= 0)) return 0;  // below the grid, or NaN
+    return x >= float(dims_[axis] - 1) ? dims_[axis] - 1 : static_cast<int>(x);
+  }
+
+  // A block in a grid cell, its box beside its id so that a query reads the cell in order.
+  struct Entry {
+    Box box;
+    std::int32_t id = 0;
+  };
 
   std::vector<std::int32_t> sizes_, per_side_;  // per Ptex face
   std::vector<std::int64_t> offsets_;           // per Ptex face: its first block's id
   std::vector<Box> boxes_;                      // per block
   // The grid: cells of side cell_ from origin_, dims_ per axis; each cell's blocks (those
-  // whose box overlaps it) at ids_[starts_[c] .. starts_[c + 1]).
+  // whose box overlaps it) at entries_[starts_[c] .. starts_[c + 1]).
   float origin_[3] = {0, 0, 0};
-  float cell_ = 1;
+  float cell_ = 1, inverse_cell_ = 1;
   int dims_[3] = {1, 1, 1};
   std::vector<std::int64_t> starts_;
-  std::vector<std::int32_t> ids_;
+  std::vector<Entry> entries_;
 };
 
 }  // namespace dispex::extract
