@@ -338,6 +338,18 @@ Located Locate(const SculptMapping& mapping, int h, Point p, Iso iso, int depth)
   return NotFound(kUnknown);
 }
 
+// Locate for a point of face h's grid beyond its edge `edge` only: the crossing, then, where
+// the point lands inside the face across, that face's grid without a further call.
+Located LocateAcross(const SculptMapping& mapping, int h, int edge, Point p) {
+  const SculptMapping::Crossing& c = mapping.crossing(h, edge);
+  if (c.kind != kCell) return NotFound(c.kind);
+  const Iso step = Then(Iso{}, Iso{c.q, c.tx, c.ty});
+  const Point q = Apply(step, p);
+  const int size = 2 * mapping.grid_size(c.to);
+  if (q.x >= 0 && q.y >= 0 && q.x <= size && q.y <= size) return Located{kCell, c.to, q, step};
+  return Locate(mapping, c.to, q, step, 1);
+}
+
 enum class CornerKind : std::uint8_t { kRegular, kNone, kFan, kUnknown };
 
 // The faces around corner `c` of `face` (not `face` itself), each with the corner of its own
@@ -470,7 +482,10 @@ void LayOut(const SculptMapping& mapping, int face, MappingScratch& w) {
           continue;
         }
       }
-      const Located at = Locate(mapping, face, {2 * a + 1, 2 * b + 1}, Iso{}, 0);
+      const Located at =
+          out_a != out_b ? LocateAcross(mapping, face, out_b ? (b < 0 ? 0 : 2) : (a < 0 ? 3 : 1),
+                                        {2 * a + 1, 2 * b + 1})
+                         : Locate(mapping, face, {2 * a + 1, 2 * b + 1}, Iso{}, 0);
       if (at.kind != kCell) {
         slot.state = at.kind;
         continue;
