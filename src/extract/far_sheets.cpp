@@ -1,6 +1,8 @@
 #include "extract/far_sheets.h"
 
+#if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
 
 #include <algorithm>
 #include <cfloat>
@@ -60,6 +62,13 @@ void Grow(Box& into, const Box& box) {
 Box WindowsBox(std::span<const std::int32_t> ks, std::span<const Float3> origins,
                std::span<const Float3> normals, const NormalQuery& query, bool nearest,
                const NormalHits& out, std::span<const std::uint8_t> undecided) {
+  Box all;
+  for (int a = 0; a < 3; ++a) {
+    all.lower[a] = INFINITY;
+    all.upper[a] = -INFINITY;
+  }
+  std::size_t s = 0;
+#if defined(__SSE2__)
   __m128 lower[3], upper[3];
   for (int a = 0; a < 3; ++a) {
     lower[a] = _mm_set1_ps(INFINITY);
@@ -68,7 +77,6 @@ Box WindowsBox(std::span<const std::int32_t> ks, std::span<const Float3> origins
   const __m128 sign = _mm_set1_ps(-0.0f), largest = _mm_set1_ps(FLT_MAX), zero = _mm_setzero_ps();
   const __m128 scale = _mm_set1_ps(0x1p-20f), tiny = _mm_set1_ps(0x1p-126f);
   auto finite = [&](__m128 v) { return _mm_cmple_ps(_mm_andnot_ps(sign, v), largest); };
-  std::size_t s = 0;
   for (; s + 4 <= ks.size(); s += 4) {
     const std::size_t k[4] = {static_cast<std::size_t>(ks[s]), static_cast<std::size_t>(ks[s + 1]),
                               static_cast<std::size_t>(ks[s + 2]),
@@ -110,7 +118,6 @@ Box WindowsBox(std::span<const std::int32_t> ks, std::span<const Float3> origins
           _mm_or_ps(_mm_and_ps(valid, _mm_max_ps(hi, upper[a])), _mm_andnot_ps(valid, upper[a]));
     }
   }
-  Box all;
   for (int a = 0; a < 3; ++a) {
     alignas(16) float lo[4], hi[4];
     _mm_store_ps(lo, lower[a]);
@@ -118,6 +125,7 @@ Box WindowsBox(std::span<const std::int32_t> ks, std::span<const Float3> origins
     all.lower[a] = std::min({lo[0], lo[1], lo[2], lo[3]});
     all.upper[a] = std::max({hi[0], hi[1], hi[2], hi[3]});
   }
+#endif
   Box box;
   for (; s < ks.size(); ++s) {
     const auto k = static_cast<std::size_t>(ks[s]);
