@@ -66,47 +66,77 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
   }
 
   // Half-edges bucketed by their start vertex, in order: bucket[v] spans [first[v],
-  // first[v + 1]). Each task owns a range of vertices and scans every half-edge for those it
-  // owns, so that the scattered updates need no atomics (which would serialise the cache
-  // misses of a sculpt numbered at random). Counted, summed into bucket ends, then filled
-  // from the last half-edge down so that the ends become the starts.
+  // first[v + 1]). The half-edges are cut in two halves, each counted into its own array (the
+  // second one's in `second`) and filled from its own cursors, so that no thread reads every
+  // half-edge; tasks also own ranges of vertices, so that the scattered updates need no atomics
+  // (which would serialise the cache misses of a sculpt numbered at random).
+  const std::size_t concurrency =
+      static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+  const std::size_t halves = concurrency >= 2 ? 2 : 1;
+  const std::size_t vertex_parts = std::max<std::size_t>(1, concurrency / halves);
   std::vector<std::uint32_t> first(num_vertices + 1, 0);
-  const auto for_each_owned = [&](bool downwards, std::uint32_t* dest, auto&& visit) {
-    const std::size_t parts = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
-    tbb::parallel_for(std::size_t{0}, parts, [&](std::size_t part) {
-      const auto lo = static_cast<std::uint32_t>(num_vertices * part / parts);
-      const auto hi = static_cast<std::uint32_t>(num_vertices * (part + 1) / parts);
-      for (std::size_t k = 0; k < num_half_edges; ++k) {
-        const std::size_t h = downwards ? num_half_edges - 1 - k : k;
-        // The scattered slots of half-edges ahead, fetched early: first[] far ahead, then
-        // (filling) the bucket slot it names nearer.
-        if (k + 4 * kAhead < num_half_edges) {
-          const auto w = static_cast<std::uint32_t>(
-              start[downwards ? num_half_edges - 1 - k - 4 * kAhead : k + 4 * kAhead]);
-          if (w - lo < hi - lo) __builtin_prefetch(&first[w], 1);
+  std::vector<std::uint32_t> second(halves == 2 ? num_vertices : 0, 0);
+  std::uint32_t* const counts[2] = {first.data(), second.data()};
+  const std::unique_ptr<std::uint32_t[]> bucket(new std::uint32_t[num_half_edges]);
+  // visit(slot, h) for each half-edge h of every task, slot its start vertex's entry in the
+  // array of its half; `filling`: the slots are cursors into the bucket, fetched ahead too.
+  const auto for_each_task = [&](bool filling, auto&& visit) {
+    tbb::parallel_for(std::size_t{0}, halves * vertex_parts, [&](std::size_t task) {
+      const std::size_t half = task % halves, part = task / halves;
+      std::uint32_t* const slots = counts[half];
+      const auto lo = static_cast<std::uint32_t>(num_vertices * part / vertex_parts);
+      const auto hi = static_cast<std::uint32_t>(num_vertices * (part + 1) / vertex_parts);
+      const std::size_t from = num_half_edges * half / halves;
+      const std::size_t to = num_half_edges * (half + 1) / halves;
+      for (std::size_t h = from; h < to; ++h) {
+        // The scattered slots of half-edges ahead, fetched early: the slot far ahead, then
+        // (filling) the bucket entry it names nearer.
+        if (h + 4 * kAhead < to) {
+          const auto w = static_cast<std::uint32_t>(start[h + 4 * kAhead]);
+          if (w - lo < hi - lo) __builtin_prefetch(&slots[w], 1);
         }
-        if (dest != nullptr && k + 2 * kAhead < num_half_edges) {
-          const auto w = static_cast<std::uint32_t>(start[num_half_edges - 1 - k - 2 * kAhead]);
-          if (w - lo < hi - lo) __builtin_prefetch(dest + first[w] - 1, 1);
+        if (filling && h + 2 * kAhead < to) {
+          const auto w = static_cast<std::uint32_t>(start[h + 2 * kAhead]);
+          if (w - lo < hi - lo) __builtin_prefetch(&bucket[slots[w]], 1);
         }
         const auto v = static_cast<std::uint32_t>(start[h]);
-        if (v - lo < hi - lo) visit(v, h);
+        if (v - lo < hi - lo) visit(slots[v], h);
       }
     });
   };
-  for_each_owned(false, nullptr, [&](std::uint32_t v, std::size_t) { ++first[v]; });
-  const std::size_t unused =
-      LowestWhere(num_vertices, num_vertices, [&](std::size_t v) { return first[v] == 0; });
+  for_each_task(false, [](std::uint32_t& count, std::size_t) { ++count; });
+  const std::size_t unused = LowestWhere(num_vertices, num_vertices, [&](std::size_t v) {
+    return first[v] == 0 && (halves == 1 || second[v] == 0);
+  });
   if (unused != num_vertices) {
     return Status::Error(fmt::format("{}: vertex {} is used by no face", mesh.source, unused));
   }
+  // Counts into cursors: the first half's half-edges of v from its bucket's start, the second
+  // half's after them.
   std::uint32_t sum = 0;
-  for (std::size_t v = 0; v < num_vertices; ++v) first[v] = sum += first[v];
+  for (std::size_t v = 0; v < num_vertices; ++v) {
+    for (std::size_t half = 0; half < halves; ++half) {
+      const std::uint32_t count = counts[half][v];
+      counts[half][v] = sum;
+      sum += count;
+    }
+  }
   first[num_vertices] = sum;
-  // Every entry is written below: no need to clear it first.
-  const std::unique_ptr<std::uint32_t[]> bucket(new std::uint32_t[num_half_edges]);
-  for_each_owned(true, bucket.get(),
-                 [&](std::uint32_t v, std::size_t h) { bucket[--first[v]] = std::uint32_t(h); });
+  // Every entry is written: no need to clear it first.
+  for_each_task(true, [&](std::uint32_t& cursor, std::size_t h) {
+    bucket[cursor++] = static_cast<std::uint32_t>(h);
+  });
+  // The cursors of the last half stopped at their bucket's end, the next bucket's start.
+  const std::uint32_t* bucket_ends = counts[halves - 1];
+  if (halves == 2 && num_vertices > 1) {
+    tbb::parallel_for(Range(1, num_vertices, 1 << 14), [&](const Range& r) {
+      for (std::size_t v = r.begin(); v < r.end(); ++v) first[v] = bucket_ends[v - 1];
+    });
+  } else if (halves == 1) {
+    for (std::size_t v = num_vertices; v-- > 1;) first[v] = first[v - 1];
+  }
+  if (num_vertices > 0) first[0] = 0;
+  std::vector<std::uint32_t>().swap(second);
 
   // Around vertex a, the quads of its half-edges a -> b_k (its bucket) also hold the half-edges
   // c_k -> a that end there (each one's previous), so its bucket alone answers every question
