@@ -438,16 +438,19 @@ void FillLattice(const Mesh& sculpt, MappingScratch& w) {
   w.extent = extent;
 }
 
-void LayOut(const SculptMapping& mapping, int face, MappingScratch& w) {
+// The apron of `face`; without `margins`, its cells only: every slot beyond the face is
+// kUnknown (a ring that reaches one leaves its sample undecided) and no corner has a fan.
+void LayOut(const SculptMapping& mapping, int face, MappingScratch& w, bool margins) {
   const int m = mapping.grid_size(face);
   const int width = m + 2 * kMargin;
   w.face = face;
   w.m = m;
+  w.margins = margins;
   w.apron.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(width), {});
   CornerKind corners[4];
   std::vector<std::pair<int, int>>& around = w.around;
   for (int c = 0; c < 4; ++c) {
-    corners[c] = WalkCorner(mapping, face, c, around);
+    corners[c] = margins ? WalkCorner(mapping, face, c, around) : CornerKind::kUnknown;
     w.fans[c].clear();
     w.fan_corner[c] = corners[c] == CornerKind::kFan;
     if (!w.fan_corner[c]) continue;
@@ -472,6 +475,10 @@ void LayOut(const SculptMapping& mapping, int face, MappingScratch& w) {
       if (!out_a && !out_b) {
         const std::uint32_t cell = mapping.cell(face, a, b);
         slot = {SculptMapping::FaceOf(cell), static_cast<std::uint8_t>(cell >> 30), kCell};
+        continue;
+      }
+      if (!margins) {
+        slot.state = kUnknown;
         continue;
       }
       if (out_a && out_b) {
@@ -968,15 +975,23 @@ void TraceRingsOfFace(const SculptMapping& mapping, const Mesh& sculpt, PtexFace
                       std::span<const Float3> normals, const NormalQuery& query,
                       const NormalHits& out, std::span<std::uint8_t> undecided, MappingScratch& w,
                       MappingCounters& counters) {
-  if (w.face != face.value) LayOut(mapping, face.value, w);
-  const int m = w.m;
+  const int m = mapping.grid_size(face.value);
+  auto cell_of = [&](int i) {
+    return static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));
+  };
+  // A few samples whose rings all stay inside the face (the search estimate's) need no apron
+  // beyond it.
+  bool inside = !samples.empty();
+  for (std::size_t s = 0; inside && s < samples.size(); ++s) {
+    for (const int cell : {cell_of(samples[s] % n), cell_of(samples[s] / n)}) {
+      inside = inside && cell >= kMaxRings && cell < m - kMaxRings;
+    }
+  }
+  if (w.face != face.value || (!w.margins && !inside)) LayOut(mapping, face.value, w, !inside);
   if (samples.empty() && w.lattice_face != face.value) {
     FillLattice(sculpt, w);
     w.lattice_face = face.value;
   }
-  auto cell_of = [&](int i) {
-    return static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));
-  };
   // Invalid queries are misses; the others get their cell's rings, one by one.
   auto valid = [&](std::size_t k) {
     const Float3& o = origins[k];

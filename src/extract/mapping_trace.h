@@ -147,6 +147,7 @@ struct MappingScratch {
   };
   int face = -1;                 // the face the apron is laid out for (-1: none)
   int lattice_face = -1;         // the face `lattice` holds (-1: none)
+  bool margins = false;          // whether the apron holds the slots beyond the face
   int m = 0;                     // its grid size
   std::vector<Slot> apron;       // (m + 2 kMaxRings)^2 slots, row by row
   std::vector<FanCell> fans[4];  // per corner of the face: cells of every face around it
