@@ -7,6 +7,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/default_init_allocator.h"
 #include "core/vec3.h"
 #include "dispex/mesh.h"
 
@@ -69,7 +70,8 @@ double MedianEdgeLength(const Mesh& mesh) {
   if (sides == 0) return 0;
   const std::size_t stride = SampleStride(sides);
   const std::size_t samples = (sides + stride - 1) / stride;
-  std::vector<double> lengths(samples);
+  // Written in full by the loop below, which first touches its pages on every thread.
+  std::vector<double, DefaultInitAllocator<double>> lengths(samples);
   // Side k runs from corner k to the next corner of the same face.
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, mesh.num_faces(), 4096),

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "core/check.h"
+#include "core/first_touch.h"
 #include "core/mapped_file.h"
 #include "dispex/mesh.h"
 #include "mesh/obj_chunk_parser.h"
@@ -39,6 +40,8 @@ namespace dispex {
 namespace {
 
 constexpr std::size_t kDefaultChunkBytes = std::size_t{4} << 20;
+// Face corners whose pages are first touched at once (AppendInOrder).
+constexpr std::size_t kTouchWindowCorners = std::size_t{1} << 18;
 
 struct Chunk {
   const char* begin;
@@ -134,6 +137,30 @@ void MergeGroups(const std::vector<mesh::ChunkOutput>& outputs, Mesh& mesh) {
   }
 }
 
+// Appends every chunk's `buffer` to `all` in file order, each freed once appended. The pages
+// they go to are first touched by every thread a window of chunks at a time, so that the peak
+// holds at most one window more than the final arrays.
+void AppendInOrder(std::vector<mesh::ChunkOutput>& outputs,
+                   mesh::ChunkBuffer<std::int32_t> mesh::ChunkOutput::*buffer, std::uint64_t total,
+                   int threads, std::vector<std::int32_t>& all) {
+  all.reserve(static_cast<std::size_t>(total));
+  for (std::size_t next = 0; next < outputs.size();) {
+    std::size_t stop = next, window = 0;
+    while (stop < outputs.size() && window < kTouchWindowCorners) {
+      window += (outputs[stop++].*buffer).size();
+    }
+    if (window * sizeof(std::int32_t) >= kFirstTouchBytes) {
+      mesh::RunWithThreads(
+          threads, [&] { TouchPages(all.data() + all.size(), window * sizeof(std::int32_t)); });
+    }
+    for (; next < stop; ++next) {
+      auto& from = outputs[next].*buffer;
+      all.insert(all.end(), from.begin(), from.end());
+      from.Release();
+    }
+  }
+}
+
 StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
                               const ReadOptions& options, bool release_mapped_pages) {
   const std::size_t chunk_bytes =
@@ -183,7 +210,11 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
         fmt::format("{}: {} texture coordinates: more than the 2^31-1 supported", name, texcoords));
   }
   // Embree reads 16 bytes at the last vertex: keep one spare element of capacity.
-  mesh.positions.reserve(static_cast<std::size_t>(vertices) + 1);
+  mesh::RunWithThreads(options.threads, [&] {
+    ReserveTouched(mesh.positions, static_cast<std::size_t>(vertices) + 1);
+    ReserveTouched(mesh.face_offsets, static_cast<std::size_t>(faces) + 1);
+    ReserveTouched(mesh.uvs, 2 * static_cast<std::size_t>(texcoords));
+  });
   mesh.positions.resize(static_cast<std::size_t>(vertices));
   mesh.face_offsets.resize(static_cast<std::size_t>(faces) + 1);
   mesh.uvs.resize(2 * static_cast<std::size_t>(texcoords));
@@ -234,19 +265,11 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     offset += mesh.face_offsets[f];
     mesh.face_offsets[f] = offset;
   }
-  mesh.face_indices.reserve(static_cast<std::size_t>(corners));
-  for (auto& out : outputs) {
-    mesh.face_indices.insert(mesh.face_indices.end(), out.indices.begin(), out.indices.end());
-    out.indices.Release();
-  }
+  AppendInOrder(outputs, &mesh::ChunkOutput::indices, corners, options.threads, mesh.face_indices);
   // UVs: all faces or none (see Mesh::faces_without_uvs).
   if (faces_without_uvs == 0 && texcoords > 0) {
-    mesh.face_uv_indices.reserve(static_cast<std::size_t>(corners));
-    for (auto& out : outputs) {
-      mesh.face_uv_indices.insert(mesh.face_uv_indices.end(), out.uv_indices.begin(),
-                                  out.uv_indices.end());
-      out.uv_indices.Release();
-    }
+    AppendInOrder(outputs, &mesh::ChunkOutput::uv_indices, corners, options.threads,
+                  mesh.face_uv_indices);
     DISPEX_CHECK_EQ(mesh.face_uv_indices.size(), mesh.face_indices.size());
   } else {
     for (auto& out : outputs) out.uv_indices.Release();

@@ -21,6 +21,7 @@
 
 #include "core/check.h"
 #include "core/first_error.h"
+#include "core/first_touch.h"
 #include "core/mapped_file.h"
 #include "dispex/mesh.h"
 #include "mesh/parallel.h"
@@ -237,6 +238,9 @@ class BinaryReader {
 
   // Walks the face records: face sizes into face_offsets, a record start every kBlock faces.
   Status SizeFaces(const Element& element, std::size_t& pos, Mesh& mesh) {
+    mesh::RunWithThreads(threads_, [&] {
+      ReserveTouched(mesh.face_offsets, static_cast<std::size_t>(element.count) + 1);
+    });
     mesh.face_offsets.resize(static_cast<std::size_t>(element.count) + 1);
     std::uint64_t corners = 0;
     for (std::uint64_t f = 0; f < element.count; ++f) {
@@ -269,7 +273,8 @@ class BinaryReader {
   Status ReadVertices(Mesh& mesh) const {
     const Element& element = header_.elements[static_cast<std::size_t>(layout_.vertex_element)];
     const std::size_t n = static_cast<std::size_t>(element.count);
-    mesh.positions.reserve(n + 1);  // Embree reads 16 bytes at the last vertex
+    // Embree reads 16 bytes at the last vertex.
+    mesh::RunWithThreads(threads_, [&] { ReserveTouched(mesh.positions, n + 1); });
     mesh.positions.resize(n);
     const std::size_t start = starts_[static_cast<std::size_t>(layout_.vertex_element)];
     const int axes[3] = {layout_.x, layout_.y, layout_.z};
@@ -329,6 +334,8 @@ class BinaryReader {
   Status ReadFaces(Mesh& mesh) const {
     const Element& element = header_.elements[static_cast<std::size_t>(layout_.face_element)];
     const std::size_t n = static_cast<std::size_t>(element.count);
+    mesh::RunWithThreads(threads_,
+                         [&] { ReserveTouched(mesh.face_indices, mesh.face_offsets.back()); });
     mesh.face_indices.resize(mesh.face_offsets.back());
     const Property& list = element.properties[static_cast<std::size_t>(layout_.indices)];
     const std::size_t count_size = static_cast<std::size_t>(mesh::SizeOf(list.count_type));

@@ -41,6 +41,7 @@
 
 #include "core/check.h"
 #include "core/first_error.h"
+#include "core/first_touch.h"
 #include "core/system.h"
 #include "core/vec3.h"
 #include "subdiv/quad_adjacency.h"
@@ -394,6 +395,7 @@ class Matcher {
     for (int c = 0; c < num_classes; ++c) class_offsets_[c + 1] += class_offsets_[c];
     if (components_.size() == 1) return;
     std::vector<std::uint32_t> next(class_offsets_.begin(), class_offsets_.end() - 1);
+    ReserveTouched(class_vertices_, num_vertices);
     class_vertices_.resize(num_vertices);
     for (std::size_t x = 0; x < num_vertices; ++x) {
       class_vertices_[next[SculptClass(x)]++] = static_cast<std::uint32_t>(x);
@@ -729,8 +731,10 @@ class Matcher {
       cell_offsets_[p + 1] = cell_offsets_[p] + n * n;
     }
     DISPEX_CHECK_EQ(static_cast<std::size_t>(cell_offsets_.back()), sculpt_.num_faces());
+    ReserveTouched(cells_, sculpt_.num_faces());
     cells_.resize(sculpt_.num_faces());  // every cell is written when FillGrids succeeds
-    out_.grid_vertices.assign(out_.grid_offsets.back(), VertexId());
+    AssignTouched(out_.grid_vertices, static_cast<std::size_t>(out_.grid_offsets.back()),
+                  VertexId());
     FirstError error;
     tbb::parallel_for(tbb::blocked_range<int>(0, num_ptex), [&](const tbb::blocked_range<int>& r) {
       for (int p = r.begin(); p < r.end(); ++p) {
@@ -806,11 +810,11 @@ class Matcher {
     const std::size_t num_faces = sculpt_.num_faces();
     std::vector<std::uint64_t> claimed;
     if (options_.face_tables) {
-      out_.face_ptex.assign(num_faces, PtexFaceId());
-      out_.face_cell.assign(num_faces, -1);
-      out_.face_rotation.assign(num_faces, 0);
+      AssignTouched(out_.face_ptex, num_faces, PtexFaceId());
+      AssignTouched(out_.face_cell, num_faces, std::int32_t{-1});
+      AssignTouched(out_.face_rotation, num_faces, std::uint8_t{0});
     } else {
-      claimed.resize((num_faces + 63) / 64);
+      AssignTouched(claimed, (num_faces + 63) / 64, std::uint64_t{0});
     }
     std::atomic<bool> twice{false};
     tbb::parallel_for(
@@ -931,8 +935,8 @@ class Matcher {
   Status FindHomes() {
     const std::size_t num_vertices = sculpt_.num_vertices();
     constexpr std::int32_t kNone = std::numeric_limits<std::int32_t>::max();
-    out_.vertex_faces.assign(num_vertices, PtexFaceId(kNone));
-    out_.vertex_uvs.resize(2 * num_vertices);
+    AssignTouched(out_.vertex_faces, num_vertices, PtexFaceId(kNone));
+    AssignTouched(out_.vertex_uvs, 2 * num_vertices, 0.0f);
     // Row by row; with `borders_only`, the points on the grid's border only.
     const auto each_grid_point = [&](bool borders_only, auto&& visit) {
       tbb::parallel_for(tbb::blocked_range<int>(0, cage_.num_ptex_faces()),

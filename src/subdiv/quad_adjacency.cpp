@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "core/check.h"
+#include "core/first_touch.h"
 
 namespace dispex::subdiv {
 namespace {
@@ -74,8 +75,9 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
       static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
   const std::size_t halves = concurrency >= 2 ? 2 : 1;
   const std::size_t vertex_parts = std::max<std::size_t>(1, concurrency / halves);
-  std::vector<std::uint32_t> first(num_vertices + 1, 0);
-  std::vector<std::uint32_t> second(halves == 2 ? num_vertices : 0, 0);
+  std::vector<std::uint32_t> first, second;
+  AssignTouched(first, num_vertices + 1, 0u);
+  AssignTouched(second, halves == 2 ? num_vertices : 0, 0u);
   std::uint32_t* const counts[2] = {first.data(), second.data()};
   const std::unique_ptr<std::uint32_t[]> bucket(new std::uint32_t[num_half_edges]);
   // visit(slot, h) for each half-edge h of every task, slot its start vertex's entry in the
@@ -147,8 +149,8 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
   // pair those that do, so it is enough to look at those leaving.
   QuadAdjacency out;
   out.opposite.resize(num_half_edges);
-  out.valence.resize(num_vertices);
-  out.boundary.resize(num_vertices);
+  AssignTouched(out.valence, num_vertices, std::uint16_t{0});
+  AssignTouched(out.boundary, num_vertices, std::uint8_t{0});
   tbb::combinable<std::uint32_t> lowest_bad([] { return kNoHalfEdge; });
   tbb::parallel_for(Range(0, num_vertices, 2048), [&](const Range& r) {
     std::uint32_t& bad = lowest_bad.local();
@@ -229,7 +231,8 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
 std::vector<std::uint32_t> QuadComponents(const QuadAdjacency& adjacency,
                                           std::uint32_t& num_components) {
   const std::size_t num_faces = adjacency.opposite.size() / 4;
-  std::vector<std::uint32_t> parent(num_faces);
+  std::vector<std::uint32_t> parent;
+  AssignTouched(parent, num_faces, 0u);
   // Union-find with links from the larger root to the smaller, so that every root is the
   // lowest quad of its component whatever the order of the unions.
   auto find = [&](std::uint32_t x) {

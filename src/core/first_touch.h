@@ -1,0 +1,52 @@
+// Growing a large array so that its fresh pages are first touched by every thread.
+//
+// The first write to a fresh page costs a page fault, and on the virtual machines the project
+// is measured on that fault is most of what clearing a large array costs (docs/BENCHMARKS.md,
+// "fresh pages first touched by every thread"). std::vector's resize and assign clear on the
+// calling thread alone; after ReserveTouched the clearing that follows runs over resident
+// pages, at memory speed. Uses the current TBB arena: include only where TBB is linked.
+#pragma once
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cstddef>
+#include <vector>
+
+namespace dispex {
+
+// Arrays smaller than this are only reserved: their faults cost less than a parallel loop.
+inline constexpr std::size_t kFirstTouchBytes = std::size_t{1} << 20;
+
+// Writes one byte in every page of [begin, begin + bytes), raw storage no object lives in yet,
+// from the threads of the current arena.
+inline void TouchPages(void* begin, std::size_t bytes) {
+  constexpr std::size_t kPage = 4096;
+  auto* first = static_cast<unsigned char*>(begin);
+  const std::size_t pages = (bytes + kPage - 1) / kPage;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pages, 256),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t p = r.begin(); p != r.end(); ++p) first[p * kPage] = 0;
+                    });
+}
+
+// Reserves room for `n` elements in `v` and, where that allocates at least kFirstTouchBytes,
+// touches the new storage beyond the elements (TouchPages). The elements are not constructed
+// here: the caller's resize, assign or insert does that.
+template <class T, class A>
+void ReserveTouched(std::vector<T, A>& v, std::size_t n) {
+  if (n <= v.capacity()) return;
+  v.reserve(n);
+  const std::size_t bytes = (v.capacity() - v.size()) * sizeof(T);
+  if (bytes >= kFirstTouchBytes) TouchPages(v.data() + v.size(), bytes);
+}
+
+// v.assign(n, value) over storage that ReserveTouched first touched.
+template <class T, class A>
+void AssignTouched(std::vector<T, A>& v, std::size_t n, const T& value) {
+  v.clear();
+  ReserveTouched(v, n);
+  v.assign(n, value);
+}
+
+}  // namespace dispex
