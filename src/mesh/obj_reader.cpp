@@ -139,10 +139,10 @@ void MergeGroups(const std::vector<mesh::ChunkOutput>& outputs, Mesh& mesh) {
 
 // Appends every chunk's `buffer` to `all` in file order, each freed once appended. The pages
 // they go to are first touched by every thread a window of chunks at a time, so that the peak
-// holds at most one window more than the final arrays.
+// holds at most one window more than the final arrays. Runs in the caller's arena.
 void AppendInOrder(std::vector<mesh::ChunkOutput>& outputs,
                    mesh::ChunkBuffer<std::int32_t> mesh::ChunkOutput::*buffer, std::uint64_t total,
-                   int threads, std::vector<std::int32_t>& all) {
+                   std::vector<std::int32_t>& all) {
   all.reserve(static_cast<std::size_t>(total));
   for (std::size_t next = 0; next < outputs.size();) {
     std::size_t stop = next, window = 0;
@@ -150,8 +150,7 @@ void AppendInOrder(std::vector<mesh::ChunkOutput>& outputs,
       window += (outputs[stop++].*buffer).size();
     }
     if (window * sizeof(std::int32_t) >= kFirstTouchBytes) {
-      mesh::RunWithThreads(
-          threads, [&] { TouchPages(all.data() + all.size(), window * sizeof(std::int32_t)); });
+      TouchPages(all.data() + all.size(), window * sizeof(std::int32_t));
     }
     for (; next < stop; ++next) {
       auto& from = outputs[next].*buffer;
@@ -265,11 +264,14 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     offset += mesh.face_offsets[f];
     mesh.face_offsets[f] = offset;
   }
-  AppendInOrder(outputs, &mesh::ChunkOutput::indices, corners, options.threads, mesh.face_indices);
+  mesh::RunWithThreads(options.threads, [&] {
+    AppendInOrder(outputs, &mesh::ChunkOutput::indices, corners, mesh.face_indices);
+  });
   // UVs: all faces or none (see Mesh::faces_without_uvs).
   if (faces_without_uvs == 0 && texcoords > 0) {
-    AppendInOrder(outputs, &mesh::ChunkOutput::uv_indices, corners, options.threads,
-                  mesh.face_uv_indices);
+    mesh::RunWithThreads(options.threads, [&] {
+      AppendInOrder(outputs, &mesh::ChunkOutput::uv_indices, corners, mesh.face_uv_indices);
+    });
     DISPEX_CHECK_EQ(mesh.face_uv_indices.size(), mesh.face_indices.size());
   } else {
     for (auto& out : outputs) out.uv_indices.Release();
