@@ -211,12 +211,10 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   // Embree reads 16 bytes at the last vertex: keep one spare element of capacity.
   mesh::RunWithThreads(options.threads, [&] {
     ReserveTouched(mesh.positions, static_cast<std::size_t>(vertices) + 1);
-    ReserveTouched(mesh.face_offsets, static_cast<std::size_t>(faces) + 1);
-    ReserveTouched(mesh.uvs, 2 * static_cast<std::size_t>(texcoords));
+    AssignTouched(mesh.face_offsets, static_cast<std::size_t>(faces) + 1, 0u);
+    AssignTouched(mesh.uvs, 2 * static_cast<std::size_t>(texcoords), 0.0f);
   });
   mesh.positions.resize(static_cast<std::size_t>(vertices));
-  mesh.face_offsets.resize(static_cast<std::size_t>(faces) + 1);
-  mesh.uvs.resize(2 * static_cast<std::size_t>(texcoords));
   for (auto& in : inputs) {
     in.num_vertices = vertices;
     in.num_texcoords = texcoords;

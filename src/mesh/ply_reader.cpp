@@ -239,9 +239,8 @@ class BinaryReader {
   // Walks the face records: face sizes into face_offsets, a record start every kBlock faces.
   Status SizeFaces(const Element& element, std::size_t& pos, Mesh& mesh) {
     mesh::RunWithThreads(threads_, [&] {
-      ReserveTouched(mesh.face_offsets, static_cast<std::size_t>(element.count) + 1);
+      AssignTouched(mesh.face_offsets, static_cast<std::size_t>(element.count) + 1, 0u);
     });
-    mesh.face_offsets.resize(static_cast<std::size_t>(element.count) + 1);
     std::uint64_t corners = 0;
     for (std::uint64_t f = 0; f < element.count; ++f) {
       if (f % kBlock == 0) face_block_starts_.push_back(pos);
@@ -335,8 +334,7 @@ class BinaryReader {
     const Element& element = header_.elements[static_cast<std::size_t>(layout_.face_element)];
     const std::size_t n = static_cast<std::size_t>(element.count);
     mesh::RunWithThreads(threads_,
-                         [&] { ReserveTouched(mesh.face_indices, mesh.face_offsets.back()); });
-    mesh.face_indices.resize(mesh.face_offsets.back());
+                         [&] { AssignTouched(mesh.face_indices, mesh.face_offsets.back(), 0); });
     const Property& list = element.properties[static_cast<std::size_t>(layout_.indices)];
     const std::size_t count_size = static_cast<std::size_t>(mesh::SizeOf(list.count_type));
     const std::size_t item_size = static_cast<std::size_t>(mesh::SizeOf(list.type));

@@ -395,8 +395,7 @@ class Matcher {
     for (int c = 0; c < num_classes; ++c) class_offsets_[c + 1] += class_offsets_[c];
     if (components_.size() == 1) return;
     std::vector<std::uint32_t> next(class_offsets_.begin(), class_offsets_.end() - 1);
-    ReserveTouched(class_vertices_, num_vertices);
-    class_vertices_.resize(num_vertices);
+    AssignTouched(class_vertices_, num_vertices, 0u);
     for (std::size_t x = 0; x < num_vertices; ++x) {
       class_vertices_[next[SculptClass(x)]++] = static_cast<std::uint32_t>(x);
     }
@@ -731,8 +730,7 @@ class Matcher {
       cell_offsets_[p + 1] = cell_offsets_[p] + n * n;
     }
     DISPEX_CHECK_EQ(static_cast<std::size_t>(cell_offsets_.back()), sculpt_.num_faces());
-    ReserveTouched(cells_, sculpt_.num_faces());
-    cells_.resize(sculpt_.num_faces());  // every cell is written when FillGrids succeeds
+    AssignTouched(cells_, sculpt_.num_faces(), Label{0});  // all written when FillGrids succeeds
     AssignTouched(out_.grid_vertices, static_cast<std::size_t>(out_.grid_offsets.back()),
                   VertexId());
     FirstError error;
