@@ -140,7 +140,8 @@ struct ExtractOptions {
   // correspondence with the base -- it must be the base refined (MatchRefinedSculpt) -- with
   // no rays. Empty: the scalar map along the limit normal. The search distance, when given,
   // bounds how far a sculpt vertex may lie from its point on the limit surface
-  // (MatchOptions::max_offset); ray, hole and watertight options do not apply.
+  // (MatchOptions::max_offset); ray and hole options do not apply. Watertight edges are held
+  // for D's length in object space (docs/VECTOR.md, "Face borders").
   std::optional<VectorSpace> vector;
 
   // UV-space maps beside the Ptex map (docs/UV_MAPS.md): when not empty, one OpenEXR file per
@@ -257,8 +258,8 @@ struct ExtractReport {
   // Spectral step.
   SpectralTotals spectral;
   // Watertight edges (kOff when the option is off or the rule is not kErrorBound). Steps are
-  // the largest over every texel breakpoint of every shared edge (MeasurePtexEdgeSteps) once
-  // the map is final, in object units.
+  // the largest over every texel breakpoint of every shared edge (MeasurePtexEdgeSteps; of a
+  // vector map, the length of D's step in object space) once the map is final, in object units.
   WatertightEdges watertight = WatertightEdges::kOff;
   std::int64_t edge_rounds = 0;          // rounds of raising resolutions
   std::int64_t edge_raised_faces = 0;    // faces whose resolution the edges raised

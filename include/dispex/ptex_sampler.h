@@ -110,5 +110,13 @@ PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
                                    std::span<const std::uint8_t> skip_edges,
                                    std::span<const std::uint8_t> skip_faces,
                                    const PtexEdgeMeasure& measure = {});
+// The same for a vector field given as its components (one `texels` as above per component,
+// on the same faces), each read by its own sampler -- as the reference filter reads each
+// channel of a map whose edge filter mode is none: per point the length of the step vector.
+PtexEdgeSteps MeasurePtexVectorEdgeSteps(
+    std::span<const PtexFaceInfo> faces,
+    std::span<const std::vector<std::vector<float>>> components,
+    std::span<const std::uint8_t> skip_edges, std::span<const std::uint8_t> skip_faces,
+    const PtexEdgeMeasure& measure = {});
 
 }  // namespace dispex

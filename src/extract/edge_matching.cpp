@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <map>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -23,38 +24,34 @@ bool Discontinuous(const FaceStats& stats) {
   return stats.all_missed || stats.filled > 0 || stats.hits_opposed > 0;
 }
 
-// The map as it stands, for the sampler: resolutions and texels of every kept face.
-struct MapView {
-  std::vector<PtexFaceInfo> faces;
-  std::vector<std::vector<float>> texels;
-  std::vector<std::uint8_t> skip_faces;  // holes, and faces whose data may jump
-};
-
-// Moves the kept texels into the view (ReturnTexels moves them back).
-MapView TakeView(const ExtractInputs& inputs, ProcessedFaces& processed) {
-  MapView view;
+// The kept texels into the map the rounds measure (ReturnTexels moves them back).
+EdgeRoundsMap TakeView(const ExtractInputs& inputs, ProcessedFaces& processed) {
+  EdgeRoundsMap view;
   view.faces = inputs.faces;
   const std::size_t n = view.faces.size();
-  view.texels.resize(n);
+  view.components.resize(1);
+  std::vector<std::vector<float>>& texels = view.components[0];
+  texels.resize(n);
   view.skip_faces.resize(n);
   for (std::size_t f = 0; f < n; ++f) {
     KeptFace& kept = processed.kept[f];
     view.skip_faces[f] = !kept.kept || inputs.surface.is_hole(PtexFaceId(static_cast<int>(f))) ||
                          Discontinuous(processed.stats[f]);
     if (!kept.kept) {
-      view.texels[f] = {0.0f};
+      texels[f] = {0.0f};
       continue;
     }
     view.faces[f].ulog2 = kept.ulog2;
     view.faces[f].vlog2 = kept.vlog2;
-    view.texels[f].swap(kept.texels);
+    texels[f].swap(kept.texels);
   }
   return view;
 }
 
-void ReturnTexels(MapView& view, ProcessedFaces& processed) {
-  for (std::size_t f = 0; f < view.texels.size(); ++f) {
-    if (processed.kept[f].kept) processed.kept[f].texels.swap(view.texels[f]);
+void ReturnTexels(EdgeRoundsMap& view, ProcessedFaces& processed) {
+  std::vector<std::vector<float>>& texels = view.components[0];
+  for (std::size_t f = 0; f < texels.size(); ++f) {
+    if (processed.kept[f].kept) processed.kept[f].texels.swap(texels[f]);
   }
 }
 
@@ -85,20 +82,19 @@ std::int64_t Texels(const ProcessedFaces& processed, const ExtractInputs& inputs
 
 }  // namespace
 
-Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, ProcessedFaces& faces,
-                  ExtractReport& report) {
+Status RaiseEdgeResolutions(const ExtractInputs& inputs, const ExtractSettings& settings,
+                            EdgeRoundsMap& view, const RedoFaces& redo_faces,
+                            ExtractReport& report) {
   const double budget = settings.edge_step_budget;
   const bool per_face = settings.watertight == WatertightEdges::kAll;
   const std::vector<std::uint8_t> sharp = SharpCreaseEdges(inputs.base, inputs.surface);
-  const std::size_t n = faces.kept.size();
-  report.texels_before_edges = Texels(faces, inputs);
+  const std::size_t n = view.faces.size();
 
   std::vector<std::array<int, 2>> least(n, {0, 0});
   std::vector<std::uint8_t> raised(n, 0), redone;
   std::map<std::pair<int, int>, double> last_step;      // (face, edge) -> step when last raised
   std::map<std::pair<int, int>, int> futile;            // raises that did not bring it down
   std::map<std::pair<int, int>, PtexEdgeStep> current;  // every measured edge, as it stands
-  MapView view = TakeView(inputs, faces);
   PtexEdgeMeasure measure;
   measure.per_face = per_face;
   measure.keep_points = false;
@@ -106,7 +102,7 @@ Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, Proces
     // The first round measures every edge, later ones the edges of the faces just redone.
     measure.only_faces = redone;
     const PtexEdgeSteps steps =
-        MeasurePtexEdgeSteps(view.faces, view.texels, sharp, view.skip_faces, measure);
+        MeasurePtexVectorEdgeSteps(view.faces, view.components, sharp, view.skip_faces, measure);
     if (round == 0) {
       report.edges_shared = static_cast<std::int64_t>(steps.edges);
       report.edges_sharp = static_cast<std::int64_t>(steps.skipped_edges);
@@ -169,11 +165,8 @@ Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, Proces
     }
     if (redo.empty()) break;
     ++report.edge_rounds;
-    ReturnTexels(view, faces);
-    DISPEX_RETURN_IF_ERROR(ReprocessFaces(inputs, settings, redo, least, faces));
-    view = TakeView(inputs, faces);
+    DISPEX_RETURN_IF_ERROR(redo_faces(redo, least, view));
   }
-  ReturnTexels(view, faces);
 
   for (std::size_t f = 0; f < n; ++f) report.edge_raised_faces += raised[f];
   for (const auto& [key, s] : current) {
@@ -181,6 +174,25 @@ Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, Proces
     report.edge_step_across_faces = std::max(report.edge_step_across_faces, s.across_faces);
     report.edges_over += s.across_faces > budget || (per_face && s.per_face > budget);
   }
+  return Status::Ok();
+}
+
+Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, ProcessedFaces& faces,
+                  ExtractReport& report) {
+  report.texels_before_edges = Texels(faces, inputs);
+  EdgeRoundsMap view = TakeView(inputs, faces);
+  const Status raised = RaiseEdgeResolutions(
+      inputs, settings, view,
+      [&](std::span<const int> redo, std::span<const std::array<int, 2>> least,
+          EdgeRoundsMap& map) {
+        ReturnTexels(map, faces);
+        DISPEX_RETURN_IF_ERROR(ReprocessFaces(inputs, settings, redo, least, faces));
+        map = TakeView(inputs, faces);
+        return Status::Ok();
+      },
+      report);
+  DISPEX_RETURN_IF_ERROR(raised);
+  ReturnTexels(view, faces);
   return Status::Ok();
 }
 

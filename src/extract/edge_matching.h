@@ -4,6 +4,11 @@
 // meets within the tolerance, or raising no longer helps.
 #pragma once
 
+#include <array>
+#include <functional>
+#include <span>
+#include <vector>
+
 #include "dispex/extract.h"
 #include "extract/extract_inputs.h"
 #include "extract/extract_settings.h"
@@ -11,16 +16,36 @@
 
 namespace dispex::extract {
 
-// In rounds: measure every shared edge (MeasurePtexEdgeSteps); for each edge over
-// settings.edge_step_budget, raise the resolution that causes it -- through the cross-face
-// filter the coarser side (along the edge first, then across), for per-face reading
-// (WatertightEdges::kAll) both sides across the edge -- and run ProcessFace again for the
-// raised faces (round by round, measuring again only the edges of the faces raised). An edge
-// whose step twice fell by less than a quarter after a raise, or whose faces are at their
-// finest sampling (settings.max_samples_log2), is left as it is and counted. Edges on
-// infinitely sharp creases and beside faces whose data may jump (ListDiscontinuousFaces) are
-// not held. Fills the report's edge fields but the discontinuous ones. Deterministic:
-// decisions depend only on the texels.
+// The map as the rounds of RaiseEdgeResolutions measure it.
+struct EdgeRoundsMap {
+  std::vector<PtexFaceInfo> faces;  // with the resolutions as they stand
+  // Per component (one for a scalar map; x, y, z of D for a vector map), per face, its level-0
+  // texels as PtexMapSampler takes them (one value for a constant face).
+  std::vector<std::vector<std::vector<float>>> components;
+  std::vector<std::uint8_t> skip_faces;  // holes, and faces whose data may jump
+};
+
+// Extracts `faces` again at no less than their least resolutions (log2 per side) and brings
+// the map up to date for them.
+using RedoFaces =
+    std::function<Status(std::span<const int> faces, std::span<const std::array<int, 2>> least_log2,
+                         EdgeRoundsMap& map)>;
+
+// In rounds: measure every shared edge (MeasurePtexVectorEdgeSteps: a vector map's step is the
+// length of the step of D); for each edge over settings.edge_step_budget, raise the resolution
+// that causes it -- through the cross-face filter the coarser side (along the edge first, then
+// across), for per-face reading (WatertightEdges::kAll) both sides across the edge -- and
+// redo the raised faces (round by round, measuring again only the edges of the faces raised).
+// An edge whose step twice fell by less than a quarter after a raise, or whose faces are at
+// their finest sampling (settings.max_samples_log2), is left as it is and counted. Edges on
+// infinitely sharp creases and faces in map.skip_faces are not held. Fills the report's edge
+// fields but texels_before_edges and the discontinuous ones. Deterministic: decisions depend
+// only on the texels.
+Status RaiseEdgeResolutions(const ExtractInputs& inputs, const ExtractSettings& settings,
+                            EdgeRoundsMap& map, const RedoFaces& redo, ExtractReport& report);
+
+// RaiseEdgeResolutions for a scalar map's kept faces, raised faces run again by ProcessFace;
+// faces whose data may jump (ListDiscontinuousFaces) are not held.
 Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, ProcessedFaces& faces,
                   ExtractReport& report);
 

@@ -204,18 +204,19 @@ std::string ExtractReportSummary(const ExtractReport& r) {
                      s.texels_before, s.texels_after,
                      s.texels_before ? 100.0 * double(s.texels_after) / double(s.texels_before) : 0,
                      s.constant_faces, s.max_measured_error);
-  if (r.watertight != WatertightEdges::kOff && !r.vector_space.empty()) {
+  if (r.watertight == WatertightEdges::kAll && !r.vector_space.empty()) {
     out += fmt::format(
         "  edges ({}): texels pinned to the edges, each face's own reading there within {:.3g} "
         "({:.2g} tolerances); {} faces whose finest samples are too coarse for it\n",
         WatertightEdgesName(r.watertight), s.max_edge_error, s.max_edge_error / r.tolerance,
         s.edge_limited_faces);
-  } else if (r.watertight != WatertightEdges::kOff) {
+  }
+  if (r.watertight != WatertightEdges::kOff) {
     out += fmt::format(
-        "  edges ({}): {} shared, largest step {:.3g} across faces ({:.2g} "
+        "  edges ({}): {} shared, largest step{} {:.3g} across faces ({:.2g} "
         "tolerances)",
-        WatertightEdgesName(r.watertight), r.edges_shared, r.edge_step_across_faces,
-        r.edge_step_across_faces / r.tolerance);
+        WatertightEdgesName(r.watertight), r.edges_shared, r.vector_space.empty() ? "" : " of D",
+        r.edge_step_across_faces, r.edge_step_across_faces / r.tolerance);
     if (r.watertight == WatertightEdges::kAll) {
       out += fmt::format(", {:.3g} per face ({:.2g} tolerances)", r.edge_step_per_face,
                          r.edge_step_per_face / r.tolerance);

@@ -113,11 +113,9 @@ StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
   settings.spectral.fixed_vlog2 = options.fixed_vlog2;
   settings.holes = options.holes;
   settings.data_type = options.data_type;
-  // Vector maps take `all` only: the rounds that raise resolutions for the cross-face filter
-  // (MatchEdges) measure scalar steps (docs/VECTOR.md, "Face borders").
-  const bool held = options.resolution_rule == ResolutionRule::kErrorBound &&
-                    (!options.vector || options.watertight == WatertightEdges::kAll);
-  settings.watertight = held ? options.watertight : WatertightEdges::kOff;
+  settings.watertight = options.resolution_rule == ResolutionRule::kErrorBound
+                            ? options.watertight
+                            : WatertightEdges::kOff;
   settings.edge_step_budget = report.tolerance;
   settings.max_samples_log2 = std::bit_width(static_cast<unsigned>(options.max_oversample)) - 1;
   // For faces read on their own (kAll): edge texels hold the edge's values, and each side of

@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -17,6 +18,7 @@
 #include "dispex/correspondence.h"
 #include "dispex/spectral.h"
 #include "dispex/vector_space.h"
+#include "extract/edge_matching.h"
 #include "extract/extract_meta.h"
 #include "extract/extract_settings.h"
 #include "extract/face_keys.h"
@@ -33,7 +35,8 @@ struct VectorScratch {
   explicit VectorScratch(const LimitSurface& surface) : evaluator(surface) {}
   LimitEvaluator evaluator;
   SpectralVectorAnalyzer analyzer;
-  std::vector<float> positions, normals, du, dv, channels, texels;
+  std::vector<float> positions, normals, du, dv, channels;
+  KeptFace face;  // the face made, when it is written at once
   double cpu_limit = 0, cpu_spectral = 0, cpu_write = 0;
 };
 
@@ -102,23 +105,31 @@ void ScaleTangentChannels(std::span<float> channels, float scale) {
   }
 }
 
+// Face `face` at no less than `least_log2` (log2 per side; a least resolution beyond the
+// planned samples takes as many samples) into `out` as the map stores it: 3 interleaved
+// channels, one texel for a constant face.
 Status ProcessVectorFace(PtexFaceId face, VectorSpace space, const ExtractInputs& inputs,
                          const ExtractSettings& settings,
-                         const SculptCorrespondence& correspondence, PtexWriter& writer,
-                         VectorScratch& w, VectorFaceStats& stats) {
+                         const SculptCorrespondence& correspondence, std::array<int, 2> least_log2,
+                         VectorScratch& w, VectorFaceStats& stats, KeptFace& out) {
+  out.kept = true;
   if (inputs.surface.is_hole(face)) {
-    const float zero[3] = {0, 0, 0};
-    return writer.SetConstantFace(face, FaceInfo(inputs, face, 0, 0), zero);
+    out.ulog2 = out.vlog2 = 0;
+    out.texels.assign(3, 0.0f);
+    return Status::Ok();
   }
   // With pinned edges (WatertightEdges::kAll), a face whose samples are too coarse to hold
   // them (the vector changes too fast across the outermost half texel) is sampled again at
   // twice the rate, up to the finest sampling allowed (ExtractSettings::max_samples_log2), as
   // the scalar edge rounds do.
-  const int max_log2 = std::max<int>(settings.plan.log2[static_cast<std::size_t>(face.value)],
-                                     settings.max_samples_log2);
+  const int planned = settings.plan.log2[static_cast<std::size_t>(face.value)];
+  const int max_log2 = std::max<int>(planned, settings.max_samples_log2);
+  SpectralOptions spectral = settings.spectral;
+  spectral.min_ulog2 = least_log2[0];
+  spectral.min_vlog2 = least_log2[1];
   std::optional<SpectralVectorFace> analysed;
   float scale = 1.0f;
-  for (int log2 = settings.plan.log2[static_cast<std::size_t>(face.value)];; ++log2) {
+  for (int log2 = std::max({planned, least_log2[0], least_log2[1]});; ++log2) {
     const int n = 1 << log2;
     ThreadCpuStopwatch limit_clock;
     DISPEX_RETURN_IF_ERROR(SampleFace(face, n, space, inputs, correspondence, w, stats));
@@ -126,7 +137,7 @@ Status ProcessVectorFace(PtexFaceId face, VectorSpace space, const ExtractInputs
     ThreadCpuStopwatch spectral_clock;
     scale = space == VectorSpace::kParametric ? ParametricScale(w) : 1.0f;
     ScaleTangentChannels(w.channels, scale);
-    auto result = w.analyzer.Analyze(w.channels, n, n, settings.spectral);
+    auto result = w.analyzer.Analyze(w.channels, n, n, spectral);
     if (!result.ok()) {
       return Status::Error(fmt::format("{}: Ptex face {}: {}", inputs.sculpt.source, face.value,
                                        result.status().message()));
@@ -137,24 +148,23 @@ Status ProcessVectorFace(PtexFaceId face, VectorSpace space, const ExtractInputs
   }
   // The texels as the map stores them, so that a face copied from it later (incremental
   // extraction) is written from the same values.
-  std::span<const float> texels = analysed->texels;
-  if (scale != 1.0f || settings.data_type == PtexDataType::kHalf) {
-    w.texels.assign(texels.begin(), texels.end());
-    ScaleTangentChannels(w.texels, 1.0f / scale);
-    ScaleTangentChannels(analysed->constant_value, 1.0f / scale);
-    RoundToDataType(settings.data_type, w.texels);
-    RoundToDataType(settings.data_type, analysed->constant_value);
-    texels = w.texels;
-  }
+  out.texels.assign(analysed->texels.begin(), analysed->texels.end());
+  ScaleTangentChannels(out.texels, 1.0f / scale);
+  RoundToDataType(settings.data_type, out.texels);
+  out.ulog2 = static_cast<std::int8_t>(analysed->ulog2);
+  out.vlog2 = static_cast<std::int8_t>(analysed->vlog2);
   stats.spectral = analysed->stats;
-  stats.ulog2 = static_cast<std::int8_t>(analysed->ulog2);
-  stats.vlog2 = static_cast<std::int8_t>(analysed->vlog2);
-  ThreadCpuStopwatch write_clock;
-  const PtexFaceInfo info = FaceInfo(inputs, face, analysed->ulog2, analysed->vlog2);
-  Status written = analysed->constant ? writer.SetConstantFace(face, info, analysed->constant_value)
-                                      : writer.SetFace(face, info, texels);
-  w.cpu_write += write_clock.seconds();
-  return written;
+  stats.ulog2 = out.ulog2;
+  stats.vlog2 = out.vlog2;
+  return Status::Ok();
+}
+
+// A face as ProcessVectorFace or ReadVectorFace left it; one texel is a constant face.
+Status WriteVectorFace(PtexFaceId face, const ExtractInputs& inputs, const KeptFace& kept,
+                       PtexWriter& writer) {
+  const PtexFaceInfo info = FaceInfo(inputs, face, kept.ulog2, kept.vlog2);
+  return kept.texels.size() == 3 ? writer.SetConstantFace(face, info, kept.texels)
+                                 : writer.SetFace(face, info, kept.texels);
 }
 
 // Per Ptex face, what its texels are made from: the settings (SettingsKey) and vector space,
@@ -187,43 +197,144 @@ std::vector<Hash128> VectorFaceKeys(const ExtractInputs& inputs, const ExtractSe
   return keys;
 }
 
-// Face f of `previous` into `writer`, as it is stored.
-Status CopyVectorFace(PtexFaceId face, const ExtractInputs& inputs, const PreviousMap& previous,
-                      PtexWriter& writer) {
-  KeptFace kept;
-  DISPEX_RETURN_IF_ERROR(previous.ReadTexels(static_cast<std::size_t>(face.value), kept));
-  const PtexFaceInfo info = FaceInfo(inputs, face, kept.ulog2, kept.vlog2);
-  return kept.ulog2 == 0 && kept.vlog2 == 0 ? writer.SetConstantFace(face, info, kept.texels)
-                                            : writer.SetFace(face, info, kept.texels);
+// Face f of `previous`, as it is stored.
+Status ReadVectorFace(PtexFaceId face, const PreviousMap& previous, KeptFace& out) {
+  DISPEX_RETURN_IF_ERROR(previous.ReadTexels(static_cast<std::size_t>(face.value), out));
+  out.kept = true;
+  return Status::Ok();
 }
 
+// Kept face f's D in object space at its texel centres, one array per component of `map`:
+// an object map's channels as they are; a tangent or parametric map's turned by the frame at
+// each texel centre (a constant face's too, as D turns over it), as verify measures them.
+Status EdgeComponents(PtexFaceId face, VectorSpace space, const ExtractInputs& inputs,
+                      const KeptFace& kept, VectorScratch& w, EdgeRoundsMap& map) {
+  const auto f = static_cast<std::size_t>(face.value);
+  const std::size_t stored = kept.texels.size() / 3;
+  if (space == VectorSpace::kObject || inputs.surface.is_hole(face)) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      std::vector<float>& out = map.components[c][f];
+      out.resize(stored);
+      for (std::size_t i = 0; i < stored; ++i) out[i] = kept.texels[3 * i + c];
+    }
+    return Status::Ok();
+  }
+  const int ures = 1 << kept.ulog2, vres = 1 << kept.vlog2;
+  const std::size_t count = static_cast<std::size_t>(ures) * static_cast<std::size_t>(vres);
+  for (auto* buffer : {&w.positions, &w.normals, &w.du, &w.dv}) buffer->resize(3 * count);
+  DISPEX_RETURN_IF_ERROR(
+      w.evaluator.EvaluateGridFrames(face, ures, vres, {w.positions, w.normals, w.du, w.dv}));
+  for (std::size_t c = 0; c < 3; ++c) map.components[c][f].resize(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::size_t k = 3 * i;
+    const SurfaceFrame frame{{w.du[k], w.du[k + 1], w.du[k + 2]},
+                             {w.dv[k], w.dv[k + 1], w.dv[k + 2]},
+                             {w.normals[k], w.normals[k + 1], w.normals[k + 2]}};
+    const Float3 d = VectorFromChannels(space, frame, &kept.texels[stored == 1 ? 0 : k]);
+    map.components[0][f][i] = d.x;
+    map.components[1][f][i] = d.y;
+    map.components[2][f][i] = d.z;
+  }
+  return Status::Ok();
+}
+
+// The watertight-edges stage for vector maps (RaiseEdgeResolutions): D's steps where faces
+// meet, measured in object space; raised faces extracted again into `kept`.
+Status HoldVectorEdges(VectorSpace space, const ExtractInputs& inputs,
+                       const ExtractSettings& settings, const SculptCorrespondence& correspondence,
+                       tbb::enumerable_thread_specific<VectorScratch>& scratches,
+                       std::vector<KeptFace>& kept, std::vector<VectorFaceStats>& stats,
+                       std::vector<std::uint8_t>& copied, ExtractReport& report) {
+  const std::size_t n = kept.size();
+  EdgeRoundsMap map;
+  map.faces = inputs.faces;
+  map.components.assign(3, std::vector<std::vector<float>>(n));
+  map.skip_faces.resize(n);
+  report.texels_before_edges = 0;
+  auto update = [&](PtexFaceId face, VectorScratch& w) {
+    const auto f = static_cast<std::size_t>(face.value);
+    map.faces[f].ulog2 = kept[f].ulog2;
+    map.faces[f].vlog2 = kept[f].vlog2;
+    return EdgeComponents(face, space, inputs, kept[f], w, map);
+  };
+  for (std::size_t f = 0; f < n; ++f) {
+    map.skip_faces[f] = inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
+    if (!map.skip_faces[f]) report.texels_before_edges += kept[f].texels.size() / 3;
+  }
+  DISPEX_RETURN_IF_ERROR(ForEachFace(
+      static_cast<int>(n), [](int k) { return k; }, scratches, nullptr, update));
+  return RaiseEdgeResolutions(
+      inputs, settings, map,
+      [&](std::span<const int> redo, std::span<const std::array<int, 2>> least, EdgeRoundsMap&) {
+        auto face_of = [&](int k) { return redo[static_cast<std::size_t>(k)]; };
+        return ForEachFace(
+            static_cast<int>(redo.size()), face_of, scratches, nullptr,
+            [&](PtexFaceId face, VectorScratch& w) {
+              const auto f = static_cast<std::size_t>(face.value);
+              copied[f] = 0;
+              stats[f] = {};
+              DISPEX_RETURN_IF_ERROR(ProcessVectorFace(
+                  face, space, inputs, settings, correspondence, least[f], w, stats[f], kept[f]));
+              return update(face, w);
+            });
+      },
+      report);
+}
+
+// Every face into `writer`: copied from `previous` where its key is unchanged and its texels
+// there are its first pass, else extracted; then the edge rounds. `stats`: each face's as
+// written; `first_pass`: before the rounds raised any (the map's records, so that a later
+// incremental run copies a face only where a full extraction would start from the same).
 Status ProcessVectorFaces(const ExtractOptions& options, const ExtractInputs& inputs,
                           const ExtractSettings& settings,
                           const SculptCorrespondence& correspondence, std::span<const Hash128> keys,
                           const PreviousMap* previous, PtexWriter& writer,
-                          std::vector<VectorFaceStats>& stats, ExtractReport& report) {
+                          std::vector<VectorFaceStats>& stats,
+                          std::vector<VectorFaceStats>& first_pass, ExtractReport& report) {
   const VectorSpace space = *options.vector;
   const int num_faces = inputs.surface.num_ptex_faces();
   stats.assign(static_cast<std::size_t>(num_faces), {});
   std::vector<std::uint8_t> copied(static_cast<std::size_t>(num_faces), 0);
+  // Faces are written as they are made, or kept for the edge rounds and written after them.
+  const bool rounds = settings.watertight != WatertightEdges::kOff;
+  std::vector<KeptFace> kept(rounds ? static_cast<std::size_t>(num_faces) : 0);
   tbb::enumerable_thread_specific<VectorScratch> scratches(
       [&] { return VectorScratch(inputs.surface); });
+  auto write = [&](PtexFaceId face, const KeptFace& made, VectorScratch& w) {
+    ThreadCpuStopwatch write_clock;
+    Status written = WriteVectorFace(face, inputs, made, writer);
+    w.cpu_write += write_clock.seconds();
+    return written;
+  };
   Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", options.progress,
                options.progress_counter);
   Status status = ForEachFace(
       num_faces, [](int k) { return k; }, scratches, &bar,
       [&](PtexFaceId face, VectorScratch& w) {
         const auto f = static_cast<std::size_t>(face.value);
+        KeptFace& made = rounds ? kept[f] : w.face;
         if (previous != nullptr && previous->Reusable(f, keys[f])) {
           stats[f] = previous->vector_record(f);
           copied[f] = 1;
-          return CopyVectorFace(face, inputs, *previous, writer);
+          DISPEX_RETURN_IF_ERROR(ReadVectorFace(face, *previous, made));
+        } else {
+          DISPEX_RETURN_IF_ERROR(ProcessVectorFace(face, space, inputs, settings, correspondence,
+                                                   {0, 0}, w, stats[f], made));
         }
-        return ProcessVectorFace(face, space, inputs, settings, correspondence, writer, w,
-                                 stats[f]);
+        return rounds ? Status::Ok() : write(face, made, w);
       });
   bar.Finish();
   DISPEX_RETURN_IF_ERROR(status);
+  first_pass = stats;
+  if (rounds) {
+    DISPEX_RETURN_IF_ERROR(HoldVectorEdges(space, inputs, settings, correspondence, scratches, kept,
+                                           stats, copied, report));
+    DISPEX_RETURN_IF_ERROR(ForEachFace(
+        num_faces, [](int k) { return k; }, scratches, nullptr,
+        [&](PtexFaceId face, VectorScratch& w) {
+          return write(face, kept[static_cast<std::size_t>(face.value)], w);
+        }));
+  }
   report.faces_copied = std::count(copied.begin(), copied.end(), 1);
   for (const VectorScratch& w : scratches) {
     report.cpu_limit += w.cpu_limit;
@@ -276,7 +387,6 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
                                            ExtractReport report, const Stopwatch& total_clock,
                                            const PreviousMap* previous) {
   report.vector_space = std::string(VectorSpaceName(*options.vector));
-  report.watertight = WatertightEdges::kOff;
   Stopwatch match_clock;
   MatchOptions match;
   match.threads = report.threads;
@@ -305,9 +415,9 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
       VectorFaceKeys(inputs, settings, *correspondence, *options.vector);
   report.t_keys = keys_clock.seconds();
   Stopwatch faces_clock;
-  std::vector<VectorFaceStats> stats;
+  std::vector<VectorFaceStats> stats, first_pass;
   DISPEX_RETURN_IF_ERROR(ProcessVectorFaces(options, inputs, settings, *correspondence, keys,
-                                            previous, writer, stats, report));
+                                            previous, writer, stats, first_pass, report));
   report.faces_extracted = inputs.surface.num_ptex_faces() -
                            inputs.surface.stats().hole_ptex_faces - report.faces_copied;
   report.t_sample_trace = faces_clock.seconds();
@@ -317,8 +427,9 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
   DISPEX_RETURN_IF_ERROR(AddExtractMetaData(writer, inputs.base, report, {}, {}, {}));
   DISPEX_RETURN_IF_ERROR(
       writer.AddMetaData(kFaceKeysMetaKey, std::span<const std::int8_t>(EncodeFaceKeys(keys))));
-  DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
-      kVectorFaceRecordsMetaKey, std::span<const std::int8_t>(EncodeVectorFaceRecords(stats))));
+  DISPEX_RETURN_IF_ERROR(
+      writer.AddMetaData(kVectorFaceRecordsMetaKey,
+                         std::span<const std::int8_t>(EncodeVectorFaceRecords(first_pass))));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData(std::string(kVectorSpaceMetaKey), report.vector_space));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData(std::string(kVectorChannelsMetaKey),
                                             std::string(VectorSpaceChannels(*options.vector))));

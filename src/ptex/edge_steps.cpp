@@ -9,13 +9,28 @@
 
 namespace dispex {
 
-PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
-                                   std::span<const std::vector<float>> texels,
-                                   std::span<const std::uint8_t> skip_edges,
-                                   std::span<const std::uint8_t> skip_faces,
-                                   const PtexEdgeMeasure& measure) {
-  const PtexMapSampler sampler(faces, texels);
+namespace {
+
+// The step between two readings of every component: its absolute value for one component, the
+// length of the step vector for several.
+template <class Read>
+double Step(std::size_t components, Read read) {
+  if (components == 1) return std::abs(read(0));
+  double sum = 0;
+  for (std::size_t c = 0; c < components; ++c) {
+    const double d = read(c);
+    sum += d * d;
+  }
+  return std::sqrt(sum);
+}
+
+PtexEdgeSteps MeasureSteps(std::span<const PtexFaceInfo> faces,
+                           std::span<const PtexMapSampler> samplers,
+                           std::span<const std::uint8_t> skip_edges,
+                           std::span<const std::uint8_t> skip_faces,
+                           const PtexEdgeMeasure& measure) {
   const std::size_t n = faces.size();
+  const std::size_t components = samplers.size();
   struct FaceSteps {
     std::size_t edges = 0, skipped_edges = 0;
     std::vector<float> per_face, across_faces;
@@ -59,11 +74,16 @@ PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
         PtexEdgePoint(e, t, u, v);
         PtexEdgePoint(other.edge, other.t, ou, ov);
         const double face_step = measure.per_face
-                                     ? std::abs(sampler.SampleFace(PtexFaceId(f), u, v) -
-                                                sampler.SampleFace(other.face, ou, ov))
+                                     ? Step(components,
+                                            [&](std::size_t c) {
+                                              return samplers[c].SampleFace(PtexFaceId(f), u, v) -
+                                                     samplers[c].SampleFace(other.face, ou, ov);
+                                            })
                                      : 0.0;
-        const double filter_step = std::abs(sampler.SampleAcrossFaces(PtexFaceId(f), u, v) -
-                                            sampler.SampleAcrossFaces(other.face, ou, ov));
+        const double filter_step = Step(components, [&](std::size_t c) {
+          return samplers[c].SampleAcrossFaces(PtexFaceId(f), u, v) -
+                 samplers[c].SampleAcrossFaces(other.face, ou, ov);
+        });
         if (measure.keep_points) {
           out.per_face.push_back(static_cast<float>(face_step));
           out.across_faces.push_back(static_cast<float>(filter_step));
@@ -86,6 +106,30 @@ PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
     steps.edge_max.insert(steps.edge_max.end(), p.edge_max.begin(), p.edge_max.end());
   }
   return steps;
+}
+
+}  // namespace
+
+PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
+                                   std::span<const std::vector<float>> texels,
+                                   std::span<const std::uint8_t> skip_edges,
+                                   std::span<const std::uint8_t> skip_faces,
+                                   const PtexEdgeMeasure& measure) {
+  const PtexMapSampler sampler[1] = {PtexMapSampler(faces, texels)};
+  return MeasureSteps(faces, sampler, skip_edges, skip_faces, measure);
+}
+
+PtexEdgeSteps MeasurePtexVectorEdgeSteps(
+    std::span<const PtexFaceInfo> faces,
+    std::span<const std::vector<std::vector<float>>> components,
+    std::span<const std::uint8_t> skip_edges, std::span<const std::uint8_t> skip_faces,
+    const PtexEdgeMeasure& measure) {
+  std::vector<PtexMapSampler> samplers;
+  samplers.reserve(components.size());
+  for (const std::vector<std::vector<float>>& texels : components) {
+    samplers.emplace_back(faces, texels);
+  }
+  return MeasureSteps(faces, samplers, skip_edges, skip_faces, measure);
 }
 
 std::size_t CountEdgesTouching(std::span<const PtexFaceInfo> faces,

@@ -21,7 +21,6 @@
 #include <numeric>
 #include <optional>
 
-#include "core/check.h"
 #include "core/first_error.h"
 #include "core/system.h"
 #include "core/vec3.h"
@@ -507,47 +506,6 @@ Status EdgeFields(const LimitSurface& surface, const PtexFile& map,
   return error.failed() ? error.status() : Status::Ok();
 }
 
-// The steps of a vector field from the steps of its three components, which MeasurePtexEdgeSteps
-// measured at the same points (t = j / n on every edge, n = max(16, 2 x the finer side's
-// texels along it)): per point the length of the step vector, per edge its largest and where.
-PtexEdgeSteps CombineSteps(std::span<const PtexFaceInfo> faces, const PtexEdgeSteps (&c)[3]) {
-  PtexEdgeSteps out;
-  out.edges = c[0].edges;
-  out.skipped_edges = c[0].skipped_edges;
-  auto length = [](float x, float y, float z) {
-    return static_cast<float>(std::sqrt(double(x) * x + double(y) * y + double(z) * z));
-  };
-  for (std::size_t i = 0; i < c[0].per_face.size(); ++i) {
-    out.per_face.push_back(length(c[0].per_face[i], c[1].per_face[i], c[2].per_face[i]));
-    out.across_faces.push_back(
-        length(c[0].across_faces[i], c[1].across_faces[i], c[2].across_faces[i]));
-  }
-  auto along = [&](int f, int e) {
-    const PtexFaceInfo& info = faces[static_cast<std::size_t>(f)];
-    return e % 2 == 0 ? info.ures() : info.vres();
-  };
-  std::size_t point = 0;
-  for (const PtexEdgeStep& e : c[0].edge_max) {
-    PtexEdgeSide other;
-    PtexAcrossEdge(faces, PtexFaceId(e.face), e.edge, 0.0, other);
-    const int points =
-        std::max(16, 2 * std::max(along(e.face, e.edge), along(other.face.value, other.edge)));
-    PtexEdgeStep worst{e.face, e.edge, e.neighbour, 0, 0, 0, 0};
-    for (int j = 0; j <= points; ++j, ++point) {
-      DISPEX_CHECK(point < out.per_face.size());
-      const double t = double(j) / points;
-      if (out.per_face[point] > worst.per_face)
-        worst.per_face = out.per_face[point], worst.t_per_face = t;
-      if (out.across_faces[point] > worst.across_faces) {
-        worst.across_faces = out.across_faces[point], worst.t_across_faces = t;
-      }
-    }
-    out.edge_max.push_back(worst);
-  }
-  DISPEX_CHECK_EQ(point, out.per_face.size());
-  return out;
-}
-
 Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFile& map,
                     std::optional<VectorSpace> space, const VerifyOptions& options,
                     VerifyReport& r) {
@@ -572,18 +530,8 @@ Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFil
     }
   }
   const std::vector<std::uint8_t> creases = SharpCreaseEdges(base, surface);
-  PtexEdgeSteps steps;
-  if (fields.size() == 1) {
-    steps = MeasurePtexEdgeSteps(faces, fields[0], creases, skip);
-  } else {
-    PtexEdgeSteps components[3];
-    for (int c = 0; c < 3; ++c) {
-      components[c] =
-          MeasurePtexEdgeSteps(faces, fields[static_cast<std::size_t>(c)], creases, skip);
-    }
-    steps = CombineSteps(faces, components);
-    r.edges_object_space = true;
-  }
+  PtexEdgeSteps steps = MeasurePtexVectorEdgeSteps(faces, fields, creases, skip);
+  r.edges_object_space = fields.size() == 3;
   r.measured_edges = true;
   r.discontinuous_edges = CountEdgesTouching(faces, discontinuous, holes);
   r.edges = steps.edges + r.discontinuous_edges;

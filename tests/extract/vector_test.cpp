@@ -9,6 +9,8 @@
 //  - With --watertight all the outermost texels hold D on the face's edges: the per-face
 //    reader then meets the exact D on every truth record, borders included (rejects the
 //    default's texels half a texel inside, which miss it at face borders).
+//  - By default faces are raised until D's step in object space where faces meet, read
+//    through the cross-face filter, is within the tolerance (rejects the map without rounds).
 //  - The map records its space; a sculpt that is not the base refined fails with the reason
 //    and writes nothing; the file does not depend on the thread count.
 #include <gtest/gtest.h>
@@ -296,7 +298,7 @@ TEST(VectorMapEdges, AllPinsEdgesSoThePerFaceReaderMeetsTheTruthAtBorders) {
     auto report = Extract(o);
     ASSERT_TRUE(report.ok()) << report.status().message();
     const bool all = mode == WatertightEdges::kAll;
-    EXPECT_EQ(report->watertight, all ? WatertightEdges::kAll : WatertightEdges::kOff);
+    EXPECT_EQ(report->watertight, mode);
     VerifyOptions v;
     v.base_path = cage;
     v.sculpt_path = dir / "sculpt.obj";
@@ -312,6 +314,51 @@ TEST(VectorMapEdges, AllPinsEdgesSoThePerFaceReaderMeetsTheTruthAtBorders) {
   }
   EXPECT_GT(over[0], 10u) << "the case must show the border error";
   EXPECT_EQ(over[1], 0u);
+}
+
+// Under the cross-face filter a face coarser than its neighbour steps where they meet: Spot's
+// overhang without the rounds steps by 1.8 (object) and 2.6 (tangent) tolerances, measured.
+// The default (`filter`) raises faces until D's step in object space is within the tolerance
+// on every edge, as verify measures it (rejects rounds that do not run, and rounds that
+// measure a tangent map's channels instead of D).
+TEST(VectorMapEdges, FilterHoldsTheCrossFaceStepsOfD) {
+  TempDir dir;
+  const std::string cage = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
+  // Amplitude 0: 1% of the cage's bounding-box diagonal, as `make-sculpt` by default.
+  ASSERT_TRUE(MakeSculpt(SculptOptions(cage, dir / "sculpt.obj", 3, Pattern::kOverhang, 0)).ok());
+  for (VectorSpace space : {VectorSpace::kObject, VectorSpace::kTangent}) {
+    for (WatertightEdges mode : {WatertightEdges::kOff, WatertightEdges::kFilter}) {
+      SCOPED_TRACE(std::string(VectorSpaceName(space)) + " " +
+                   std::string(WatertightEdgesName(mode)));
+      ExtractOptions o;
+      o.base_path = cage;
+      o.sculpt_path = dir / "sculpt.obj";
+      o.output_path = dir / "map.ptx";
+      o.vector = space;
+      o.watertight = mode;
+      auto report = Extract(o);
+      ASSERT_TRUE(report.ok()) << report.status().message();
+      EXPECT_EQ(report->watertight, mode);
+      VerifyOptions v;
+      v.base_path = cage;
+      v.sculpt_path = dir / "sculpt.obj";
+      v.map_path = o.output_path;
+      auto verified = Verify(v);
+      ASSERT_TRUE(verified.ok()) << verified.status().message();
+      ASSERT_TRUE(verified->measured_edges);
+      const double tau = report->tolerance;
+      const double step = verified->edge_across_faces.max;
+      if (mode == WatertightEdges::kOff) {
+        EXPECT_GT(step, 1.5 * tau) << "the case must step";
+        continue;
+      }
+      EXPECT_GT(report->edge_raised_faces, 0);
+      EXPECT_EQ(report->edges_over, 0);
+      EXPECT_LE(report->edge_step_across_faces, tau);
+      EXPECT_NEAR(step, report->edge_step_across_faces, 1e-6 * tau);
+      EXPECT_LE(step, tau);
+    }
+  }
 }
 
 }  // namespace

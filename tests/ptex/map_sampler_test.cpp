@@ -4,8 +4,10 @@
 // extraordinary vertices (constants stay constant, equal resolutions meet without a step).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -154,6 +156,48 @@ TEST(PtexMapSampler, MixedResolutionsKeepConstantsConstant) {
         EXPECT_NEAR(sampler.SampleAcrossFaces(PtexFaceId(f), u, v), 0.75, 1e-12);
       }
     }
+  }
+}
+
+// A vector field's step is the length of its components' steps at each point: components
+// (s, 2s, 2s) of a field s step 3 times as far as s does (the largest component would read 2
+// times, their sum 5), and one component reads as the scalar measure. The grid is turned and of
+// mixed resolutions, so the steps are not zero.
+TEST(PtexEdgeSteps, VectorStepIsTheLengthOfTheComponentsSteps) {
+  std::mt19937 rng(5);
+  std::vector<int> turn(16);
+  std::vector<std::array<int, 2>> res(16);
+  for (int f = 0; f < 16; ++f) {
+    turn[std::size_t(f)] = int(rng() % 4);
+    res[std::size_t(f)] = {int(rng() % 4), int(rng() % 4)};
+  }
+  const Grid g = MakeGrid(4, turn, res, [](double x, double y) { return std::sin(2 * x) * y; });
+  std::vector<std::vector<std::vector<float>>> components(3, g.texels);
+  for (std::size_t c = 1; c < 3; ++c) {
+    for (auto& face : components[c]) {
+      for (float& x : face) x *= 2;  // exact
+    }
+  }
+  const std::vector<std::uint8_t> none(g.faces.size(), 0);
+  const PtexEdgeSteps scalar = MeasurePtexEdgeSteps(g.faces, g.texels, none, none);
+  const PtexEdgeSteps vector = MeasurePtexVectorEdgeSteps(g.faces, components, none, none);
+  const PtexEdgeSteps one =
+      MeasurePtexVectorEdgeSteps(g.faces, std::span(components.data(), 1), none, none);
+  ASSERT_EQ(scalar.edges, 24u);
+  ASSERT_EQ(vector.across_faces.size(), scalar.across_faces.size());
+  ASSERT_EQ(vector.edge_max.size(), scalar.edge_max.size());
+  float largest = 0;
+  for (std::size_t i = 0; i < scalar.across_faces.size(); ++i) {
+    largest = std::max(largest, scalar.across_faces[i]);
+    EXPECT_NEAR(vector.across_faces[i], 3 * scalar.across_faces[i], 1e-6) << "point " << i;
+    EXPECT_NEAR(vector.per_face[i], 3 * scalar.per_face[i], 1e-6) << "point " << i;
+    EXPECT_EQ(one.across_faces[i], scalar.across_faces[i]);
+    EXPECT_EQ(one.per_face[i], scalar.per_face[i]);
+  }
+  EXPECT_GT(largest, 0.05f) << "the case must step";
+  for (std::size_t e = 0; e < scalar.edge_max.size(); ++e) {
+    EXPECT_NEAR(vector.edge_max[e].across_faces, 3 * scalar.edge_max[e].across_faces, 1e-6);
+    EXPECT_EQ(vector.edge_max[e].t_across_faces, scalar.edge_max[e].t_across_faces);
   }
 }
 
