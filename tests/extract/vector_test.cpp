@@ -319,8 +319,8 @@ TEST(VectorMapEdges, AllPinsEdgesSoThePerFaceReaderMeetsTheTruthAtBorders) {
 // Under the cross-face filter a face coarser than its neighbour steps where they meet: Spot's
 // overhang without the rounds steps by 1.8 (object) and 2.6 (tangent) tolerances, measured.
 // The default (`filter`) raises faces until D's step in object space is within the tolerance
-// on every edge, as verify measures it (rejects rounds that do not run, and rounds that
-// measure a tangent map's channels instead of D).
+// on every edge, as verify measures it (rejects rounds that do not run; the step checked is
+// verify's, of D, whatever the rounds measure).
 TEST(VectorMapEdges, FilterHoldsTheCrossFaceStepsOfD) {
   TempDir dir;
   const std::string cage = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
