@@ -31,6 +31,7 @@ std::string MatchJson(const MatchArgs& args, const LimitSurface& surface, const 
   j["base"] = args.base_path;
   j["sculpt"] = args.sculpt_path;
   j["levels"] = c.levels;
+  j["reversed"] = c.reversed;
   j["components"] = c.components;
   j["ptex_faces"] = surface.num_ptex_faces();
   j["hole_ptex_faces"] = surface.stats().hole_ptex_faces;
@@ -63,7 +64,9 @@ int RunMatch(MatchArgs& args) {
   if (!surface.ok()) return ReportFailure(surface.status());
   auto sculpt = ReadMesh(args.sculpt_path, read);
   if (!sculpt.ok()) return ReportFailure(sculpt.status());
-  auto c = MatchRefinedSculpt(*surface, *sculpt, args.options);
+  MatchOptions options = args.options;
+  options.accept_reversed = true;  // as extract does; said below
+  auto c = MatchRefinedSculpt(*surface, *sculpt, options);
   if (!c.ok()) return ReportFailure(c.status(), kMatchFlags);
   if (!args.json_path.empty()) {
     const std::string json = MatchJson(args, *surface, *sculpt, *c);
@@ -74,6 +77,11 @@ int RunMatch(MatchArgs& args) {
     const int worst = c->worst_vertex.value;
     fmt::print("level {} (the sculpt is {} refined {} times)\n", c->levels, args.base_path,
                c->levels);
+    if (c->reversed) {
+      fmt::print(
+          "reversed (every sculpt face winds the other way from the cage's: flipped normals; "
+          "extract reads it reversed)\n");
+    }
     fmt::print("components {}\n", c->components);
     fmt::print("ptex faces {} ({} holes)\n", surface->num_ptex_faces(),
                surface->stats().hole_ptex_faces);
@@ -94,8 +102,8 @@ void SetupMatch(CLI::App& app, int& exit_code) {
   CLI::App* cmd = app.add_subcommand(
       "match",
       "Decide whether SCULPT is BASE refined L times (Catmull-Clark, quads, any numbering) with "
-      "its vertices moved, and find every sculpt vertex's Ptex face and (u, v) on BASE; exit 1 "
-      "with the reason when it is not");
+      "its vertices moved (its faces wound either way), and find every sculpt vertex's Ptex "
+      "face and (u, v) on BASE; exit 1 with the reason when it is not");
   cmd->add_option("base", args->base_path, "base cage (.obj, .ply)")->required();
   cmd->add_option("sculpt", args->sculpt_path, "sculpt (.obj, .ply)")->required();
   cmd->add_option("--max-offset", o.max_offset,

@@ -36,10 +36,18 @@ struct MatchOptions {
   // Fill SculptCorrespondence::face_ptex, face_cell and face_rotation (cell_labels holds the
   // same facts by cell; without the tables the match needs 9 bytes per sculpt face less).
   bool face_tables = true;
+  // A sculpt whose every face winds the other way from the cage's (flipped normals), and which
+  // reversed is the cage refined, matches: SculptCorrespondence::reversed is set and the result
+  // is that of the sculpt after ReverseWinding, which the caller applies to it before using
+  // the two together. Otherwise such a sculpt fails, saying so.
+  bool accept_reversed = false;
 };
 
 struct SculptCorrespondence {
   int levels = 0;  // the sculpt is the cage refined this many times
+  // The sculpt matched only with every face wound the other way (MatchOptions::accept_reversed):
+  // everything below is of ReverseWinding(sculpt).
+  bool reversed = false;
 
   // Per Ptex face f: its (n+1) x (n+1) grid of sculpt vertex ids, n = grid_sizes[f]; vertex
   // (i, j), at Ptex (u, v) = (i / n, j / n), is grid_vertices[grid_offsets[f] + j * (n+1) + i].

@@ -99,6 +99,10 @@ struct Mesh {
   std::size_t num_uvs() const { return uvs.size() / 2; }
 };
 
+// Every face wound the other way: corners 1..n-1 in reverse order, corner 0 kept (texture
+// coordinates with them). Tags and groups are unchanged.
+void ReverseWinding(Mesh& mesh);
+
 // ---- Reading -------------------------------------------------------------------------------
 
 struct ReadOptions {

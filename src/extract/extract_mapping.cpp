@@ -13,11 +13,25 @@
 
 #include "core/system.h"
 #include "dispex/cancel.h"
-#include "dispex/correspondence.h"
 #include "extract/face_keys.h"
 #include "extract/parallel_errors.h"
 
 namespace dispex::extract {
+
+StatusOr<SculptCorrespondence> MatchSculpt(MatchOptions match, ExtractInputs& inputs,
+                                           ExtractReport& report) {
+  match.accept_reversed = true;
+  StatusOr<SculptCorrespondence> correspondence =
+      MatchRefinedSculpt(inputs.surface, inputs.sculpt, match);
+  if (correspondence.ok() && correspondence->reversed) {
+    ReverseWinding(inputs.sculpt);
+    report.warnings.push_back(fmt::format(
+        "{}: every face winds the other way from the base's (flipped normals); it is read with "
+        "the winding reversed",
+        inputs.sculpt.source));
+  }
+  return correspondence;
+}
 
 Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report) {
   report.method = ExtractMethod::kRays;
@@ -26,8 +40,7 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   MatchOptions match;
   match.threads = report.threads;
   match.face_tables = false;  // the mapping reads the cells
-  StatusOr<SculptCorrespondence> correspondence =
-      MatchRefinedSculpt(inputs.surface, inputs.sculpt, match);
+  StatusOr<SculptCorrespondence> correspondence = MatchSculpt(match, inputs, report);
   if (!correspondence.ok()) {
     report.t_match = clock.seconds();
     report.mapping_reason = correspondence.status().message();

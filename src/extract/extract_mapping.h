@@ -5,6 +5,7 @@
 
 #include <span>
 
+#include "dispex/correspondence.h"
 #include "dispex/extract.h"
 #include "dispex/status.h"
 #include "dispex/trace.h"
@@ -14,7 +15,13 @@
 
 namespace dispex::extract {
 
-// Under kAuto and kMapping, matches the sculpt to the base (MatchRefinedSculpt) and on a match
+// MatchRefinedSculpt of inputs.sculpt to the base, a sculpt wound the other way accepted: it is
+// then reversed in place (ReverseWinding), with a warning in the report, so that everything
+// after the match sees it wound as the base is.
+StatusOr<SculptCorrespondence> MatchSculpt(MatchOptions match, ExtractInputs& inputs,
+                                           ExtractReport& report);
+
+// Under kAuto and kMapping, matches the sculpt to the base (MatchSculpt) and on a match
 // sets inputs.mapping (no BVH is built up front then). Records the method that will run and
 // the match (time, level, offsets, or why there is none) in the report. kMapping fails with
 // the match's reason; kAuto then runs rays.

@@ -65,6 +65,16 @@ Status AddFaceTotals(const ExtractOptions& options, const ExtractInputs& inputs,
                      ExtractReport& report) {
   SumFaces(inputs, settings, faces, report);
   DISPEX_RETURN_IF_ERROR(CheckMissFraction(options, report));
+  // A sculpt that is the base refined is read reversed when it winds the other way
+  // (MatchSculpt); any other can only be named.
+  const std::int64_t hits = report.samples - report.misses;
+  if (hits > 0 && 2 * report.hits_opposed > hits) {
+    report.warnings.push_back(fmt::format(
+        "{} of {} hits are on sculpt faces facing against the base's normal: {} may wind the "
+        "other way from {} (flipped normals), and edges beside those faces are not held; "
+        "reverse its faces",
+        report.hits_opposed, hits, options.sculpt_path, options.base_path));
+  }
   const WorkerTotals& w = faces.workers;
   report.rays_cast += w.rays_cast;
   report.cpu_limit += w.cpu_limit;

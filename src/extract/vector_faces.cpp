@@ -19,6 +19,7 @@
 #include "dispex/spectral.h"
 #include "dispex/vector_space.h"
 #include "extract/edge_matching.h"
+#include "extract/extract_mapping.h"
 #include "extract/extract_meta.h"
 #include "extract/extract_settings.h"
 #include "extract/face_keys.h"
@@ -394,7 +395,7 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
     DISPEX_ASSIGN_OR_RETURN(match.max_offset,
                             ResolveSearchDistance(options.search_distance, report.base_diagonal));
   }
-  auto correspondence = MatchRefinedSculpt(inputs.surface, inputs.sculpt, match);
+  auto correspondence = MatchSculpt(match, inputs, report);
   if (!correspondence.ok()) {
     return Status::Error(fmt::format(
         "vector displacement reads the sculpt through its correspondence with the base, and "

@@ -1,6 +1,10 @@
-// CheckMeshArrays: a mesh built in memory held to what the readers guarantee of a file's.
+// CheckMeshArrays: a mesh built in memory held to what the readers guarantee of a file's;
+// ReverseWinding.
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -121,6 +125,21 @@ Status CheckMeshArrays(const Mesh& mesh) {
   DISPEX_RETURN_IF_ERROR(CheckFaces(mesh).WithPrefix(name));
   DISPEX_RETURN_IF_ERROR(CheckTags(mesh).WithPrefix(name));
   return CheckGroupsAndUvs(mesh).WithPrefix(name);
+}
+
+void ReverseWinding(Mesh& mesh) {
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, mesh.num_faces(), 1 << 14),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t f = range.begin(); f != range.end(); ++f) {
+          const std::size_t begin = mesh.face_offsets[f] + 1;
+          const std::size_t end = mesh.face_offsets[f + 1];
+          std::reverse(mesh.face_indices.begin() + begin, mesh.face_indices.begin() + end);
+          if (mesh.has_uvs()) {
+            std::reverse(mesh.face_uv_indices.begin() + begin, mesh.face_uv_indices.begin() + end);
+          }
+        }
+      });
 }
 
 }  // namespace dispex

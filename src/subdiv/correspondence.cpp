@@ -1122,22 +1122,25 @@ StatusOr<SculptCorrespondence> MatchRefinedSculpt(const LimitSurface& surface, c
       labelling = matcher.labelling();
     }
     if (result->ok() || !labelling) return;
-    // Flipped normals: say so rather than which quad the labelling stumbled on.
+    // Flipped normals: match the sculpt reversed when asked to, else say so rather than which
+    // quad the labelling stumbled on.
     Mesh reversed;
     reversed.source = sculpt.source;
     reversed.positions = sculpt.positions;
     reversed.face_offsets = sculpt.face_offsets;
     reversed.face_indices = sculpt.face_indices;
-    for (std::size_t f = 0; f < reversed.num_faces(); ++f) {
-      std::swap(reversed.face_indices[4 * f + 1], reversed.face_indices[4 * f + 3]);
-    }
+    ReverseWinding(reversed);
     auto mirrored = Matcher(surface, reversed, options).Run();
-    if (mirrored.ok()) {
-      result.emplace(Status::Error(fmt::format(
-          "{}: every face winds the other way from the cage's (flipped normals); reversed, it "
-          "is the cage refined {} times",
-          sculpt.source.empty() ? "sculpt" : sculpt.source, mirrored->levels)));
+    if (!mirrored.ok()) return;
+    if (options.accept_reversed) {
+      mirrored->reversed = true;
+      result.emplace(std::move(mirrored));
+      return;
     }
+    result.emplace(Status::Error(fmt::format(
+        "{}: every face winds the other way from the cage's (flipped normals); reversed, it "
+        "is the cage refined {} times",
+        sculpt.source.empty() ? "sculpt" : sculpt.source, mirrored->levels)));
   });
   return std::move(*result);
 }

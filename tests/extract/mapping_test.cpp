@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,6 +27,7 @@
 #include "dispex/ptex.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
+#include "dispex/vector_space.h"
 #include "dispex/verify.h"
 #include "e2e_support.h"
 #include "extract/extract_inputs.h"
@@ -374,6 +376,58 @@ TEST(MappingMethod, AutoFallsBackToRaysAndMappingFailsWithTheReason) {
   EXPECT_EQ(
       nlohmann::json::parse(statistics->FindMetaData("dispex:statistics")->AsString())["method"],
       "mapping");
+}
+
+// A sculpt exported with every face wound the other way (flipped normals) is still the base
+// refined: it is read reversed, with a warning, and gives the maps of the sculpt wound as the
+// base is, scalar and vector, texel for texel. Rejects refusing it (the ray path then counts
+// every hit as facing against the normal and holds no edge), and matching it without reversing
+// the faces the mapping tests.
+TEST(MappingMethod, SculptWoundTheOtherWayIsReadReversed) {
+  TempDir dir;
+  const std::string cage = Cage("catmark_nonquads.obj");
+  auto sculpt = ReadMesh(MakeRefined(dir, cage, 3, Pattern::kDetail));
+  ASSERT_TRUE(sculpt.ok());
+  ASSERT_TRUE(WriteObj(dir / "wound.obj", *sculpt).ok());
+  ReverseWinding(*sculpt);
+  ASSERT_TRUE(WriteObj(dir / "flipped.obj", *sculpt).ok());
+  for (const bool vector : {false, true}) {
+    SCOPED_TRACE(vector ? "vector" : "scalar");
+    std::optional<ExtractReport> reports[2];
+    for (const bool flipped : {false, true}) {
+      ExtractOptions o =
+          Options(cage, dir / (flipped ? "flipped.obj" : "wound.obj"),
+                  dir / (flipped ? "flipped.ptx" : "wound.ptx"), ExtractMethod::kAuto);
+      if (vector) o.vector = VectorSpace::kObject;
+      auto report = Extract(o);
+      ASSERT_TRUE(report.ok()) << report.status().message();
+      reports[flipped] = *report;
+    }
+    const ExtractReport& flipped = *reports[1];
+    EXPECT_EQ(flipped.mapping_levels, 3);
+    if (!vector) {
+      EXPECT_EQ(flipped.method, ExtractMethod::kMapping);
+      EXPECT_EQ(flipped.hits_opposed, 0);
+      EXPECT_EQ(flipped.edges_discontinuous, 0);
+    }
+    ASSERT_EQ(flipped.warnings.size(), reports[0]->warnings.size() + 1);
+    EXPECT_NE(flipped.warnings.back().find(
+                  "flipped.obj: every face winds the other way from the base's (flipped "
+                  "normals); it is read with the winding reversed"),
+              std::string::npos)
+        << flipped.warnings.back();
+    const TexelComparison t = CompareTexels(dir / "flipped.ptx", dir / "wound.ptx", 1.0);
+    EXPECT_TRUE(t.same_resolutions);
+    EXPECT_GT(t.texels, 0u);
+    EXPECT_EQ(t.differ, 0u);
+  }
+  // Through rays nothing is matched: most hits face against the normal, and the report says why.
+  auto rays = Extract(Options(cage, dir / "flipped.obj", dir / "rays.ptx", ExtractMethod::kRays));
+  ASSERT_TRUE(rays.ok()) << rays.status().message();
+  EXPECT_GT(2 * rays->hits_opposed, rays->samples);
+  ASSERT_FALSE(rays->warnings.empty());
+  EXPECT_NE(rays->warnings.back().find("flipped.obj may wind the other way"), std::string::npos)
+      << rays->warnings.back();
 }
 
 // Rejects a name table that loses a method, and a parser that takes what it should not.

@@ -1,5 +1,5 @@
 // CheckMeshArrays: a mesh built in memory held to the readers' contract, one case per rule, and
-// every mesh a reader returns passing it.
+// every mesh a reader returns passing it. ReverseWinding.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -81,6 +81,24 @@ TEST(CheckMeshArrays, EachRuleNamesTheElement) {
   m.source.clear();
   m.positions[0].x = INFINITY;
   EXPECT_EQ(Error(m), "mesh: vertex 0 is not finite");
+}
+
+// Each face's corners after the first in reverse order, texture coordinates with them; twice
+// is the mesh itself.
+TEST(ReverseWinding, KeepsTheFirstCornerAndReversesTheRest) {
+  const Mesh original = testing::ObjOrDie(
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n"
+      "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 0.5\n"
+      "f 1/1 2/2 3/3 4/4\nf 2/2 5/5 6/1 3/3\nf 1/1 2/2 4/4\n");
+  Mesh mesh = original;
+  ReverseWinding(mesh);
+  EXPECT_EQ(mesh.face_indices, (std::vector<std::int32_t>{0, 3, 2, 1, 1, 2, 5, 4, 0, 3, 1}));
+  EXPECT_EQ(mesh.face_uv_indices, (std::vector<std::int32_t>{0, 3, 2, 1, 1, 2, 0, 4, 0, 3, 1}));
+  EXPECT_EQ(mesh.face_offsets, original.face_offsets);
+  EXPECT_TRUE(CheckMeshArrays(mesh).ok());
+  ReverseWinding(mesh);
+  EXPECT_EQ(mesh.face_indices, original.face_indices);
+  EXPECT_EQ(mesh.face_uv_indices, original.face_uv_indices);
 }
 
 }  // namespace

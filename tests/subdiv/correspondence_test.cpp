@@ -481,10 +481,36 @@ TEST_F(NearMiss, TwoVerticesSwapped) {
 TEST_F(NearMiss, EveryFaceWoundTheOtherWay) {
   auto faces = Faces(sculpt_);
   for (auto& face : faces) std::reverse(face.begin(), face.end());
-  EXPECT_NE(Reason(WithFaces(sculpt_, faces))
-                .find("every face winds the other way from the cage's (flipped normals); "
-                      "reversed, it is the cage refined 2 times"),
+  const Mesh flipped = WithFaces(sculpt_, faces);
+  EXPECT_NE(Reason(flipped).find("every face winds the other way from the cage's (flipped "
+                                 "normals); reversed, it is the cage refined 2 times"),
             std::string::npos);
+
+  // Accepted, it is the correspondence of the sculpt wound back (which is not the original's
+  // corner lists: each face is reversed keeping its first corner, so its rotations differ).
+  MatchOptions accept;
+  accept.accept_reversed = true;
+  auto matched = MatchRefinedSculpt(*surface_, flipped, accept);
+  ASSERT_TRUE(matched.ok()) << matched.status().message();
+  EXPECT_TRUE(matched->reversed);
+  Mesh wound_back = flipped;
+  ReverseWinding(wound_back);
+  auto direct = MatchRefinedSculpt(*surface_, wound_back);
+  ASSERT_TRUE(direct.ok()) << direct.status().message();
+  EXPECT_FALSE(direct->reversed);
+  EXPECT_EQ(matched->levels, 2);
+  EXPECT_EQ(matched->grid_vertices, direct->grid_vertices);
+  EXPECT_EQ(matched->cell_labels, direct->cell_labels);
+  EXPECT_EQ(matched->vertex_faces, direct->vertex_faces);
+  EXPECT_EQ(matched->vertex_uvs, direct->vertex_uvs);
+  // The grids are the original sculpt's: the same vertices at the same (u, v).
+  auto original = MatchRefinedSculpt(*surface_, sculpt_);
+  ASSERT_TRUE(original.ok());
+  EXPECT_EQ(matched->grid_vertices, original->grid_vertices);
+
+  // A sculpt that is not the cage refined either way still fails with its reason.
+  faces[7].pop_back();
+  EXPECT_FALSE(MatchRefinedSculpt(*surface_, WithFaces(sculpt_, faces), accept).ok());
 }
 
 TEST_F(NearMiss, SculptOfAnotherCage) {
