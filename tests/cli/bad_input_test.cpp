@@ -198,7 +198,8 @@ TEST_F(BadInput, OutputPaths) {
 }
 
 // `dispex match`: a sculpt that is the base refined is matched (facts on stdout, JSON on
-// request); one of another cage, or too far from the limit surface, is refused with the reason.
+// request), wound either way; one of another cage, or too far from the limit surface, is
+// refused with the reason.
 TEST_F(BadInput, MatchRefusesWithTheReasonAndAcceptsTheRefinedBase) {
   const std::string spot = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
   ExpectFailure("match " + spot + " " + sculpt_ + " --json " + (dir_ / "m.json"),
@@ -216,6 +217,23 @@ TEST_F(BadInput, MatchRefusesWithTheReasonAndAcceptsTheRefinedBase) {
   std::ifstream json(dir_ / "m.json");
   const std::string text((std::istreambuf_iterator<char>(json)), {});
   EXPECT_NE(text.find("\"levels\": 2"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"reversed\": false"), std::string::npos) << text;
+  EXPECT_EQ(r.out.find("reversed"), std::string::npos) << r.out;
+
+  // Wound the other way (flipped normals): matched reversed, and said.
+  auto flipped = ReadMesh(sculpt_);
+  ASSERT_TRUE(flipped.ok());
+  ReverseWinding(*flipped);
+  ASSERT_TRUE(WriteObj(dir_ / "flipped.obj", *flipped).ok());
+  r = RunDispex("match " + cage_ + " " + (dir_ / "flipped.obj") + " --json " + (dir_ / "f.json"),
+                dir_);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("level 2 (the sculpt is"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\nreversed (every sculpt face winds the other way"), std::string::npos)
+      << r.out;
+  std::ifstream flipped_json(dir_ / "f.json");
+  const std::string flipped_text((std::istreambuf_iterator<char>(flipped_json)), {});
+  EXPECT_NE(flipped_text.find("\"reversed\": true"), std::string::npos) << flipped_text;
 }
 
 // Vector maps through the command line: a bad space, a sculpt that is not the base refined,
