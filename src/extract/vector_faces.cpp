@@ -252,11 +252,16 @@ Status HoldVectorEdges(VectorSpace space, const ExtractInputs& inputs,
   map.components.assign(3, std::vector<std::vector<float>>(n));
   map.skip_faces.resize(n);
   report.texels_before_edges = 0;
+  // An object map's components are its channels: while the rounds run they hold the texels
+  // (the kept copy is let go, and interleaved again at the end), so the map is held once.
+  const bool held_as_components = space == VectorSpace::kObject;
   auto update = [&](PtexFaceId face, VectorScratch& w) {
     const auto f = static_cast<std::size_t>(face.value);
     map.faces[f].ulog2 = kept[f].ulog2;
     map.faces[f].vlog2 = kept[f].vlog2;
-    return EdgeComponents(face, space, inputs, kept[f], w, map);
+    DISPEX_RETURN_IF_ERROR(EdgeComponents(face, space, inputs, kept[f], w, map));
+    if (held_as_components) std::vector<float>().swap(kept[f].texels);
+    return Status::Ok();
   };
   for (std::size_t f = 0; f < n; ++f) {
     map.skip_faces[f] = inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
@@ -264,7 +269,7 @@ Status HoldVectorEdges(VectorSpace space, const ExtractInputs& inputs,
   }
   DISPEX_RETURN_IF_ERROR(ForEachFace(
       static_cast<int>(n), [](int k) { return k; }, scratches, nullptr, update));
-  return RaiseEdgeResolutions(
+  const Status raised = RaiseEdgeResolutions(
       inputs, settings, map,
       [&](std::span<const int> redo, std::span<const std::array<int, 2>> least, EdgeRoundsMap&) {
         auto face_of = [&](int k) { return redo[static_cast<std::size_t>(k)]; };
@@ -280,6 +285,18 @@ Status HoldVectorEdges(VectorSpace space, const ExtractInputs& inputs,
             });
       },
       report);
+  DISPEX_RETURN_IF_ERROR(raised);
+  if (!held_as_components) return Status::Ok();
+  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t f) {
+    const std::size_t count = map.components[0][f].size();
+    kept[f].texels.resize(3 * count);
+    for (std::size_t c = 0; c < 3; ++c) {
+      std::vector<float>& component = map.components[c][f];
+      for (std::size_t i = 0; i < count; ++i) kept[f].texels[3 * i + c] = component[i];
+      std::vector<float>().swap(component);
+    }
+  });
+  return Status::Ok();
 }
 
 // Every face into `writer`: copied from `previous` where its key is unchanged and its texels
