@@ -57,4 +57,10 @@ two_groups() {
 two_groups "$cage" one two > "$work/asset.obj"
 two_groups "$work/sculpt.obj" two one > "$work/asset_sculpt.obj"
 "$dispex" extract "$work/asset.obj" "$work/asset_sculpt.obj" --out-dir "$work/maps" --threads 4 -q
-echo "tsan-extract: make-sculpt, extract (filter and all, incremental, shards and merge, UV maps, two shapes) and verify at 4 threads ran without a data race"
+# A vector map (its edge rounds re-extract faces in parallel), and the sculpt wound the other
+# way (matched reversed, its faces reversed in place).
+"$dispex" extract "$cage" "$work/sculpt.obj" -o "$work/vector.ptx" --vector tangent --threads 4 -q
+awk '/^f /{printf "f"; for (i = NF; i >= 2; --i) printf " %s", $i; print ""; next} {print}' \
+  "$work/sculpt.obj" > "$work/flipped.obj"
+"$dispex" extract "$cage" "$work/flipped.obj" -o "$work/flipped.ptx" --threads 4 -q
+echo "tsan-extract: make-sculpt, extract (filter and all, incremental, shards and merge, UV maps, two shapes, a vector map, a flipped sculpt) and verify at 4 threads ran without a data race"
