@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -38,6 +39,12 @@ struct SurfaceFrame {
 // tangential part are 0 and a tangent frame falls back to any unit vector orthogonal to N).
 Float3 VectorFromChannels(VectorSpace space, const SurfaceFrame& frame, const float c[3]);
 void VectorToChannels(VectorSpace space, const SurfaceFrame& frame, const Float3& d, float c[3]);
+// VectorFromChannels at x.size() points: their frames as 3 floats per point in du, dv and
+// normal, their channels as 3 per point in `channels` (or 3 in all: one value for every point,
+// a constant face's), D's components into x, y and z.
+void VectorsFromChannels(VectorSpace space, std::span<const float> du, std::span<const float> dv,
+                         std::span<const float> normal, std::span<const float> channels,
+                         std::span<float> x, std::span<float> y, std::span<float> z);
 
 // ---- Scalar or vector: what a displacement map holds -----------------------------------------
 

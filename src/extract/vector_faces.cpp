@@ -226,16 +226,8 @@ Status EdgeComponents(PtexFaceId face, VectorSpace space, const ExtractInputs& i
   DISPEX_RETURN_IF_ERROR(
       w.evaluator.EvaluateGridFrames(face, ures, vres, {w.positions, w.normals, w.du, w.dv}));
   for (std::size_t c = 0; c < 3; ++c) map.components[c][f].resize(count);
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::size_t k = 3 * i;
-    const SurfaceFrame frame{{w.du[k], w.du[k + 1], w.du[k + 2]},
-                             {w.dv[k], w.dv[k + 1], w.dv[k + 2]},
-                             {w.normals[k], w.normals[k + 1], w.normals[k + 2]}};
-    const Float3 d = VectorFromChannels(space, frame, &kept.texels[stored == 1 ? 0 : k]);
-    map.components[0][f][i] = d.x;
-    map.components[1][f][i] = d.y;
-    map.components[2][f][i] = d.z;
-  }
+  VectorsFromChannels(space, w.du, w.dv, w.normals, kept.texels, map.components[0][f],
+                      map.components[1][f], map.components[2][f]);
   return Status::Ok();
 }
 

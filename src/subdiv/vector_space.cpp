@@ -94,6 +94,22 @@ Float3 VectorFromChannels(VectorSpace space, const SurfaceFrame& frame, const fl
   return FromVec3d<Float3>(d);
 }
 
+void VectorsFromChannels(VectorSpace space, std::span<const float> du, std::span<const float> dv,
+                         std::span<const float> normal, std::span<const float> channels,
+                         std::span<float> x, std::span<float> y, std::span<float> z) {
+  const bool constant = channels.size() == 3;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const std::size_t k = 3 * i;
+    const SurfaceFrame frame{{du[k], du[k + 1], du[k + 2]},
+                             {dv[k], dv[k + 1], dv[k + 2]},
+                             {normal[k], normal[k + 1], normal[k + 2]}};
+    const Float3 d = VectorFromChannels(space, frame, &channels[constant ? 0 : k]);
+    x[i] = d.x;
+    y[i] = d.y;
+    z[i] = d.z;
+  }
+}
+
 void VectorToChannels(VectorSpace space, const SurfaceFrame& frame, const Float3& d_in,
                       float c[3]) {
   const Vec3d d = ToVec3d(d_in), n = ToVec3d(frame.normal);

@@ -491,10 +491,7 @@ Status EdgeFields(const LimitSurface& surface, const PtexFile& map,
       s.Resize(texels);
       Status st = evaluator->EvaluateGridFrames(face, faces[f].ures(), faces[f].vres(), s.Frames());
       if (!st.ok()) return error.Record(static_cast<int>(f), st);
-      for (std::size_t i = 0; i < texels; ++i) {
-        const Float3 d = VectorFromChannels(*space, s.At(i), &all[3 * i]);
-        fields[0][f][i] = d.x, fields[1][f][i] = d.y, fields[2][f][i] = d.z;
-      }
+      VectorsFromChannels(*space, s.du, s.dv, s.nrm, all, fields[0][f], fields[1][f], fields[2][f]);
       return;
     }
     for (std::size_t c = 0; c < fields.size(); ++c) {
