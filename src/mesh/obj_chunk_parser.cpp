@@ -165,6 +165,17 @@ class ChunkParser {
     return Fail("face texture index 0 (OBJ indices start at 1)");
   }
 
+  void AddCorner(std::int32_t vertex) {
+    if (in_.indices == nullptr) {
+      DISPEX_CHECK(!out_.indices.full());
+      out_.indices.push_back(vertex);
+      return;
+    }
+    // The count is checked against the counting pass's after the parse (obj_reader.cpp).
+    if (out_.corners < in_.corners) in_.indices[out_.corners] = vertex;
+    ++out_.corners;
+  }
+
   // One corner "v", "v/t", "v//n" or "v/t/n". Vertex and texture indices are resolved and
   // checked; normal indices are checked for syntax only (they may point at vn lines the file
   // does not have). Texture ids are kept while every face of the chunk has one per corner.
@@ -187,8 +198,7 @@ class ChunkParser {
       if (q > p_ && q < end_ && (*q == ' ' || *q == '\n') && digits > 0 &&
           digits <= in_.num_vertices) {
         p_ = q;
-        DISPEX_CHECK(!out_.indices.full());
-        out_.indices.push_back(static_cast<std::int32_t>(digits - 1));
+        AddCorner(static_cast<std::int32_t>(digits - 1));
         ++count;
         continue;
       }
@@ -244,8 +254,7 @@ class ChunkParser {
         }
         ++textured;
       }
-      DISPEX_CHECK(!out_.indices.full());
-      out_.indices.push_back(static_cast<std::int32_t>(vertex));
+      AddCorner(static_cast<std::int32_t>(vertex));
       ++count;
     }
     if (count < 3) {
@@ -309,7 +318,7 @@ class ChunkParser {
 bool ParseChunk(const ChunkInput& in, ChunkOutput& out) {
   // Every face corner takes at least two bytes ("1 "), so this bounds the chunk's indices.
   const std::size_t bytes = static_cast<std::size_t>(in.end - in.begin);
-  if (!out.indices.Reserve(bytes / 2 + 2)) return false;
+  if (in.indices == nullptr && !out.indices.Reserve(bytes / 2 + 2)) return false;
   // Without a vt line every texture index is an error: no buffer needed.
   if (in.num_texcoords > 0 && !out.uv_indices.Reserve(bytes / 2 + 2)) return false;
   ChunkParser(in, out).Run();

@@ -1,10 +1,10 @@
 // The parsing pass of the parallel OBJ reader: one chunk of whole logical lines at a time.
 //
 // The counting pass (obj_reader.cpp) has already told each chunk where its vertices, texture
-// coordinates and faces go in the final arrays and how many the whole file has, so a chunk
-// writes positions, UVs and face sizes in place, resolves relative (negative) indices and
-// checks every index and tag id while it parses: the first error of each chunk is found with
-// its exact line number.
+// coordinates, faces and (where it counted them) face corners go in the final arrays and how many
+// the whole file has, so a chunk writes positions, UVs and face sizes in place, resolves relative
+// (negative) indices and checks every index and tag id while it parses: the first error of each
+// chunk is found with its exact line number.
 #pragma once
 
 #include <cstdint>
@@ -31,6 +31,10 @@ struct ChunkInput {
   Float3* positions = nullptr;          // the final array, num_vertices long
   float* uvs = nullptr;                 // the final array, 2 * num_texcoords long
   std::uint32_t* face_sizes = nullptr;  // num_faces long: the size of face f at [f]
+  // Where the chunk's face indices go in the final array, room for `corners` (the counting
+  // pass's); null: into ChunkOutput::indices.
+  std::int32_t* indices = nullptr;
+  std::int64_t corners = 0;
 };
 
 struct GroupStart {
@@ -44,7 +48,8 @@ struct ChunkError {
 };
 
 struct ChunkOutput {
-  ChunkBuffer<std::int32_t> indices;  // 0-based vertex ids, face after face
+  ChunkBuffer<std::int32_t> indices;  // 0-based vertex ids, face after face (unless in place)
+  std::int64_t corners = 0;           // vertex ids read, when ChunkInput::indices is set
   // 0-based texture coordinate ids, one per corner of indices, while every face of the chunk
   // so far names one at every corner (unused when the file has no vt line, and no longer
   // filled after a face without: the file then has no UVs).

@@ -2,18 +2,22 @@
 //
 // 1. Cut the file into chunks of about ReadOptions::chunk_bytes that start at logical line
 //    starts (a cut never splits a `\` continuation).
-// 2. Counting pass, in parallel: per chunk, physical lines, `v`, `vt` and `f` lines.
-//    Prefix sums give each chunk its first line number, vertex, texture coordinate and face
-//    bases, and the totals size the final arrays.
-// 3. Parsing pass, in parallel: each chunk writes its positions, UVs and face sizes straight
-//    into the final arrays and its face (and texture) indices into per-chunk buffers;
+// 2. Counting pass, in parallel: per chunk, physical lines, `v`, `vt` and `f` lines, and the
+//    corners of its face lines (obj_syntax.h, CountFaceCorners). Prefix sums give each chunk
+//    its first line number, vertex, texture coordinate, face and corner bases, and the totals
+//    size the final arrays.
+// 3. Parsing pass, in parallel: each chunk writes its positions, UVs, face sizes and face
+//    indices straight into the final arrays (its texture indices into a per-chunk buffer);
 //    relative indices, index ranges and tag ids are checked there with the exact line number.
+//    A file with a comment or a continuation in a face line, where the counting pass does not
+//    count corners, has its face indices go to per-chunk buffers too.
 // 4. Merge, in file order: the first error of the earliest chunk is the file's first error;
 //    face sizes become offsets; index buffers are appended and freed one by one; groups and
 //    tags are concatenated. UVs are kept only when every face had them (Mesh::uvs).
-// Memory: the final arrays plus the index buffers of the chunks not yet appended; for a
-// mapped file the pages of each chunk are dropped after each pass, so the file itself does
-// not stay resident. The result is identical for any thread count and chunk size.
+// Memory: the final arrays plus the index buffers of the chunks not yet appended (none for
+// face indices parsed in place); for a mapped file the pages of each chunk are dropped after
+// each pass, so the file itself does not stay resident. The result is identical for any
+// thread count and chunk size.
 #include <fmt/format.h>
 #include <sys/mman.h>
 #include <tbb/parallel_for.h>
@@ -53,6 +57,8 @@ struct ChunkCounts {
   std::int64_t vertices = 0;
   std::int64_t texcoords = 0;
   std::int64_t faces = 0;
+  std::int64_t corners = 0;  // of its faces, meaningful while `plain` (CountFaceCorners)
+  bool plain = true;
 };
 
 std::vector<Chunk> CutIntoChunks(std::string_view bytes, std::size_t chunk_bytes) {
@@ -72,9 +78,11 @@ std::vector<Chunk> CutIntoChunks(std::string_view bytes, std::size_t chunk_bytes
 }
 
 // A logical line starts at the chunk's start and after every '\n' that is not continued; each
-// is classified exactly as the parsing pass will classify it (SkipBlanks, then ReadKeyword).
+// is classified exactly as the parsing pass will classify it (SkipBlanks, then ReadKeyword),
+// and a face line's corners are counted up to its end.
 ChunkCounts CountChunk(const char* file_begin, const Chunk& chunk) {
   ChunkCounts counts;
+  const char* face = nullptr;  // the arguments of the face line being read
   auto classify = [&](const char* p) {
     std::int64_t crossed = 0;  // continuations at the line start: counted below, as newlines
     mesh::SkipBlanks(p, chunk.end, crossed);
@@ -82,14 +90,20 @@ ChunkCounts CountChunk(const char* file_begin, const Chunk& chunk) {
     counts.vertices += kind == mesh::LineKind::kVertex;
     counts.texcoords += kind == mesh::LineKind::kTexCoord;
     counts.faces += kind == mesh::LineKind::kFace;
+    face = kind == mesh::LineKind::kFace ? p : nullptr;
+  };
+  auto end_line = [&](const char* end) {
+    if (face != nullptr) counts.corners += mesh::CountFaceCorners(face, end, counts.plain);
+    face = nullptr;
   };
   classify(chunk.begin);
   mesh::ForEachNewline(chunk.begin, chunk.end, [&](const char* newline) {
     ++counts.lines;
-    if (newline + 1 < chunk.end && !mesh::IsContinuedNewline(file_begin, newline)) {
-      classify(newline + 1);
-    }
+    if (mesh::IsContinuedNewline(file_begin, newline)) return;
+    end_line(newline);
+    if (newline + 1 < chunk.end) classify(newline + 1);
   });
+  end_line(chunk.end);
   return counts;
 }
 
@@ -182,8 +196,14 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     });
   });
 
-  std::int64_t lines = 0, vertices = 0, texcoords = 0, faces = 0;
+  std::int64_t lines = 0, vertices = 0, texcoords = 0, faces = 0, corners_counted = 0;
+  // Whether every face line's corners were counted: they are then parsed in place.
+  bool in_place = true;
+  std::vector<std::int64_t> corner_base(n);
   for (std::size_t i = 0; i < n; ++i) {
+    corner_base[i] = corners_counted;
+    corners_counted += counts[i].corners;
+    in_place = in_place && counts[i].plain;
     inputs[i].file_begin = file_begin;
     inputs[i].begin = chunks[i].begin;
     inputs[i].end = chunks[i].end;
@@ -208,20 +228,27 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     return Status::Error(
         fmt::format("{}: {} texture coordinates: more than the 2^31-1 supported", name, texcoords));
   }
+  in_place = in_place && corners_counted <= std::numeric_limits<std::uint32_t>::max();
   // Embree reads 16 bytes at the last vertex: keep one spare element of capacity.
   mesh::RunWithThreads(options.threads, [&] {
     ReserveTouched(mesh.positions, static_cast<std::size_t>(vertices) + 1);
     AssignTouched(mesh.face_offsets, static_cast<std::size_t>(faces) + 1, 0u);
     AssignTouched(mesh.uvs, 2 * static_cast<std::size_t>(texcoords), 0.0f);
+    if (in_place) AssignTouched(mesh.face_indices, static_cast<std::size_t>(corners_counted), 0);
   });
   mesh.positions.resize(static_cast<std::size_t>(vertices));
-  for (auto& in : inputs) {
+  for (std::size_t i = 0; i < n; ++i) {
+    mesh::ChunkInput& in = inputs[i];
     in.num_vertices = vertices;
     in.num_texcoords = texcoords;
     in.num_faces = faces;
     in.positions = mesh.positions.data();
     in.uvs = mesh.uvs.data();
     in.face_sizes = mesh.face_offsets.data() + 1;
+    if (in_place) {
+      in.indices = mesh.face_indices.data() + corner_base[i];
+      in.corners = counts[i].corners;
+    }
   }
 
   mesh::RunWithThreads(options.threads, [&] {
@@ -240,7 +267,9 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     DISPEX_CHECK_EQ(out.vertices, counts[i].vertices);
     DISPEX_CHECK_EQ(out.texcoords, counts[i].texcoords);
     DISPEX_CHECK_EQ(out.faces, counts[i].faces);
-    corners += out.indices.size();
+    // In place, a chunk parsed without error read the corners counted (CountFaceCorners).
+    if (in_place) DISPEX_CHECK_EQ(out.corners, counts[i].corners);
+    corners += in_place ? static_cast<std::uint64_t>(out.corners) : out.indices.size();
     faces_without_uvs += out.faces - out.faces_with_uvs;
     if (first_face_without_uvs < 0 && out.first_face_without_uvs >= 0) {
       first_face_without_uvs = faces_before + out.first_face_without_uvs;
@@ -262,9 +291,11 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     offset += mesh.face_offsets[f];
     mesh.face_offsets[f] = offset;
   }
-  mesh::RunWithThreads(options.threads, [&] {
-    AppendInOrder(outputs, &mesh::ChunkOutput::indices, corners, mesh.face_indices);
-  });
+  if (!in_place) {
+    mesh::RunWithThreads(options.threads, [&] {
+      AppendInOrder(outputs, &mesh::ChunkOutput::indices, corners, mesh.face_indices);
+    });
+  }
   // UVs: all faces or none (see Mesh::faces_without_uvs).
   if (faces_without_uvs == 0 && texcoords > 0) {
     mesh::RunWithThreads(options.threads, [&] {

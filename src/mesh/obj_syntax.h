@@ -8,6 +8,10 @@
 
 #include <cstdint>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "mesh/text_scan.h"
 
 namespace dispex::mesh {
@@ -74,6 +78,53 @@ inline LineKind ReadKeyword(const char*& p, const char* end) {
   }
   p = q;
   return kind;
+}
+
+// The corners of a face line whose arguments (after the keyword) span [p, end), `end` its
+// '\n' or the buffer's end: the runs of bytes that are not blanks. They are the corners
+// ParseFace reads whenever it accepts the line and the span holds no '#' (a comment) and no
+// '\' (a continuation), where `plain` becomes false (the count then says nothing).
+inline std::int64_t CountFaceCorners(const char* p, const char* end, bool& plain) {
+  std::int64_t corners = 0;
+  bool after_blank = true;  // the keyword ends at a blank, or the line has no argument
+#if defined(__SSE2__)
+  const __m128i space = _mm_set1_epi8(' '), tab = _mm_set1_epi8('\t'), cr = _mm_set1_epi8('\r');
+  const __m128i hash = _mm_set1_epi8('#'), backslash = _mm_set1_epi8('\\');
+  // Per byte of the 16 at q: blank, and '#' or '\\'.
+  auto classify = [&](const char* q, unsigned& blank, unsigned& special) {
+    const __m128i bytes = _mm_loadu_si128(reinterpret_cast<const __m128i*>(q));
+    blank = static_cast<unsigned>(_mm_movemask_epi8(
+        _mm_or_si128(_mm_or_si128(_mm_cmpeq_epi8(bytes, space), _mm_cmpeq_epi8(bytes, tab)),
+                     _mm_cmpeq_epi8(bytes, cr))));
+    special = static_cast<unsigned>(_mm_movemask_epi8(
+        _mm_or_si128(_mm_cmpeq_epi8(bytes, hash), _mm_cmpeq_epi8(bytes, backslash))));
+  };
+  const bool long_line = end - p >= 16;
+  unsigned blank = 0, special = 0;
+  for (; end - p >= 16; p += 16) {
+    classify(p, blank, special);
+    plain = plain && special == 0;
+    // A run starts at a byte that is not blank after one that is.
+    corners += __builtin_popcount(~blank & ((blank << 1) | (after_blank ? 1u : 0u)) & 0xffffu);
+    after_blank = (blank & 0x8000u) != 0;
+  }
+  if (long_line && p < end) {
+    // The last 16 bytes, of which the first `seen` were counted above.
+    const auto seen = static_cast<unsigned>(16 - (end - p));
+    classify(end - 16, blank, special);
+    const unsigned fresh = (0xffffu << seen) & 0xffffu;
+    plain = plain && (special & fresh) == 0;
+    corners += __builtin_popcount(~blank & (blank << 1) & fresh);
+    p = end;
+  }
+#endif
+  for (; p < end; ++p) {
+    plain = plain && *p != '#' && *p != '\\';
+    const bool blank_byte = IsBlank(*p);
+    corners += !blank_byte && after_blank;
+    after_blank = blank_byte;
+  }
+  return corners;
 }
 
 // The start of the logical line after the one containing `p` (or `end`). `begin` is the start

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "dispex/mesh.h"
+#include "mesh/obj_syntax.h"
 #include "mesh_test_util.h"
 
 namespace dispex {
@@ -308,6 +309,78 @@ TEST(ObjParallel, ErrorLineDoesNotDependOnChunks) {
     StatusOr<Mesh> mesh = ParseObj(text, "gen.obj", ReadOptions{2, chunk});
     ASSERT_FALSE(mesh.ok());
     EXPECT_EQ(mesh.status().message(), expected) << "chunk " << chunk;
+  }
+}
+
+// The counting pass's corners of a face line against a byte-by-byte count, on random lines of
+// every length around the 16-byte blocks: runs of non-blanks, blanks being ' ', '\t', '\r'.
+TEST(ObjParallel, FaceCornersCountedAsRunsOfNonBlanks) {
+  std::mt19937 rng(7);
+  const std::string alphabet = "  \t\r0123456789/-";
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::string line(rng() % 70, ' ');
+    for (char& c : line) c = alphabet[rng() % alphabet.size()];
+    const bool special = rng() % 4 == 0 && !line.empty();
+    if (special) line[rng() % line.size()] = rng() % 2 ? '#' : '\\';
+    std::int64_t expected = 0;
+    bool before_blank = true;
+    for (char c : line) {
+      const bool blank = c == ' ' || c == '\t' || c == '\r';
+      expected += !blank && before_blank;
+      before_blank = blank;
+    }
+    bool plain = true;
+    const std::int64_t counted =
+        mesh::CountFaceCorners(line.data(), line.data() + line.size(), plain);
+    EXPECT_EQ(plain, !special) << "'" << line << "'";
+    if (!special) {
+      EXPECT_EQ(counted, expected) << "'" << line << "'";
+    }
+  }
+}
+
+// A file whose face lines hold no comment and no continuation has its face indices parsed in
+// place (counted by the counting pass); one such comment sends them through per-chunk buffers.
+// Both give the same mesh, for any chunking; so do every index form and CRLF lines.
+TEST(ObjParallel, FaceIndicesInPlaceEqualBuffered) {
+  std::mt19937 rng(11);
+  std::string plain;
+  const int n = 120;
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) plain += fmt::format("v {} {} {}\n", i, j, (rng() % 100) * 0.01);
+  }
+  plain += "vt 0 0\n";
+  for (int j = 0; j + 1 < n; ++j) {
+    for (int i = 0; i + 1 < n; ++i) {
+      const int a = j * n + i + 1, b = a + 1, c = a + n + 1, d = a + n;
+      switch (rng() % 5) {
+        case 0:
+          plain += fmt::format("f {}/1 {}/1 {}/1 {}/1\r\n", a, b, c, d);
+          break;
+        case 1:
+          plain += fmt::format("f\t{}//4  {}//4\t {}//4 {}//4 \n", a, b, c, d);
+          break;
+        case 2:
+          plain += fmt::format("f {} {} {}\nf {} {} {}\n", a, b, c, a, c, d);
+          break;
+        default:
+          plain += fmt::format("f {} {} {} {}\n", a - n * n - 1, b - n * n - 1, c, d);
+          break;
+      }
+    }
+  }
+  std::string commented = plain;
+  commented.insert(commented.find('\n', commented.find("\nf ") + 1), " # a comment");
+  StatusOr<Mesh> reference = ParseObj(plain, "grid.obj", ReadOptions{1, kOneChunk});
+  ASSERT_TRUE(reference.ok()) << reference.status().message();
+  EXPECT_GT(reference->num_faces(), std::size_t(n - 1) * (n - 1));
+  for (std::size_t chunk : {kOneChunk, std::size_t{0}, std::size_t{1000}, std::size_t{4096}}) {
+    for (const std::string* text : {&plain, &commented}) {
+      StatusOr<Mesh> mesh = ParseObj(*text, "grid.obj", ReadOptions{2, chunk});
+      ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+      EXPECT_TRUE(testing::SameMesh(*mesh, *reference))
+          << "chunk " << chunk << (text == &plain ? ", in place" : ", buffered");
+    }
   }
 }
 
