@@ -11,7 +11,7 @@
 set(levels core 0 mesh 1 subdiv 2 trace 3 spectral 4 ptex 5 uvmap 5 extract 6 verify 7 render 7)
 # The module each public header belongs to.
 set(owners
-  status core ids core version core files core cancel core progress core
+  status core ids core version core files core cancel core progress core allocator core
   mesh mesh shapes mesh mesh_summary mesh
   subdiv subdiv vector_space subdiv correspondence subdiv
   trace trace

@@ -1,19 +1,15 @@
 // dispex: extract displacement maps from sculpts. This file only dispatches to the
 // subcommands (cmd_*.cpp); the work happens in the library.
 #include <unistd.h>
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
 
 #include <algorithm>
-#include <climits>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <utility>
 #include <vector>
 
 #include "command.h"
+#include "dispex/allocator.h"
 #include "dispex/version.h"
 
 namespace dispex::cli {
@@ -21,22 +17,6 @@ namespace {
 std::vector<std::pair<int, CommandSetup>>& Registry() {
   static std::vector<std::pair<int, CommandSetup>> registry;
   return registry;
-}
-
-// Asks glibc to keep the memory the process frees for its next allocations instead of returning
-// it to the system: one run's phases free large arrays and allocate others, and every page the
-// system hands out again costs a page fault on its first write (docs/BENCHMARKS.md, "Session 16:
-// freed memory kept"). Left alone when GLIBC_TUNABLES sets a malloc tunable or the environment
-// sets DISPEX_KEEP_FREED_MEMORY=0.
-void KeepFreedMemory() {
-#if defined(__GLIBC__)
-  const char* keep = std::getenv("DISPEX_KEEP_FREED_MEMORY");
-  if (keep != nullptr && std::strcmp(keep, "0") == 0) return;
-  const char* tunables = std::getenv("GLIBC_TUNABLES");
-  if (tunables != nullptr && std::strstr(tunables, "glibc.malloc.") != nullptr) return;
-  mallopt(M_MMAP_MAX, 0);  // large blocks from the heap, not from mmap (which free unmaps)
-  mallopt(M_TRIM_THRESHOLD, INT_MAX);  // the heap's free top kept, not trimmed
-#endif
 }
 }  // namespace
 
@@ -87,7 +67,7 @@ CLI::Validator NonNegative() {
 
 int main(int argc, char** argv) {
   using namespace dispex::cli;
-  KeepFreedMemory();
+  dispex::KeepFreedMemory();  // one run's phases re-use each other's pages
   CLI::App app{"dispex " DISPEX_VERSION_STRING
                ": displacement maps (Ptex) from a Catmull-Clark base mesh and its sculpt"};
   app.set_version_flag("--version", dispex::Version());

@@ -27,6 +27,7 @@
 #include <utility>
 
 #include "core/system.h"
+#include "dispex/allocator.h"
 #include "dispex/correspondence.h"
 #include "dispex/extract.h"
 #include "dispex/mesh.h"
@@ -61,6 +62,7 @@ void MustOk(const Status& status) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  KeepFreedMemory();  // as the command-line tool does, so that the parts compare with its runs
   if (argc < 3) {
     fmt::print(stderr,
                "usage: dispex_components BASE SCULPT [--json FILE] [--threads N] [--repeat N]\n");
