@@ -122,16 +122,32 @@ struct FaceBounds {
   float half_extent = 0;
 };
 
-// The corners of sculpt face `s`, xyz after xyz, into `xyz`.
-void Corners(const Mesh& sculpt, std::size_t s, std::vector<float>& xyz) {
-  xyz.clear();
-  for (std::int32_t v : sculpt.face(s)) {
-    const Float3& p = sculpt.positions[static_cast<std::size_t>(v)];
-    xyz.insert(xyz.end(), {p.x, p.y, p.z});
+// The corners of sculpt face `s`, xyz after xyz, in storage re-used from face to face: a
+// fixed array up to 8 corners, a growing one beyond.
+class Corners {
+ public:
+  std::span<const float> Of(const Mesh& sculpt, std::size_t s) {
+    const std::span<const std::int32_t> face = sculpt.face(s);
+    float* out = fixed_.data();
+    if (3 * face.size() > fixed_.size()) {
+      spill_.resize(3 * face.size());
+      out = spill_.data();
+    }
+    for (std::size_t c = 0; c < face.size(); ++c) {
+      const Float3& p = sculpt.positions[static_cast<std::size_t>(face[c])];
+      out[3 * c] = p.x;
+      out[3 * c + 1] = p.y;
+      out[3 * c + 2] = p.z;
+    }
+    return {out, 3 * face.size()};
   }
-}
 
-FaceBounds Bounds(std::span<const float> xyz) {
+ private:
+  std::array<float, 3 * 8> fixed_;
+  std::vector<float> spill_;
+};
+
+inline FaceBounds Bounds(std::span<const float> xyz) {
   std::array<float, 3> lower{INFINITY, INFINITY, INFINITY};
   std::array<float, 3> upper{-INFINITY, -INFINITY, -INFINITY};
   for (std::size_t i = 0; i < xyz.size(); i += 3) {
@@ -177,13 +193,13 @@ std::vector<Hash128> SculptReachKeys(const Mesh& sculpt, const std::vector<Box>&
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sculpt.num_faces(), 1 << 14),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       Sums& local = sums.local();
-                      std::vector<float> corners;
+                      Corners corners;
                       for (std::size_t s = range.begin(); s != range.end(); ++s) {
-                        Corners(sculpt, s, corners);
-                        const FaceBounds b = Bounds(corners);
+                        const std::span<const float> xyz = corners.Of(sculpt, s);
+                        const FaceBounds b = Bounds(xyz);
                         local.half_extent = std::max(local.half_extent, b.half_extent);
                         const std::size_t cell = grid.CellOf(b.centre);
-                        local.cells[cell] += HashBytes(std::as_bytes(std::span(corners)));
+                        local.cells[cell] += HashBytes(std::as_bytes(xyz));
                         ++local.counts[cell];
                       }
                     });
@@ -302,10 +318,9 @@ Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
   std::vector<std::uint8_t> keep(sculpt.num_faces());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sculpt.num_faces(), 1 << 14),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      std::vector<float> corners;
+                      Corners corners;
                       for (std::size_t s = range.begin(); s != range.end(); ++s) {
-                        Corners(sculpt, s, corners);
-                        const std::array<float, 3> centre = Bounds(corners).centre;
+                        const std::array<float, 3> centre = Bounds(corners.Of(sculpt, s)).centre;
                         // Beyond the grid's reach a face is out of reach: not kept for the
                         // border cell CellOf would give it.
                         keep[s] = grid.Near(centre, half_extent) && marked[grid.CellOf(centre)];
