@@ -43,7 +43,7 @@ std::size_t LowestWhere(std::size_t count, std::size_t none, Bad bad) {
 
 }  // namespace
 
-StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
+StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh, std::size_t bucket_entries) {
   DISPEX_CHECK(mesh.all_quads());
   const std::size_t num_faces = mesh.num_faces();
   const std::size_t num_vertices = mesh.num_vertices();
@@ -70,7 +70,9 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
   // first[v + 1]). The half-edges are cut in two halves, each counted into its own array (the
   // second one's in `second`) and filled from its own cursors, so that no thread reads every
   // half-edge; tasks also own ranges of vertices, so that the scattered updates need no atomics
-  // (which would serialise the cache misses of a sculpt numbered at random).
+  // (which would serialise the cache misses of a sculpt numbered at random). The vertices are
+  // bucketed and resolved in passes of at most `bucket_entries` half-edges (a vertex with more
+  // is a pass of its own), one bucket re-used by each: fresh memory is most of what this costs.
   const std::size_t concurrency =
       static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
   const std::size_t halves = concurrency >= 2 ? 2 : 1;
@@ -79,15 +81,19 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
   AssignTouched(first, num_vertices + 1, 0u);
   AssignTouched(second, halves == 2 ? num_vertices : 0, 0u);
   std::uint32_t* const counts[2] = {first.data(), second.data()};
-  const std::unique_ptr<std::uint32_t[]> bucket(new std::uint32_t[num_half_edges]);
-  // visit(slot, h) for each half-edge h of every task, slot its start vertex's entry in the
-  // array of its half; `filling`: the slots are cursors into the bucket, fetched ahead too.
-  const auto for_each_task = [&](bool filling, auto&& visit) {
+  // visit(slot, h) for each half-edge h starting at a vertex of [pass_lo, pass_hi), slot its
+  // start vertex's entry in the array of its half. Filling (`bucket` given), the slots are
+  // cursors into the bucket, whose entry 0 is cursor `base`, fetched ahead too.
+  const auto for_each_task = [&](std::size_t pass_lo, std::size_t pass_hi, std::uint32_t* bucket,
+                                 std::uint32_t base, auto&& visit) {
     tbb::parallel_for(std::size_t{0}, halves * vertex_parts, [&](std::size_t task) {
       const std::size_t half = task % halves, part = task / halves;
       std::uint32_t* const slots = counts[half];
-      const auto lo = static_cast<std::uint32_t>(num_vertices * part / vertex_parts);
-      const auto hi = static_cast<std::uint32_t>(num_vertices * (part + 1) / vertex_parts);
+      const auto lo =
+          static_cast<std::uint32_t>(std::max(pass_lo, num_vertices * part / vertex_parts));
+      const auto hi =
+          static_cast<std::uint32_t>(std::min(pass_hi, num_vertices * (part + 1) / vertex_parts));
+      if (lo >= hi) return;
       const std::size_t from = num_half_edges * half / halves;
       const std::size_t to = num_half_edges * (half + 1) / halves;
       for (std::size_t h = from; h < to; ++h) {
@@ -97,16 +103,16 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
           const auto w = static_cast<std::uint32_t>(start[h + 4 * kAhead]);
           if (w - lo < hi - lo) __builtin_prefetch(&slots[w], 1);
         }
-        if (filling && h + 2 * kAhead < to) {
+        if (bucket != nullptr && h + 2 * kAhead < to) {
           const auto w = static_cast<std::uint32_t>(start[h + 2 * kAhead]);
-          if (w - lo < hi - lo) __builtin_prefetch(&bucket[slots[w]], 1);
+          if (w - lo < hi - lo) __builtin_prefetch(&bucket[slots[w] - base], 1);
         }
         const auto v = static_cast<std::uint32_t>(start[h]);
         if (v - lo < hi - lo) visit(slots[v], h);
       }
     });
   };
-  for_each_task(false, [](std::uint32_t& count, std::size_t) { ++count; });
+  for_each_task(0, num_vertices, nullptr, 0, [](std::uint32_t& count, std::size_t) { ++count; });
   const std::size_t unused = LowestWhere(num_vertices, num_vertices, [&](std::size_t v) {
     return first[v] == 0 && (halves == 1 || second[v] == 0);
   });
@@ -114,31 +120,28 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
     return Status::Error(fmt::format("{}: vertex {} is used by no face", mesh.source, unused));
   }
   // Counts into cursors: the first half's half-edges of v from its bucket's start, the second
-  // half's after them.
-  std::uint32_t sum = 0;
+  // half's after them. The passes start at `pass_starts`.
+  std::vector<std::size_t> pass_starts;
+  std::uint32_t sum = 0, pass_sum = 0, largest_pass = 0;
   for (std::size_t v = 0; v < num_vertices; ++v) {
+    std::uint32_t count = 0;
+    for (std::size_t half = 0; half < halves; ++half) count += counts[half][v];
+    if (pass_starts.empty() || (pass_sum > 0 && pass_sum + count > bucket_entries)) {
+      pass_starts.push_back(v);
+      pass_sum = 0;
+    }
+    pass_sum += count;
+    largest_pass = std::max(largest_pass, pass_sum);
     for (std::size_t half = 0; half < halves; ++half) {
-      const std::uint32_t count = counts[half][v];
+      const std::uint32_t in_half = counts[half][v];
       counts[half][v] = sum;
-      sum += count;
+      sum += in_half;
     }
   }
   first[num_vertices] = sum;
-  // Every entry is written: no need to clear it first.
-  for_each_task(true, [&](std::uint32_t& cursor, std::size_t h) {
-    bucket[cursor++] = static_cast<std::uint32_t>(h);
-  });
-  // The cursors of the last half stopped at their bucket's end, the next bucket's start.
-  const std::uint32_t* bucket_ends = counts[halves - 1];
-  if (halves == 2 && num_vertices > 1) {
-    tbb::parallel_for(Range(1, num_vertices, 1 << 14), [&](const Range& r) {
-      for (std::size_t v = r.begin(); v < r.end(); ++v) first[v] = bucket_ends[v - 1];
-    });
-  } else if (halves == 1) {
-    for (std::size_t v = num_vertices; v-- > 1;) first[v] = first[v - 1];
-  }
-  if (num_vertices > 0) first[0] = 0;
-  std::vector<std::uint32_t>().swap(second);
+  pass_starts.push_back(num_vertices);
+  const std::unique_ptr<std::uint32_t[]> storage(new std::uint32_t[largest_pass]);
+  std::uint32_t* const bucket = storage.get();
 
   // Around vertex a, the quads of its half-edges a -> b_k (its bucket) also hold the half-edges
   // c_k -> a that end there (each one's previous), so its bucket alone answers every question
@@ -152,61 +155,84 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
   AssignTouched(out.valence, num_vertices, std::uint16_t{0});
   AssignTouched(out.boundary, num_vertices, std::uint8_t{0});
   tbb::combinable<std::uint32_t> lowest_bad([] { return kNoHalfEdge; });
-  tbb::parallel_for(Range(0, num_vertices, 2048), [&](const Range& r) {
-    std::uint32_t& bad = lowest_bad.local();
-    std::vector<std::int32_t> ends, ins;  // b_k, c_k
-    for (std::size_t a = r.begin(); a < r.end(); ++a) {
-      // The quads of a vertex some way ahead, fetched while this one waits for its own.
-      if (a + kAhead < r.end()) {
-        for (std::uint32_t k = first[a + kAhead]; k < first[a + kAhead + 1]; ++k) {
-          __builtin_prefetch(start + (bucket[k] & ~3u));
-        }
-      }
-      const std::uint32_t* around = &bucket[first[a]];
-      const std::uint32_t count = first[a + 1] - first[a];
-      ends.resize(count);
-      ins.resize(count);
-      for (std::uint32_t k = 0; k < count; ++k) {
-        const std::uint32_t h = around[k];
-        ends[k] = start[QuadAdjacency::Next(h)];
-        ins[k] = start[QuadAdjacency::Prev(h)];
-      }
-      bool border = false;
-      for (std::uint32_t k = 0; k < count; ++k) {
-        const std::int32_t b = ends[k];
-        int same_way = 0, other_way = 0;
-        std::uint32_t g = kNoHalfEdge;
-        for (std::uint32_t j = 0; j < count; ++j) {
-          same_way += ends[j] == b;
-          if (ins[j] == b) {
-            ++other_way;
-            g = QuadAdjacency::Prev(around[j]);
+  const std::uint32_t* bucket_ends = counts[halves - 1];
+  for (std::size_t pass = 0; pass + 1 < pass_starts.size(); ++pass) {
+    const std::size_t lo = pass_starts[pass], hi = pass_starts[pass + 1];
+    const std::uint32_t bucket_base = first[lo];
+    // Every entry of the pass is written: no need to clear it first.
+    for_each_task(lo, hi, bucket, bucket_base,
+                  [bucket, bucket_base](std::uint32_t& cursor, std::size_t h) {
+                    bucket[cursor++ - bucket_base] = static_cast<std::uint32_t>(h);
+                  });
+    // The cursors of the last half stopped at their bucket's end, the next bucket's start.
+    if (halves == 2) {
+      tbb::parallel_for(Range(lo + 1, std::max(lo + 1, hi), 1 << 14), [&](const Range& r) {
+        for (std::size_t v = r.begin(); v < r.end(); ++v) first[v] = bucket_ends[v - 1];
+      });
+    } else {
+      for (std::size_t v = hi; v-- > lo + 1;) first[v] = first[v - 1];
+    }
+    first[lo] = bucket_base;
+    tbb::parallel_for(Range(lo, hi, 2048), [&](const Range& r) {
+      std::uint32_t& bad = lowest_bad.local();
+      std::vector<std::int32_t> ends, ins;  // b_k, c_k
+      for (std::size_t a = r.begin(); a < r.end(); ++a) {
+        // The quads of a vertex some way ahead, fetched while this one waits for its own.
+        if (a + kAhead < r.end()) {
+          for (std::uint32_t k = first[a + kAhead]; k < first[a + kAhead + 1]; ++k) {
+            __builtin_prefetch(start + (bucket[k - bucket_base] & ~3u));
           }
         }
-        const std::uint32_t h = around[k];
-        if (same_way > 1 || (b > static_cast<std::int32_t>(a) && other_way > 1)) {
-          bad = std::min(bad, h);
+        const std::uint32_t* around = &bucket[first[a] - bucket_base];
+        const std::uint32_t count = first[a + 1] - first[a];
+        ends.resize(count);
+        ins.resize(count);
+        for (std::uint32_t k = 0; k < count; ++k) {
+          const std::uint32_t h = around[k];
+          ends[k] = start[QuadAdjacency::Next(h)];
+          ins[k] = start[QuadAdjacency::Prev(h)];
         }
-        const bool paired = same_way == 1 && other_way == 1;
-        out.opposite[h] = paired ? g : kNoHalfEdge;
-        border |= !paired;
+        bool border = false;
+        for (std::uint32_t k = 0; k < count; ++k) {
+          const std::int32_t b = ends[k];
+          int same_way = 0, other_way = 0;
+          std::uint32_t g = kNoHalfEdge;
+          for (std::uint32_t j = 0; j < count; ++j) {
+            same_way += ends[j] == b;
+            if (ins[j] == b) {
+              ++other_way;
+              g = QuadAdjacency::Prev(around[j]);
+            }
+          }
+          const std::uint32_t h = around[k];
+          if (same_way > 1 || (b > static_cast<std::int32_t>(a) && other_way > 1)) {
+            bad = std::min(bad, h);
+          }
+          const bool paired = same_way == 1 && other_way == 1;
+          out.opposite[h] = paired ? g : kNoHalfEdge;
+          border |= !paired;
+        }
+        out.valence[a] = static_cast<std::uint16_t>(std::min<std::uint32_t>(count, 65535));
+        out.boundary[a] = border ? 1 : 0;
       }
-      out.valence[a] = static_cast<std::uint16_t>(std::min<std::uint32_t>(count, 65535));
-      out.boundary[a] = border ? 1 : 0;
-    }
-  });
+    });
+    // The lowest half-edge leaving each vertex: the first of its bucket, in place of the
+    // bucket's start (the next pass reads only its own vertices' starts, and first[hi]).
+    tbb::parallel_for(Range(lo, hi, 1 << 14), [&](const Range& r) {
+      for (std::size_t v = r.begin(); v < r.end(); ++v) first[v] = bucket[first[v] - bucket_base];
+    });
+  }
+  std::vector<std::uint32_t>().swap(second);
   const std::uint32_t bad =
       lowest_bad.combine([](std::uint32_t x, std::uint32_t y) { return std::min(x, y); });
   if (bad != kNoHalfEdge) {
+    // The buckets are gone: the faces along the edge, from every half-edge.
     const std::int32_t a = start[bad], b = end(bad);
     std::vector<std::uint32_t> same_way, other_way;
-    for (std::uint32_t k = first[a]; k < first[a + 1]; ++k) {
-      if (end(bucket[k]) == b) same_way.push_back(bucket[k] / 4);
+    for (std::uint32_t h = 0; h < num_half_edges; ++h) {
+      if (start[h] == a && end(h) == b) same_way.push_back(h / 4);
+      if (start[h] == b && end(h) == a) other_way.push_back(h / 4);
     }
-    for (std::uint32_t k = first[b]; k < first[b + 1]; ++k) {
-      if (end(bucket[k]) == a) other_way.push_back(bucket[k] / 4);
-    }
-    std::sort(same_way.begin(), same_way.end());
     if (same_way.size() + other_way.size() > 2) {
       std::vector<std::uint32_t> faces = same_way;
       faces.insert(faces.end(), other_way.begin(), other_way.end());
@@ -218,11 +244,6 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh) {
         "{}: faces {} and {} both run edge {}-{} from {} to {} (their windings disagree)",
         mesh.source, same_way[0], same_way[1], a, b, a, b));
   }
-  // The lowest half-edge leaving each vertex: the first of its bucket, in place of the
-  // bucket's start.
-  tbb::parallel_for(Range(0, num_vertices, 1 << 14), [&](const Range& r) {
-    for (std::size_t v = r.begin(); v < r.end(); ++v) first[v] = bucket[first[v]];
-  });
   first.pop_back();
   out.first_half_edge = std::move(first);
   return out;

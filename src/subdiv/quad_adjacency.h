@@ -2,10 +2,12 @@
 //
 // Half-edge 4 f + k runs from corner k of quad f to corner k + 1 (mod 4); it starts at vertex
 // mesh.face_indices[4 f + k]. Built in parallel from the half-edges bucketed by start vertex
-// (no map per edge), each vertex's edges resolved from its own bucket: about 32 bytes per quad
-// and 7 per vertex at the peak, 16 per quad and 7 per vertex after.
+// (no map per edge), each vertex's edges resolved from its own bucket, a pass of vertices at a
+// time: 16 bytes per quad, 11 per vertex and one pass's bucket at the peak (at most 128 MB by
+// default), 16 per quad and 7 per vertex after.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -33,11 +35,17 @@ struct QuadAdjacency {
   static std::uint32_t Prev(std::uint32_t h) { return (h & ~3u) | ((h + 3) & 3u); }
 };
 
+// The most half-edges bucketed at once by default (128 MB).
+inline constexpr std::size_t kAdjacencyBucketEntries = std::size_t{1} << 25;
+
 // Requires mesh.all_quads(), indices in range and fewer than 2^30 faces. Fails with one line
 // starting with mesh.source, naming the lowest offending element, when a quad repeats a
 // vertex, a vertex is used by no face, an edge has more than two faces, or two faces run an
-// edge the same way (opposite windings). Deterministic for any thread count.
-StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh);
+// edge the same way (opposite windings). Deterministic for any thread count and any
+// `bucket_entries` (> 0): each pass of vertices buckets at most that many half-edges, and reads
+// every quad once more.
+StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh,
+                                           std::size_t bucket_entries = kAdjacencyBucketEntries);
 
 // Connected components of the quads through shared edges: per quad the component's index,
 // components numbered in the order of their lowest quad. Deterministic for any thread count.

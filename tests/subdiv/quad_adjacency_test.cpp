@@ -56,12 +56,16 @@ TEST(QuadAdjacency, ComponentsNumberedByTheirLowestQuad) {
 TEST(QuadAdjacency, Errors) {
   std::vector<std::int32_t> flipped = kGrid;
   std::swap(flipped[4 * 3 + 1], flipped[4 * 3 + 3]);  // quad 3 wound the other way
-  EXPECT_EQ(BuildQuadAdjacency(Quads(9, flipped)).status().message(),
-            "quads.obj: faces 1 and 3 both run edge 5-4 from 5 to 4 (their windings disagree)");
   std::vector<std::int32_t> fin = kGrid;
   fin.insert(fin.end(), {4, 1, 9, 10});  // a third quad on edge 1-4
-  EXPECT_EQ(BuildQuadAdjacency(Quads(11, fin)).status().message(),
-            "quads.obj: edge 1-4 has more than two faces (0, 1, 4)");
+  // In one pass, and in passes of one vertex's half-edges or a few.
+  for (const std::size_t entries : {kAdjacencyBucketEntries, std::size_t{1}, std::size_t{5}}) {
+    SCOPED_TRACE(entries);
+    EXPECT_EQ(BuildQuadAdjacency(Quads(9, flipped), entries).status().message(),
+              "quads.obj: faces 1 and 3 both run edge 5-4 from 5 to 4 (their windings disagree)");
+    EXPECT_EQ(BuildQuadAdjacency(Quads(11, fin), entries).status().message(),
+              "quads.obj: edge 1-4 has more than two faces (0, 1, 4)");
+  }
   EXPECT_EQ(BuildQuadAdjacency(Quads(10, kGrid)).status().message(),
             "quads.obj: vertex 9 is used by no face");
   EXPECT_EQ(BuildQuadAdjacency(Quads(4, {0, 1, 2, 1})).status().message(),
@@ -132,6 +136,20 @@ TEST(QuadAdjacency, AgreesWithAMapOfEdgesOnAShuffledGridWithHoles) {
   EXPECT_EQ(adjacency->valence, valence);
   EXPECT_EQ(adjacency->boundary, boundary);
   EXPECT_EQ(adjacency->first_half_edge, first);
+
+  // Bucketed a pass of vertices at a time: every pass boundary, from one vertex a pass
+  // (entries 1: each vertex alone) to a few passes, gives the same adjacency. A pass that
+  // reads another's bucket entries, or resolves a vertex against the wrong bucket start,
+  // changes an opposite.
+  for (const std::size_t entries : {1, 3, 64, 1000, 4000}) {
+    SCOPED_TRACE(entries);
+    auto passes = BuildQuadAdjacency(mesh, entries);
+    ASSERT_TRUE(passes.ok()) << passes.status().message();
+    EXPECT_EQ(passes->opposite, adjacency->opposite);
+    EXPECT_EQ(passes->valence, valence);
+    EXPECT_EQ(passes->boundary, boundary);
+    EXPECT_EQ(passes->first_half_edge, first);
+  }
 }
 
 }  // namespace
