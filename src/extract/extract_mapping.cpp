@@ -250,7 +250,9 @@ void ReportMapping(const ExtractInputs& inputs, const ProcessedFaces& faces,
   report.mapping_fallback_samples = faces.fallback_samples;
   report.mapping_fallback_faces = faces.fallback_faces;
   report.t_bvh += inputs.fallback_bvh_seconds;
-  report.tracer = fmt::format("subdivision correspondence (level {})", report.mapping_levels);
+  report.tracer = fmt::format("subdivision correspondence (level {}; {})", report.mapping_levels,
+                              PairedBlocksByDefault() ? "cells traced two at a time, AVX2"
+                                                      : "cells traced one at a time, SSE2");
   if (!inputs.tracer) return;
   report.tracer +=
       fmt::format("; {} for {} samples of {} faces it left undecided",

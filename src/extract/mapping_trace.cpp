@@ -9,8 +9,10 @@
 #include <array>
 #include <climits>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <optional>
+#include <string_view>
 
 #include "core/vec3.h"
 #include "dispex/ptex_sampler.h"
@@ -965,6 +967,152 @@ void TraceBlock(const MappingScratch& w, const Mesh& sculpt, int ci, int cj, con
   }
 }
 
+#if defined(__x86_64__)
+// ---- Two blocks at once, in AVX2 -------------------------------------------------------------
+// The 8 lanes of a 256-bit register hold two blocks of the same face (lane 4 h + l: block h's
+// lane l), each of its own cell. Every lane's floats come from the operations TraceBlock does,
+// in the same order (no fused multiply-add in either), so both kernels keep the same samples
+// for the exact test and answer alike (tests/extract/mapping_test.cpp compares them). Written
+// without lambdas or helpers: code outside this function is compiled for the baseline ISA.
+
+using f8 = float __attribute__((vector_size(32)));
+using i8 = std::int32_t __attribute__((vector_size(32)));
+
+__attribute__((target("avx2"))) void TraceBlockPair(const MappingScratch& w, const Mesh& sculpt,
+                                                    const int ci[2], const int cj[2],
+                                                    const Lanes* const blocks[2],
+                                                    const NormalQuery& query, const NormalHits& out,
+                                                    bool decided[2][kLanes],
+                                                    bool settled[2][kLanes]) {
+  const int width = w.m + 2 * kMargin, points = width + 1;
+  const Lanes& A = *blocks[0];
+  const Lanes& B = *blocks[1];
+#define DISPEX_JOIN(field) __builtin_shufflevector(A.field, B.field, 0, 1, 2, 3, 4, 5, 6, 7)
+  const f8 ox = DISPEX_JOIN(ox), oy = DISPEX_JOIN(oy), oz = DISPEX_JOIN(oz);
+  const f8 e1x = DISPEX_JOIN(e1x), e1y = DISPEX_JOIN(e1y), e1z = DISPEX_JOIN(e1z);
+  const f8 e2x = DISPEX_JOIN(e2x), e2y = DISPEX_JOIN(e2y), e2z = DISPEX_JOIN(e2z);
+#undef DISPEX_JOIN
+  f8 px[16], py[16];
+  f8 reach = {};
+  for (int q = 0; q < 16; ++q) {
+    const float* v[2];
+    for (int h = 0; h < 2; ++h) {
+      const int x = ci[h] - 1 + (q & 3) + kMargin, y = cj[h] - 1 + (q >> 2) + kMargin;
+      v[h] = &w.lattice[3 * static_cast<std::size_t>(y * points + x)];
+    }
+    const f8 vx = {v[0][0], v[0][0], v[0][0], v[0][0], v[1][0], v[1][0], v[1][0], v[1][0]};
+    const f8 vy = {v[0][1], v[0][1], v[0][1], v[0][1], v[1][1], v[1][1], v[1][1], v[1][1]};
+    const f8 vz = {v[0][2], v[0][2], v[0][2], v[0][2], v[1][2], v[1][2], v[1][2], v[1][2]};
+    const f8 wx = vx - ox, wy = vy - oy, wz = vz - oz;
+    px[q] = wx * e1x + wy * e1y + wz * e1z;
+    py[q] = wx * e2x + wy * e2y + wz * e2z;
+    const f8 ax = px[q] < 0 ? -px[q] : px[q], ay = py[q] < 0 ? -py[q] : py[q];
+    const f8 sum = ax + ay;
+    reach = reach > sum ? reach : sum;
+  }
+  // TraceBlock's bound on an edge value's error, lane by lane.
+  const f8 aox = ox < 0 ? -ox : ox, aoy = oy < 0 ? -oy : oy, aoz = oz < 0 ? -oz : oz;
+  const f8 extent = f8{} + w.extent;
+  const f8 mxy = aox > aoy ? aox : aoy, mze = aoz > extent ? aoz : extent;
+  const f8 magnitude = mxy > mze ? mxy : mze;
+  const f8 tol = 4 * reach * magnitude * 0x1p-19f + reach * reach * 0x1p-19f;
+#define DISPEX_EDGE(a, c) (px[a] * py[c] - py[a] * px[c])
+  f8 hz[4][3], vt[3][4];
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 3; ++x) hz[y][x] = DISPEX_EDGE(y * 4 + x, y * 4 + x + 1);
+  }
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 4; ++x) vt[y][x] = DISPEX_EDGE(y * 4 + x, (y + 1) * 4 + x);
+  }
+  const unsigned active = ((1u << A.count) - 1) | (((1u << B.count) - 1) << 4);
+  Crossings x[2 * kLanes];
+  for (int l = 0; l < 2 * kLanes; ++l) x[l].distance = query.distance;
+  i8 counter_clockwise = {}, clockwise = {};
+  const Float3* p = sculpt.positions.data();
+  for (int sy = 0; sy < 3; ++sy) {
+    for (int sx = 0; sx < 3; ++sx) {
+      const MappingScratch::Slot* slot[2];
+      int corner2[2];
+      bool main[2];
+      for (int h = 0; h < 2; ++h) {
+        slot[h] = &w.apron[static_cast<std::size_t>((cj[h] - 1 + sy + kMargin) * width + ci[h] - 1 +
+                                                    sx + kMargin)];
+        corner2[h] = (2 - slot[h]->corner) & 3;
+        main[h] = (corner2[h] & 1) != 0;
+      }
+      const int ring = sx == 1 && sy == 1 ? 0 : 1;
+      const int c0 = sy * 4 + sx, c1 = c0 + 1, c2 = c0 + 5, c3 = c0 + 4;
+      const std::int32_t ma = main[0] ? -1 : 0, mb = main[1] ? -1 : 0;
+      const i8 is_main = {ma, ma, ma, ma, mb, mb, mb, mb};
+      const f8 dg = is_main ? DISPEX_EDGE(c0, c2) : DISPEX_EDGE(c1, c3);
+      const f8 bottom = hz[sy][sx], right = vt[sy][sx + 1], top = -hz[sy + 1][sx],
+               left = -vt[sy][sx];
+      const i8 ccw = bottom + right + top + left > 0;
+      counter_clockwise |= ccw;
+      clockwise |= ~ccw;
+      const f8 tri[2][3] = {{bottom, is_main ? right : dg, is_main ? -dg : left},
+                            {is_main ? dg : right, top, is_main ? left : -dg}};
+      for (int t = 0; t < 2; ++t) {
+        const f8 lo01 = tri[t][0] < tri[t][1] ? tri[t][0] : tri[t][1];
+        const f8 low = lo01 < tri[t][2] ? lo01 : tri[t][2];
+        const f8 hi01 = tri[t][0] > tri[t][1] ? tri[t][0] : tri[t][1];
+        const f8 high = hi01 > tri[t][2] ? hi01 : tri[t][2];
+        const i8 maybe_mask = (low >= -tol) | (high <= tol);
+        const unsigned maybe =
+            static_cast<unsigned>(__builtin_ia32_movmskps256(reinterpret_cast<f8>(maybe_mask))) &
+            active;
+        if (maybe == 0) continue;
+        const i8 sure_mask = (low > tol) | (high < -tol);
+        const auto sure =
+            static_cast<unsigned>(__builtin_ia32_movmskps256(reinterpret_cast<f8>(sure_mask)));
+        for (int l = 0; l < 2 * kLanes; ++l) {
+          if (!(maybe & (1u << l))) continue;
+          const int h = l >> 2, lane = l & 3;
+          const Lanes& b = *blocks[h];
+          const int left_out = t == 0 ? (main[h] ? 3 : 2) : (main[h] ? 1 : 0);
+          const bool first = left_out == corner2[h];  // the face's (v0, v1, v3)
+          const std::int32_t* ids =
+              sculpt.face_indices.data() + 4 * static_cast<std::size_t>(slot[h]->face);
+          const Float3& fa = p[ids[first ? 0 : 2]];
+          const Float3& fb = p[ids[first ? 1 : 3]];
+          const Float3& fc = p[ids[first ? 3 : 1]];
+          if (!(sure & (1u << l)) && !ExactInside(Line(b.o[lane], b.d[lane]), fa, fb, fc)) {
+            continue;
+          }
+          double den = 0;
+          const double tt = PlaneT(fa, fb, fc, b.o[lane], b.d[lane], den);
+          if (!std::isfinite(tt)) {
+            x[l].degenerate = true;
+          } else {
+            x[l].Add(static_cast<float>(tt), den, ring, slot[h]->face);
+          }
+        }
+      }
+    }
+  }
+#undef DISPEX_EDGE
+  const unsigned both =
+      static_cast<unsigned>(__builtin_ia32_movmskps256(reinterpret_cast<f8>(counter_clockwise))) &
+      static_cast<unsigned>(__builtin_ia32_movmskps256(reinterpret_cast<f8>(clockwise)));
+  for (int h = 0; h < 2; ++h) {
+    const Lanes& b = *blocks[h];
+    for (int l = 0; l < b.count; ++l) {
+      const int lane = 4 * h + l;
+      settled[h][l] = x[lane].degenerate || (both & (1u << lane)) != 0;
+      decided[h][l] = !settled[h][l] && Decide(x[lane], 1, query.policy, b.k[l], out);
+    }
+  }
+}
+
+bool CpuPairsBlocks() {
+  return __builtin_cpu_supports("avx2") != 0;
+}
+#else
+bool CpuPairsBlocks() {
+  return false;
+}
+#endif
+
 }  // namespace
 
 namespace {
@@ -1033,13 +1181,16 @@ void TraceRingsOfFace(const SculptMapping& mapping, const Mesh& sculpt, PtexFace
     }
     return true;
   };
-  Lanes lanes{};
-  auto flush = [&](int ci, int cj) {
-    if (lanes.count == 0) return;
-    bool decided[kLanes], settled[kLanes];
-    TraceBlock(w, sculpt, ci, cj, lanes, query, out, decided, settled);
-    for (int l = 0; l < lanes.count; ++l) {
-      const std::size_t k = lanes.k[l];
+  // Blocks of samples, one cell's each, filled in blocks[fill]; paired, a full block
+  // waits in the other slot for a second one, and the two are traced together.
+  const bool pairs = w.paired_blocks && CpuPairsBlocks();
+  Lanes blocks[2];
+  int block_ci[2] = {}, block_cj[2] = {};
+  int fill = 0;
+  bool waiting = false;
+  auto finish = [&](int b, const bool* decided, const bool* settled) {
+    for (int l = 0; l < blocks[b].count; ++l) {
+      const std::size_t k = blocks[b].k[l];
       counters.quads += 9;
       if (decided[l]) {
         undecided[k] = 0;
@@ -1047,10 +1198,38 @@ void TraceRingsOfFace(const SculptMapping& mapping, const Mesh& sculpt, PtexFace
       } else if (settled[l]) {
         undecided[k] = 1;
       } else {
-        one(k, ci, cj);
+        one(k, block_ci[b], block_cj[b]);
       }
     }
-    lanes.count = 0;
+    blocks[b].count = 0;
+  };
+  auto trace_alone = [&](int b) {
+    bool decided[kLanes], settled[kLanes];
+    TraceBlock(w, sculpt, block_ci[b], block_cj[b], blocks[b], query, out, decided, settled);
+    finish(b, decided, settled);
+  };
+  auto flush = [&](int ci, int cj) {
+    if (blocks[fill].count == 0) return;
+    block_ci[fill] = ci;
+    block_cj[fill] = cj;
+    if (!pairs) {
+      trace_alone(fill);
+    } else if (!waiting) {
+      waiting = true;
+      fill = 1 - fill;
+    } else {
+#if defined(__x86_64__)
+      const int first = 1 - fill;
+      const int ci_pair[2] = {block_ci[first], block_ci[fill]};
+      const int cj_pair[2] = {block_cj[first], block_cj[fill]};
+      const Lanes* const pair[2] = {&blocks[first], &blocks[fill]};
+      bool decided[2][kLanes], settled[2][kLanes];
+      TraceBlockPair(w, sculpt, ci_pair, cj_pair, pair, query, out, decided, settled);
+      finish(first, decided[0], settled[0]);
+      finish(fill, decided[1], settled[1]);
+      waiting = false;
+#endif
+    }
   };
   // The first sample row (column) of each cell row (column); n at the end.
   w.first_sample.assign(static_cast<std::size_t>(m) + 1, n);
@@ -1074,16 +1253,25 @@ void TraceRingsOfFace(const SculptMapping& mapping, const Mesh& sculpt, PtexFace
             one(k, ci, cj);
             continue;
           }
-          AddLane(w, k, origins[k], FlushTiny(normals[k]), lanes);
-          if (lanes.count == kLanes) flush(ci, cj);
+          AddLane(w, k, origins[k], FlushTiny(normals[k]), blocks[fill]);
+          if (blocks[fill].count == kLanes) flush(ci, cj);
         }
       }
       flush(ci, cj);
     }
   }
+  if (waiting) trace_alone(1 - fill);
 }
 
 }  // namespace
+
+bool PairedBlocksByDefault() {
+  static const bool paired = [] {
+    const char* kernel = std::getenv("DISPEX_MAPPING_KERNEL");
+    return CpuPairsBlocks() && !(kernel != nullptr && std::string_view(kernel) == "sse2");
+  }();
+  return paired;
+}
 
 bool WindowCrossesBlock(const SculptMapping& mapping, const Mesh& sculpt, std::int64_t block,
                         const Float3& origin, const Float3& normal, float window) {

@@ -133,9 +133,16 @@ struct MappingCounters {
   MappingCounters& operator+=(const MappingCounters& other);
 };
 
+// Whether this CPU runs the kernel that traces two blocks of samples at once (AVX2 on x86-64),
+// unless the environment variable DISPEX_MAPPING_KERNEL is "sse2": the 4-lane kernel alone,
+// which every x86-64 CPU runs. Both answer alike.
+bool PairedBlocksByDefault();
+
 // Per-thread buffers: the neighbourhood of the face last traced (kept while the same face is
 // traced again, e.g. for a second search) and the rings' scratch. Never shrinks.
 struct MappingScratch {
+  // Trace blocks of samples two at a time (PairedBlocksByDefault); false on a CPU without it.
+  bool paired_blocks = PairedBlocksByDefault();
   struct Slot {
     std::int32_t face = -1;   // sculpt face
     std::uint8_t corner = 0;  // which of its corners sits at the slot's lower-left corner
