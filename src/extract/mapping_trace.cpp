@@ -416,10 +416,24 @@ void FillLattice(const Mesh& sculpt, MappingScratch& w) {
   w.centre[1] = c.y;
   w.centre[2] = c.z;
   float extent = 0;
-  // Each point from one slot that has it as a corner.
+  // Each point from one slot that has it as a corner: mostly its own slot (k = 0), whose
+  // quad's corner ids are fetched 16 points ahead and their position 6 ahead (the sculpt's
+  // arrays are read at random).
   static constexpr int kDx[4] = {0, -1, -1, 0}, kDy[4] = {0, 0, -1, -1};
+  const std::int32_t* const indices = sculpt.face_indices.data();
   for (int b = 0; b < points; ++b) {
     for (int a = 0; a < points; ++a) {
+      if (b < width && a + 16 < width) {
+        const MappingScratch::Slot& ahead = w.apron[static_cast<std::size_t>(b * width + a + 16)];
+        if (ahead.state == kCell) __builtin_prefetch(indices + 4 * std::size_t(ahead.face));
+      }
+      if (b < width && a + 6 < width) {
+        const MappingScratch::Slot& ahead = w.apron[static_cast<std::size_t>(b * width + a + 6)];
+        if (ahead.state == kCell) {
+          __builtin_prefetch(&sculpt.positions[static_cast<std::size_t>(
+              indices[4 * std::size_t(ahead.face) + ahead.corner])]);
+        }
+      }
       for (int k = 0; k < 4; ++k) {
         const int sa = a + kDx[k], sb = b + kDy[k];
         if (sa < 0 || sb < 0 || sa >= width || sb >= width) continue;
