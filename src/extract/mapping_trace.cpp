@@ -986,8 +986,9 @@ void TraceBlock(const MappingScratch& w, const Mesh& sculpt, int ci, int cj, con
 // The 8 lanes of a 256-bit register hold two blocks of the same face (lane 4 h + l: block h's
 // lane l), each of its own cell. Every lane's floats come from the operations TraceBlock does,
 // in the same order (no fused multiply-add in either), so both kernels keep the same samples
-// for the exact test and answer alike (tests/extract/mapping_test.cpp compares them). Written
-// without lambdas or helpers: code outside this function is compiled for the baseline ISA.
+// for the exact test and answer alike (tests/extract/mapping_test.cpp compares them). Its
+// vector code is written out here: lambdas and helper functions would be compiled for the
+// baseline ISA, not this function's.
 
 using f8 = float __attribute__((vector_size(32)));
 using i8 = std::int32_t __attribute__((vector_size(32)));

@@ -16,6 +16,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -69,20 +70,43 @@ struct KernelResult {
 
 // Every face's samples at `n` per side (2^L per sub-face side when n = 0: extract's own plan is
 // 2^(L+1) on quads, 2^L on sub-faces) through TraceMapped and through the Embree tracer.
-KernelResult CompareKernel(const std::string& cage, const std::string& sculpt_path,
-                           HitPolicy policy, double distance_fraction) {
+// A cage, a sculpt that is it refined, and the mapping extract builds between them (held in
+// place: the surface and the mapping are built from the meshes here).
+struct MappedSculpt {
+  Mesh base, sculpt;
+  std::optional<LimitSurface> surface;
+  std::vector<PtexFaceInfo> faces;
+  std::optional<SculptMapping> mapping;
+};
+
+std::unique_ptr<MappedSculpt> MapSculpt(const std::string& cage, const std::string& sculpt_path) {
+  auto m = std::make_unique<MappedSculpt>();
   auto base = ReadMesh(cage);
   auto sculpt = ReadMesh(sculpt_path);
   EXPECT_TRUE(base.ok() && sculpt.ok());
-  auto surface = LimitSurface::Build(*base);
+  m->base = std::move(*base);
+  m->sculpt = std::move(*sculpt);
+  auto surface = LimitSurface::Build(m->base);
   EXPECT_TRUE(surface.ok());
-  const std::vector<PtexFaceInfo> faces = PtexFaceTable(*surface);
-  auto correspondence = MatchRefinedSculpt(*surface, *sculpt);
+  m->surface.emplace(std::move(*surface));
+  m->faces = PtexFaceTable(*m->surface);
+  auto correspondence = MatchRefinedSculpt(*m->surface, m->sculpt);
   EXPECT_TRUE(correspondence.ok()) << correspondence.status().message();
-  auto mapping = SculptMapping::Build(*correspondence, *sculpt, faces);
+  auto mapping = SculptMapping::Build(*correspondence, m->sculpt, m->faces);
   EXPECT_TRUE(mapping.ok()) << mapping.status().message();
-  EXPECT_TRUE(mapping->MarkFolds(*surface, *sculpt, faces).ok());
-  mapping->BuildBlocks(*sculpt);
+  EXPECT_TRUE(mapping->MarkFolds(*m->surface, m->sculpt, m->faces).ok());
+  mapping->BuildBlocks(m->sculpt);
+  m->mapping.emplace(std::move(*mapping));
+  return m;
+}
+
+KernelResult CompareKernel(const std::string& cage, const std::string& sculpt_path,
+                           HitPolicy policy, double distance_fraction) {
+  const auto mapped = MapSculpt(cage, sculpt_path);
+  const Mesh* const base = &mapped->base;
+  const Mesh* const sculpt = &mapped->sculpt;
+  const auto& surface = mapped->surface;
+  const auto& mapping = mapped->mapping;
   EXPECT_EQ(mapping->fold_risk_faces(), 0u) << "these sculpts do not fold";
   TracerOptions options;
   options.scale = TracerScale(*base);
@@ -178,18 +202,11 @@ INSTANTIATE_TEST_SUITE_P(
 // for bit. Returns the number of samples whose answer differs, counting those traced.
 std::size_t PairedAgainstSingleBlocks(const std::string& cage, const std::string& sculpt_path,
                                       HitPolicy policy, std::size_t& samples) {
-  auto base = ReadMesh(cage);
-  auto sculpt = ReadMesh(sculpt_path);
-  EXPECT_TRUE(base.ok() && sculpt.ok());
-  auto surface = LimitSurface::Build(*base);
-  EXPECT_TRUE(surface.ok());
-  const std::vector<PtexFaceInfo> faces = PtexFaceTable(*surface);
-  auto correspondence = MatchRefinedSculpt(*surface, *sculpt);
-  EXPECT_TRUE(correspondence.ok()) << correspondence.status().message();
-  auto mapping = SculptMapping::Build(*correspondence, *sculpt, faces);
-  EXPECT_TRUE(mapping.ok()) << mapping.status().message();
-  EXPECT_TRUE(mapping->MarkFolds(*surface, *sculpt, faces).ok());
-  mapping->BuildBlocks(*sculpt);
+  const auto mapped = MapSculpt(cage, sculpt_path);
+  const Mesh* const base = &mapped->base;
+  const Mesh* const sculpt = &mapped->sculpt;
+  const auto& surface = mapped->surface;
+  const auto& mapping = mapped->mapping;
   const NormalQuery query{static_cast<float>(0.05 * ComputeBounds(*base).diagonal()), policy};
   LimitEvaluator evaluator(*surface);
   MappingScratch single, paired;
