@@ -18,8 +18,10 @@
 // face indices parsed in place); for a mapped file the pages of each chunk are dropped after
 // each pass, so the file itself does not stay resident. The result is identical for any
 // thread count and chunk size.
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <sys/mman.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <unistd.h>
 
@@ -174,8 +176,22 @@ void AppendInOrder(std::vector<mesh::ChunkOutput>& outputs,
   }
 }
 
+// Reads `size` bytes at `offset` of `fd` into `out`; false on an error or a short read.
+bool ReadFully(int fd, char* out, std::size_t size, std::size_t offset) {
+  while (size > 0) {
+    const ssize_t got = ::pread(fd, out, size, static_cast<off_t>(offset));
+    if (got <= 0) return false;
+    out += got;
+    size -= static_cast<std::size_t>(got);
+    offset += static_cast<std::size_t>(got);
+  }
+  return true;
+}
+
+// `bytes` is the file `copy_fd` mapped when copy_fd >= 0.
 StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
-                              const ReadOptions& options, bool release_mapped_pages) {
+                              const ReadOptions& options, bool release_mapped_pages,
+                              int copy_fd = -1) {
   const std::size_t chunk_bytes =
       options.chunk_bytes > 0 ? options.chunk_bytes : kDefaultChunkBytes;
   const std::vector<Chunk> chunks = CutIntoChunks(bytes, chunk_bytes);
@@ -189,12 +205,32 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   std::vector<mesh::ChunkInput> inputs(n);
   std::atomic<bool> out_of_memory{false};
 
-  mesh::RunWithThreads(options.threads, [&] {
-    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      counts[i] = CountChunk(file_begin, chunks[i]);
-      if (release_mapped_pages) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
+  // Counting a file (`copy_fd`) reads each chunk, with the two bytes before it that a
+  // continued newline looks back at, into a buffer of its thread's: the mapping's pages are
+  // then first touched by the parsing pass alone, where mapping them twice cost more than the
+  // copy (docs/BENCHMARKS.md, session 17). A failed read counts from the mapping.
+  {
+    tbb::enumerable_thread_specific<std::vector<char>> copies;
+    mesh::RunWithThreads(options.threads, [&] {
+      tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+        const Chunk& chunk = chunks[i];
+        if (copy_fd >= 0) {
+          const std::size_t offset = static_cast<std::size_t>(chunk.begin - file_begin);
+          const std::size_t before = std::min<std::size_t>(offset, 2);
+          const std::size_t size = before + static_cast<std::size_t>(chunk.end - chunk.begin);
+          std::vector<char>& buffer = copies.local();
+          if (buffer.size() < size) buffer.resize(size);
+          if (ReadFully(copy_fd, buffer.data(), size, offset - before)) {
+            const char* begin = buffer.data() + before;
+            counts[i] = CountChunk(buffer.data(), {begin, begin + (chunk.end - chunk.begin)});
+            return;
+          }
+        }
+        counts[i] = CountChunk(file_begin, chunk);
+        if (release_mapped_pages) ReleaseMappedPages(chunk.begin, chunk.end);
+      });
     });
-  });
+  }
 
   std::int64_t lines = 0, vertices = 0, texcoords = 0, faces = 0, corners_counted = 0;
   // Whether every face line's corners were counted: they are then parsed in place.
@@ -345,7 +381,10 @@ StatusOr<Mesh> ParseObj(std::string_view bytes, const std::string& name,
 
 StatusOr<Mesh> ReadObj(const std::string& path, const ReadOptions& options) {
   DISPEX_ASSIGN_OR_RETURN(MappedFile file, MappedFile::Open(path));
-  return ParseObjBuffer(file.view(), path, options, /*release_mapped_pages=*/true);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  auto mesh = ParseObjBuffer(file.view(), path, options, /*release_mapped_pages=*/true, fd);
+  if (fd >= 0) ::close(fd);
+  return mesh;
 }
 
 }  // namespace dispex

@@ -294,6 +294,43 @@ TEST(ObjParallel, ReadObjMatchesParseObj) {
   std::remove(path.c_str());
 }
 
+// The file path counts its chunks from copies read with pread (the two bytes before each
+// included), the buffer path from the bytes themselves: thousands of chunks, cut beside
+// continued lines (CRLF too) and comments in face lines, give the same mesh, and an error the
+// same line. (Much smaller chunks of these 3-4 MB files would exceed the process's count of
+// memory maps: each chunk's buffers are maps of their own.)
+TEST(ObjParallel, ReadObjCountsCopiesAsParseObjCountsBytes) {
+  for (int seed : {4, 5}) {
+    std::string text = seed == 4 ? GenerateTexturedObj(seed) : GenerateObj(seed);
+    const std::string path = testing::TempPath(".obj");
+    {
+      std::ofstream out(path, std::ios::binary);
+      out << text;
+    }
+    StatusOr<Mesh> reference = ParseObj(text, path, ReadOptions{1, kOneChunk});
+    ASSERT_TRUE(reference.ok()) << reference.status().message();
+    for (std::size_t chunk : {std::size_t{1000}, std::size_t{4097}, std::size_t{65536}}) {
+      StatusOr<Mesh> mesh = ReadObj(path, ReadOptions{2, chunk});
+      ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+      EXPECT_TRUE(testing::SameMesh(*mesh, *reference)) << "seed " << seed << ", chunk " << chunk;
+    }
+    // A face index 0 two thirds in.
+    const std::size_t pos = text.find("\nf ", text.size() * 2 / 3);
+    ASSERT_NE(pos, std::string::npos);
+    text.insert(pos + 3, "0 ");
+    {
+      std::ofstream out(path, std::ios::binary);
+      out << text;
+    }
+    const StatusOr<Mesh> broken = ParseObj(text, path, ReadOptions{1, kOneChunk});
+    ASSERT_FALSE(broken.ok());
+    for (std::size_t chunk : {std::size_t{1000}, std::size_t{4097}}) {
+      EXPECT_EQ(ReadObj(path, ReadOptions{2, chunk}).status().message(), broken.status().message());
+    }
+    std::remove(path.c_str());
+  }
+}
+
 // An error deep in the file: the same line number for every chunking.
 TEST(ObjParallel, ErrorLineDoesNotDependOnChunks) {
   std::string text = GenerateObj(3);
