@@ -1067,6 +1067,11 @@ __attribute__((target("avx2"))) void TraceBlockPair(const MappingScratch& w, con
       clockwise |= ~ccw;
       const f8 tri[2][3] = {{bottom, is_main ? right : dg, is_main ? -dg : left},
                             {is_main ? dg : right, top, is_main ? left : -dg}};
+      // A lane's exact value of the slot's diagonal (slot corner 0 to 2, or 1 to 3), once
+      // computed: where a triangle is unsure only along the diagonal (texel centres at a
+      // quarter of a cell lie on it), that value decides both triangles; see below.
+      double diagonal[2 * kLanes];
+      unsigned have_diagonal = 0;
       for (int t = 0; t < 2; ++t) {
         const f8 lo01 = tri[t][0] < tri[t][1] ? tri[t][0] : tri[t][1];
         const f8 low = lo01 < tri[t][2] ? lo01 : tri[t][2];
@@ -1091,8 +1096,32 @@ __attribute__((target("avx2"))) void TraceBlockPair(const MappingScratch& w, con
           const Float3& fa = p[ids[first ? 0 : 2]];
           const Float3& fb = p[ids[first ? 1 : 3]];
           const Float3& fc = p[ids[first ? 3 : 1]];
-          if (!(sure & (1u << l)) && !ExactInside(Line(b.o[lane], b.d[lane]), fa, fb, fc)) {
-            continue;
+          if (!(sure & (1u << l))) {
+            // The triangle's diagonal is tri[t][di] (dg, or -dg where `negated`). When its
+            // two other edges lie beyond the float error with one sign, ExactInside's answer
+            // is that the diagonal's exact value, seen the same way round, has that sign or
+            // is 0: its other two exact values have the sign the float ones have (what "sure"
+            // relies on), and ExactInside's three values are these, all negated or not.
+            const int di = main[h] ? (t == 0 ? 2 : 0) : (t == 0 ? 1 : 2);
+            const bool negated = (t == 0) == main[h];
+            const float ea = tri[t][(di + 1) % 3][l], eb = tri[t][(di + 2) % 3][l];
+            const bool positive = ea > tol[l] && eb > tol[l];
+            const bool negative = ea < -tol[l] && eb < -tol[l];
+            if (positive || negative) {
+              if (!(have_diagonal & (1u << l))) {
+                const Line line(b.o[lane], b.d[lane]);
+                const int k = main[h] ? 0 : 1;  // the diagonal's first slot corner
+                double xa, ya, xb, yb;
+                line.Project(p[ids[(slot[h]->corner + k) & 3]], xa, ya);
+                line.Project(p[ids[(slot[h]->corner + k + 2) & 3]], xb, yb);
+                diagonal[l] = EdgeValue(xa, ya, xb, yb);
+                have_diagonal |= 1u << l;
+              }
+              const double along = negated ? -diagonal[l] : diagonal[l];
+              if (positive ? !(along >= 0) : !(along <= 0)) continue;
+            } else if (!ExactInside(Line(b.o[lane], b.d[lane]), fa, fb, fc)) {
+              continue;
+            }
           }
           double den = 0;
           const double tt = PlaneT(fa, fb, fc, b.o[lane], b.d[lane], den);
