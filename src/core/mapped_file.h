@@ -26,11 +26,15 @@ class MappedFile {
   std::size_t size() const { return size_; }
   std::string_view view() const { return {data_, size_}; }
   const std::string& path() const { return path_; }
+  // The open file the map was made from, kept open while the map lives: reads of it see that
+  // file whatever later happens to the path (a new file renamed over it).
+  int fd() const { return fd_; }
 
  private:
   std::string path_;
   const char* data_ = nullptr;
   std::size_t size_ = 0;
+  int fd_ = -1;
 };
 
 }  // namespace dispex

@@ -15,10 +15,10 @@
 //    face sizes become offsets; index buffers are appended and freed one by one; groups and
 //    tags are concatenated. UVs are kept only when every face had them (Mesh::uvs).
 // Memory: the final arrays plus the index buffers of the chunks not yet appended (none for
-// face indices parsed in place); for a mapped file the pages of each chunk are dropped after
-// each pass, so the file itself does not stay resident. The result is identical for any
-// thread count and chunk size.
-#include <fcntl.h>
+// face indices parsed in place). A file's counting pass reads copies of its chunks (pread,
+// a buffer per thread) and the parsing pass drops each chunk's mapped pages after it, so the
+// file itself does not stay resident and its pages are mapped once. The result is identical
+// for any thread count and chunk size.
 #include <fmt/format.h>
 #include <sys/mman.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -29,6 +29,7 @@
 #include <atomic>
 #include <cstdint>
 #include <limits>
+#include <new>
 #include <string_view>
 #include <unordered_map>
 #include <vector>
@@ -208,7 +209,8 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   // Counting a file (`copy_fd`) reads each chunk, with the two bytes before it that a
   // continued newline looks back at, into a buffer of its thread's: the mapping's pages are
   // then first touched by the parsing pass alone, where mapping them twice cost more than the
-  // copy (docs/BENCHMARKS.md, session 17). A failed read counts from the mapping.
+  // copy (docs/BENCHMARKS.md, session 17). The file is the one mapped (MappedFile::fd), not
+  // whatever its path names now. A failed read counts from the mapping.
   {
     tbb::enumerable_thread_specific<std::vector<char>> copies;
     mesh::RunWithThreads(options.threads, [&] {
@@ -219,8 +221,13 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
           const std::size_t before = std::min<std::size_t>(offset, 2);
           const std::size_t size = before + static_cast<std::size_t>(chunk.end - chunk.begin);
           std::vector<char>& buffer = copies.local();
-          if (buffer.size() < size) buffer.resize(size);
-          if (ReadFully(copy_fd, buffer.data(), size, offset - before)) {
+          bool room = true;
+          try {
+            if (buffer.size() < size) buffer.resize(size);
+          } catch (const std::bad_alloc&) {
+            room = false;  // a chunk of one enormous line: counted from the mapping
+          }
+          if (room && ReadFully(copy_fd, buffer.data(), size, offset - before)) {
             const char* begin = buffer.data() + before;
             counts[i] = CountChunk(buffer.data(), {begin, begin + (chunk.end - chunk.begin)});
             return;
@@ -381,10 +388,7 @@ StatusOr<Mesh> ParseObj(std::string_view bytes, const std::string& name,
 
 StatusOr<Mesh> ReadObj(const std::string& path, const ReadOptions& options) {
   DISPEX_ASSIGN_OR_RETURN(MappedFile file, MappedFile::Open(path));
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  auto mesh = ParseObjBuffer(file.view(), path, options, /*release_mapped_pages=*/true, fd);
-  if (fd >= 0) ::close(fd);
-  return mesh;
+  return ParseObjBuffer(file.view(), path, options, /*release_mapped_pages=*/true, file.fd());
 }
 
 }  // namespace dispex
