@@ -189,10 +189,12 @@ bool ReadFully(int fd, char* out, std::size_t size, std::size_t offset) {
   return true;
 }
 
-// `bytes` is the file `copy_fd` mapped when copy_fd >= 0.
+// `bytes` is the mapping of the open file `mapped_fd`, or a buffer in memory when it is -1:
+// a mapping's pages are dropped after each chunk is parsed, and its chunks counted from
+// copies read from `mapped_fd`.
 StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
-                              const ReadOptions& options, bool release_mapped_pages,
-                              int copy_fd = -1) {
+                              const ReadOptions& options, int mapped_fd) {
+  const bool mapped = mapped_fd >= 0;
   const std::size_t chunk_bytes =
       options.chunk_bytes > 0 ? options.chunk_bytes : kDefaultChunkBytes;
   const std::vector<Chunk> chunks = CutIntoChunks(bytes, chunk_bytes);
@@ -206,7 +208,7 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   std::vector<mesh::ChunkInput> inputs(n);
   std::atomic<bool> out_of_memory{false};
 
-  // Counting a file (`copy_fd`) reads each chunk, with the two bytes before it that a
+  // Counting a file reads each chunk, with the two bytes before it that a
   // continued newline looks back at, into a buffer of its thread's: the mapping's pages are
   // then first touched by the parsing pass alone, where mapping them twice cost more than the
   // copy (docs/BENCHMARKS.md, session 17). The file is the one mapped (MappedFile::fd), not
@@ -216,7 +218,7 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     mesh::RunWithThreads(options.threads, [&] {
       tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
         const Chunk& chunk = chunks[i];
-        if (copy_fd >= 0) {
+        if (mapped) {
           const std::size_t offset = static_cast<std::size_t>(chunk.begin - file_begin);
           const std::size_t before = std::min<std::size_t>(offset, 2);
           const std::size_t size = before + static_cast<std::size_t>(chunk.end - chunk.begin);
@@ -227,14 +229,14 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
           } catch (const std::bad_alloc&) {
             room = false;  // a chunk of one enormous line: counted from the mapping
           }
-          if (room && ReadFully(copy_fd, buffer.data(), size, offset - before)) {
+          if (room && ReadFully(mapped_fd, buffer.data(), size, offset - before)) {
             const char* begin = buffer.data() + before;
             counts[i] = CountChunk(buffer.data(), {begin, begin + (chunk.end - chunk.begin)});
             return;
           }
         }
         counts[i] = CountChunk(file_begin, chunk);
-        if (release_mapped_pages) ReleaseMappedPages(chunk.begin, chunk.end);
+        if (mapped) ReleaseMappedPages(chunk.begin, chunk.end);
       });
     });
   }
@@ -297,7 +299,7 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   mesh::RunWithThreads(options.threads, [&] {
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
       if (!mesh::ParseChunk(inputs[i], outputs[i])) out_of_memory.store(true);
-      if (release_mapped_pages) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
+      if (mapped) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
     });
   });
   if (out_of_memory.load()) return Status::Error(name + ": out of memory while reading");
@@ -383,12 +385,12 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
 
 StatusOr<Mesh> ParseObj(std::string_view bytes, const std::string& name,
                         const ReadOptions& options) {
-  return ParseObjBuffer(bytes, name, options, /*release_mapped_pages=*/false);
+  return ParseObjBuffer(bytes, name, options, /*mapped_fd=*/-1);
 }
 
 StatusOr<Mesh> ReadObj(const std::string& path, const ReadOptions& options) {
   DISPEX_ASSIGN_OR_RETURN(MappedFile file, MappedFile::Open(path));
-  return ParseObjBuffer(file.view(), path, options, /*release_mapped_pages=*/true, file.fd());
+  return ParseObjBuffer(file.view(), path, options, file.fd());
 }
 
 }  // namespace dispex
