@@ -37,10 +37,10 @@
 #include "core/check.h"
 #include "core/first_touch.h"
 #include "core/mapped_file.h"
+#include "core/parallel.h"
 #include "dispex/mesh.h"
 #include "mesh/obj_chunk_parser.h"
 #include "mesh/obj_syntax.h"
-#include "mesh/parallel.h"
 #include "mesh/text_scan.h"
 
 namespace dispex {
@@ -215,7 +215,7 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   // whatever its path names now. A failed read counts from the mapping.
   {
     tbb::enumerable_thread_specific<std::vector<char>> copies;
-    mesh::RunWithThreads(options.threads, [&] {
+    RunWithThreads(options.threads, [&] {
       tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
         const Chunk& chunk = chunks[i];
         if (mapped) {
@@ -275,7 +275,7 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   }
   in_place = in_place && corners_counted <= std::numeric_limits<std::uint32_t>::max();
   // Embree reads 16 bytes at the last vertex: keep one spare element of capacity.
-  mesh::RunWithThreads(options.threads, [&] {
+  RunWithThreads(options.threads, [&] {
     ReserveTouched(mesh.positions, static_cast<std::size_t>(vertices) + 1);
     AssignTouched(mesh.face_offsets, static_cast<std::size_t>(faces) + 1, 0u);
     AssignTouched(mesh.uvs, 2 * static_cast<std::size_t>(texcoords), 0.0f);
@@ -296,7 +296,7 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     }
   }
 
-  mesh::RunWithThreads(options.threads, [&] {
+  RunWithThreads(options.threads, [&] {
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
       if (!mesh::ParseChunk(inputs[i], outputs[i])) out_of_memory.store(true);
       if (mapped) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
@@ -337,13 +337,13 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     mesh.face_offsets[f] = offset;
   }
   if (!in_place) {
-    mesh::RunWithThreads(options.threads, [&] {
+    RunWithThreads(options.threads, [&] {
       AppendInOrder(outputs, &mesh::ChunkOutput::indices, corners, mesh.face_indices);
     });
   }
   // UVs: all faces or none (see Mesh::faces_without_uvs).
   if (faces_without_uvs == 0 && texcoords > 0) {
-    mesh::RunWithThreads(options.threads, [&] {
+    RunWithThreads(options.threads, [&] {
       AppendInOrder(outputs, &mesh::ChunkOutput::uv_indices, corners, mesh.face_uv_indices);
     });
     DISPEX_CHECK_EQ(mesh.face_uv_indices.size(), mesh.face_indices.size());

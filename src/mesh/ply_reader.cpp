@@ -23,8 +23,8 @@
 #include "core/first_error.h"
 #include "core/first_touch.h"
 #include "core/mapped_file.h"
+#include "core/parallel.h"
 #include "dispex/mesh.h"
-#include "mesh/parallel.h"
 #include "mesh/ply_header.h"
 #include "mesh/text_scan.h"
 
@@ -238,7 +238,7 @@ class BinaryReader {
 
   // Walks the face records: face sizes into face_offsets, a record start every kBlock faces.
   Status SizeFaces(const Element& element, std::size_t& pos, Mesh& mesh) {
-    mesh::RunWithThreads(threads_, [&] {
+    RunWithThreads(threads_, [&] {
       AssignTouched(mesh.face_offsets, static_cast<std::size_t>(element.count) + 1, 0u);
     });
     std::uint64_t corners = 0;
@@ -273,7 +273,7 @@ class BinaryReader {
     const Element& element = header_.elements[static_cast<std::size_t>(layout_.vertex_element)];
     const std::size_t n = static_cast<std::size_t>(element.count);
     // Embree reads 16 bytes at the last vertex.
-    mesh::RunWithThreads(threads_, [&] { ReserveTouched(mesh.positions, n + 1); });
+    RunWithThreads(threads_, [&] { ReserveTouched(mesh.positions, n + 1); });
     mesh.positions.resize(n);
     const std::size_t start = starts_[static_cast<std::size_t>(layout_.vertex_element)];
     const int axes[3] = {layout_.x, layout_.y, layout_.z};
@@ -301,7 +301,7 @@ class BinaryReader {
     };
     FirstError error;
     if (fixed > 0) {
-      mesh::RunWithThreads(threads_, [&] {
+      RunWithThreads(threads_, [&] {
         tbb::parallel_for(std::size_t{0}, (n + kBlock - 1) / kBlock, [&](std::size_t b) {
           for (std::size_t v = b * kBlock; v < std::min(n, (b + 1) * kBlock); ++v) {
             const std::size_t record = start + v * fixed;
@@ -333,14 +333,14 @@ class BinaryReader {
   Status ReadFaces(Mesh& mesh) const {
     const Element& element = header_.elements[static_cast<std::size_t>(layout_.face_element)];
     const std::size_t n = static_cast<std::size_t>(element.count);
-    mesh::RunWithThreads(threads_,
-                         [&] { AssignTouched(mesh.face_indices, mesh.face_offsets.back(), 0); });
+    RunWithThreads(threads_,
+                   [&] { AssignTouched(mesh.face_indices, mesh.face_offsets.back(), 0); });
     const Property& list = element.properties[static_cast<std::size_t>(layout_.indices)];
     const std::size_t count_size = static_cast<std::size_t>(mesh::SizeOf(list.count_type));
     const std::size_t item_size = static_cast<std::size_t>(mesh::SizeOf(list.type));
     const std::int64_t num_vertices = static_cast<std::int64_t>(layout_.num_vertices);
     FirstError error;
-    mesh::RunWithThreads(threads_, [&] {
+    RunWithThreads(threads_, [&] {
       tbb::parallel_for(std::size_t{0}, face_block_starts_.size(), [&](std::size_t b) {
         std::size_t pos = face_block_starts_[b];
         for (std::size_t f = b * kBlock; f < std::min(n, (b + 1) * kBlock); ++f) {

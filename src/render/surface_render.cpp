@@ -3,13 +3,13 @@
 // options -> limit surface -> per-face density -> welded displaced tessellation (with vertex
 // normals) -> Embree tracer -> rows of camera rays -> shaded pixels.
 #include <fmt/format.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
 
+#include "core/parallel.h"
 #include "dispex/render.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
@@ -159,18 +159,12 @@ StatusOr<render::ShadedMesh> Surface(const Mesh& base, const LimitSurface& surfa
                                         use.space);
 }
 
-template <class F>
-auto InArena(int threads, F&& work) {
-  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
-  return arena.execute(std::forward<F>(work));
-}
-
 }  // namespace
 
 StatusOr<Image> RenderSurface(const Mesh& base, const PtexFile* map,
                               const SurfaceRenderOptions& options) {
   DISPEX_RETURN_IF_ERROR(ValidateSurfaceRenderOptions(options));
-  return InArena(options.threads, [&]() -> StatusOr<Image> {
+  return RunWithThreads(options.threads, [&]() -> StatusOr<Image> {
     DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
     MapUse use;
     if (map) {
@@ -185,7 +179,7 @@ StatusOr<Image> RenderSurface(const Mesh& base, const PtexFile* map,
 StatusOr<Image> RenderMesh(const Mesh& mesh, std::span<const Float3> frame,
                            const SurfaceRenderOptions& options) {
   DISPEX_RETURN_IF_ERROR(ValidateSurfaceRenderOptions(options));
-  return InArena(options.threads, [&]() -> StatusOr<Image> {
+  return RunWithThreads(options.threads, [&]() -> StatusOr<Image> {
     const render::ShadedMesh shaded = render::ShadePolygonMesh(mesh);
     return Cast(shaded, frame, options, options.width, options.height);
   });
@@ -210,7 +204,7 @@ StatusOr<Image> RenderComparison(const Mesh& base, const PtexFile& map, const Me
         fmt::format("width x height = {}x{}: too low for labelled panels (at least {})",
                     options.width, options.height, strip + 16));
   }
-  return InArena(options.threads, [&]() -> StatusOr<Image> {
+  return RunWithThreads(options.threads, [&]() -> StatusOr<Image> {
     DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
     DISPEX_ASSIGN_OR_RETURN(const MapUse use, CheckMap(base, surface, map, options.channel));
     const std::span<const Float3> frame = base.positions;

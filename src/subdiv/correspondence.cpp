@@ -28,7 +28,6 @@
 #include <tbb/combinable.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -42,6 +41,7 @@
 #include "core/check.h"
 #include "core/first_error.h"
 #include "core/first_touch.h"
+#include "core/parallel.h"
 #include "core/system.h"
 #include "core/vec3.h"
 #include "subdiv/quad_adjacency.h"
@@ -1112,9 +1112,8 @@ Float3 SculptPointAt(const SculptCorrespondence& correspondence, const Mesh& scu
 
 StatusOr<SculptCorrespondence> MatchRefinedSculpt(const LimitSurface& surface, const Mesh& sculpt,
                                                   const MatchOptions& options) {
-  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   std::optional<StatusOr<SculptCorrespondence>> result;
-  arena.execute([&] {
+  RunWithThreads(options.threads, [&] {
     bool labelling = false;
     {
       Matcher matcher(surface, sculpt, options);
