@@ -298,6 +298,10 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
 
   RunWithThreads(options.threads, [&] {
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+      if (mapped) {
+        PopulateMappedPages(chunks[i].begin,
+                            static_cast<std::size_t>(chunks[i].end - chunks[i].begin));
+      }
       if (!mesh::ParseChunk(inputs[i], outputs[i])) out_of_memory.store(true);
       if (mapped) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
     });

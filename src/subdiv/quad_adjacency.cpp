@@ -142,6 +142,9 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh, std::size_t bucket_
   pass_starts.push_back(num_vertices);
   const std::unique_ptr<std::uint32_t[]> storage(new std::uint32_t[largest_pass]);
   std::uint32_t* const bucket = storage.get();
+  if (largest_pass * sizeof(std::uint32_t) >= kFirstTouchBytes) {
+    TouchPages(bucket, largest_pass * sizeof(std::uint32_t));
+  }
 
   // Around vertex a, the quads of its half-edges a -> b_k (its bucket) also hold the half-edges
   // c_k -> a that end there (each one's previous), so its bucket alone answers every question
@@ -151,6 +154,7 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh, std::size_t bucket_
   // leaving it or ending there has no opposite: as many end there as leave, and the opposites
   // pair those that do, so it is enough to look at those leaving.
   QuadAdjacency out;
+  ReserveTouched(out.opposite, num_half_edges);
   out.opposite.resize(num_half_edges);
   AssignTouched(out.valence, num_vertices, std::uint16_t{0});
   AssignTouched(out.boundary, num_vertices, std::uint8_t{0});
