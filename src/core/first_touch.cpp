@@ -37,7 +37,9 @@ bool Populate(const void* begin, std::size_t bytes, int advice) {
 
 }  // namespace
 
-bool PopulatePages(void* begin, std::size_t bytes) { return Populate(begin, bytes, kPopulateWrite); }
+bool PopulatePages(void* begin, std::size_t bytes) {
+  return Populate(begin, bytes, kPopulateWrite);
+}
 
 bool PopulateMappedPages(const void* begin, std::size_t bytes) {
   return Populate(begin, bytes, kPopulateRead);
