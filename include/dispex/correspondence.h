@@ -32,7 +32,8 @@ struct MatchOptions {
   // The position check: a sculpt vertex farther than this from its home point on the limit
   // surface rejects the match (object units; 0: 15% of the base's bounding-box diagonal).
   double max_offset = 0;
-  int threads = 0;  // 0: TBB's default; the result does not depend on it
+  // Threads; 0: the caller's TBB arena (all cores by default). The result does not depend on it.
+  int threads = 0;
   // Fill SculptCorrespondence::face_ptex, face_cell and face_rotation (cell_labels holds the
   // same facts by cell; without the tables the match needs 9 bytes per sculpt face less).
   bool face_tables = true;
@@ -115,7 +116,7 @@ Float3 SculptPointAt(const SculptCorrespondence& correspondence, const Mesh& scu
 // whose offsets at the base vertices, across the limit normal above all, are least) and bound
 // the result.
 //
-// Runs in a TBB arena of options.threads; the result is the same for any thread count. Memory
+// Runs on options.threads threads; the result is the same for any thread count. Memory
 // besides the sculpt: about 40 bytes per sculpt face at the peak (its half-edge adjacency),
 // of which the result keeps about 29 (20 without the face tables).
 StatusOr<SculptCorrespondence> MatchRefinedSculpt(const LimitSurface& surface, const Mesh& sculpt,

@@ -106,7 +106,7 @@ void ReverseWinding(Mesh& mesh);
 // ---- Reading -------------------------------------------------------------------------------
 
 struct ReadOptions {
-  int threads = 0;  // 0: all available (TBB's default)
+  int threads = 0;  // 0: the caller's TBB arena (all available cores by default)
   // Size of the pieces a text file is cut into for parallel parsing (0: 4 MiB). Cuts fall at
   // line starts, so the result never depends on it or on `threads`; tests make it small to
   // exercise the cuts.

@@ -190,8 +190,8 @@ bool ReadFully(int fd, char* out, std::size_t size, std::size_t offset) {
 }
 
 // `bytes` is the mapping of the open file `mapped_fd`, or a buffer in memory when it is -1:
-// a mapping's pages are dropped after each chunk is parsed, and its chunks counted from
-// copies read from `mapped_fd`.
+// a mapping's chunks are counted from copies read from `mapped_fd`, and each one's pages are
+// mapped in one call before it is parsed (PopulateMappedPages) and dropped after.
 StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
                               const ReadOptions& options, int mapped_fd) {
   const bool mapped = mapped_fd >= 0;
