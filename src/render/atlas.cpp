@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,6 +13,7 @@
 #include <mutex>
 #include <string>
 
+#include "core/parallel.h"
 #include "dispex/render.h"
 #include "dispex/vector_space.h"
 #include "render/atlas_layout.h"
@@ -173,14 +173,13 @@ StatusOr<Image> RenderAtlas(const PtexFile& map, const AtlasOptions& options,
   const bool vector = options.mode == AtlasMode::kVector;
   const int count = vector ? 3 : 1;
 
-  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   // Texels shown per face (at most one per pixel of its tile, so bounded by the image).
   std::vector<std::vector<float>> shown(static_cast<std::size_t>(n));
   tbb::enumerable_thread_specific<std::vector<float>> scratches;
   std::mutex mutex;
   Status error;
   int error_face = std::numeric_limits<int>::max();
-  arena.execute([&] {
+  RunWithThreads(options.threads, [&] {
     tbb::parallel_for(0, n, [&](int f) {
       std::vector<float>& scratch = scratches.local();
       const auto& tile = layout.tiles[static_cast<std::size_t>(f)];
@@ -222,7 +221,7 @@ StatusOr<Image> RenderAtlas(const PtexFile& map, const AtlasOptions& options,
   }
 
   Image image(layout.width, layout.height, kBackground);
-  arena.execute([&] {
+  RunWithThreads(options.threads, [&] {
     tbb::parallel_for(0, n, [&](int f) {
       const auto& tile = layout.tiles[static_cast<std::size_t>(f)];
       const PtexFaceInfo& info = map.face_info(PtexFaceId(f));

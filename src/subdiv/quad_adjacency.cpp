@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <memory>
 
 #include "core/check.h"
 #include "core/first_touch.h"
@@ -140,11 +139,10 @@ StatusOr<QuadAdjacency> BuildQuadAdjacency(const Mesh& mesh, std::size_t bucket_
   }
   first[num_vertices] = sum;
   pass_starts.push_back(num_vertices);
-  const std::unique_ptr<std::uint32_t[]> storage(new std::uint32_t[largest_pass]);
-  std::uint32_t* const bucket = storage.get();
-  if (largest_pass * sizeof(std::uint32_t) >= kFirstTouchBytes) {
-    TouchPages(bucket, largest_pass * sizeof(std::uint32_t));
-  }
+  std::vector<std::uint32_t, DefaultInitAllocator<std::uint32_t>> storage;
+  ReserveTouched(storage, largest_pass);
+  storage.resize(largest_pass);
+  std::uint32_t* const bucket = storage.data();
 
   // Around vertex a, the quads of its half-edges a -> b_k (its bucket) also hold the half-edges
   // c_k -> a that end there (each one's previous), so its bucket alone answers every question
