@@ -15,10 +15,9 @@
 //    face sizes become offsets; index buffers are appended and freed one by one; groups and
 //    tags are concatenated. UVs are kept only when every face had them (Mesh::uvs).
 // Memory: the final arrays plus the index buffers of the chunks not yet appended (none for
-// face indices parsed in place). A file's counting pass reads copies of its chunks (pread,
-// a buffer per thread) and the parsing pass drops each chunk's mapped pages after it, so the
-// file itself does not stay resident and its pages are mapped once. The result is identical
-// for any thread count and chunk size.
+// face indices parsed in place). Both passes over a file read copies of its chunks (pread, a
+// buffer per thread), so the file itself is never resident in the process and its mapping's
+// pages are not touched. The result is identical for any thread count and chunk size.
 #include <fmt/format.h>
 #include <sys/mman.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -30,6 +29,7 @@
 #include <cstdint>
 #include <limits>
 #include <new>
+#include <optional>
 #include <string_view>
 #include <unordered_map>
 #include <vector>
@@ -189,9 +189,32 @@ bool ReadFully(int fd, char* out, std::size_t size, std::size_t offset) {
   return true;
 }
 
-// `bytes` is the mapping of the open file `mapped_fd`, or a buffer in memory when it is -1:
-// a mapping's chunks are counted from copies read from `mapped_fd`, and each one's pages are
-// mapped in one call before it is parsed (PopulateMappedPages) and dropped after.
+// A chunk read into a buffer: `chunk` within it, `file_begin` where the look-back stops.
+struct ChunkCopy {
+  const char* file_begin;
+  Chunk chunk;
+};
+
+// Reads `chunk` of the mapped file `fd` (mapped at `file_begin`), with the two bytes before it,
+// into `buffer`; nothing when the buffer cannot grow (a chunk of one enormous line) or the read
+// fails.
+std::optional<ChunkCopy> CopyChunk(int fd, const char* file_begin, const Chunk& chunk,
+                                   std::vector<char>& buffer) {
+  const std::size_t offset = static_cast<std::size_t>(chunk.begin - file_begin);
+  const std::size_t before = std::min<std::size_t>(offset, 2);
+  const std::size_t size = before + static_cast<std::size_t>(chunk.end - chunk.begin);
+  try {
+    if (buffer.size() < size) buffer.resize(size);
+  } catch (const std::bad_alloc&) {
+    return std::nullopt;
+  }
+  if (!ReadFully(fd, buffer.data(), size, offset - before)) return std::nullopt;
+  const char* begin = buffer.data() + before;
+  return ChunkCopy{buffer.data(), {begin, begin + (chunk.end - chunk.begin)}};
+}
+
+// `bytes` is the mapping of the open file `mapped_fd`, or a buffer in memory when it is -1: a
+// mapping's chunks are counted and parsed from copies read from `mapped_fd` (CopyChunk).
 StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
                               const ReadOptions& options, int mapped_fd) {
   const bool mapped = mapped_fd >= 0;
@@ -208,38 +231,26 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   std::vector<mesh::ChunkInput> inputs(n);
   std::atomic<bool> out_of_memory{false};
 
-  // Counting a file reads each chunk, with the two bytes before it that a
-  // continued newline looks back at, into a buffer of its thread's: the mapping's pages are
-  // then first touched by the parsing pass alone, where mapping them twice cost more than the
-  // copy (docs/BENCHMARKS.md, session 17). The file is the one mapped (MappedFile::fd), not
-  // whatever its path names now. A failed read counts from the mapping.
-  {
-    tbb::enumerable_thread_specific<std::vector<char>> copies;
-    RunWithThreads(options.threads, [&] {
-      tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-        const Chunk& chunk = chunks[i];
-        if (mapped) {
-          const std::size_t offset = static_cast<std::size_t>(chunk.begin - file_begin);
-          const std::size_t before = std::min<std::size_t>(offset, 2);
-          const std::size_t size = before + static_cast<std::size_t>(chunk.end - chunk.begin);
-          std::vector<char>& buffer = copies.local();
-          bool room = true;
-          try {
-            if (buffer.size() < size) buffer.resize(size);
-          } catch (const std::bad_alloc&) {
-            room = false;  // a chunk of one enormous line: counted from the mapping
-          }
-          if (room && ReadFully(mapped_fd, buffer.data(), size, offset - before)) {
-            const char* begin = buffer.data() + before;
-            counts[i] = CountChunk(buffer.data(), {begin, begin + (chunk.end - chunk.begin)});
-            return;
-          }
-        }
-        counts[i] = CountChunk(file_begin, chunk);
-        if (mapped) ReleaseMappedPages(chunk.begin, chunk.end);
-      });
+  // Both passes read a mapped file's chunks as copies, each with the two bytes before it that a
+  // continued newline looks back at, into a buffer of its thread's (CopyChunk): the buffers'
+  // pages are first touched once and reused chunk after chunk, where the mapping's pages were each
+  // first touched by a pass (docs/BENCHMARKS.md, sessions 17 and 19). The file is the one mapped
+  // (MappedFile::fd), not whatever its path names now. A chunk that cannot be copied is read
+  // through the mapping, whose pages are then dropped after it.
+  tbb::enumerable_thread_specific<std::vector<char>> copies;
+  auto copy_of = [&](std::size_t i) -> std::optional<ChunkCopy> {
+    return mapped ? CopyChunk(mapped_fd, file_begin, chunks[i], copies.local()) : std::nullopt;
+  };
+  RunWithThreads(options.threads, [&] {
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+      if (const std::optional<ChunkCopy> copy = copy_of(i)) {
+        counts[i] = CountChunk(copy->file_begin, copy->chunk);
+        return;
+      }
+      counts[i] = CountChunk(file_begin, chunks[i]);
+      if (mapped) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
     });
-  }
+  });
 
   std::int64_t lines = 0, vertices = 0, texcoords = 0, faces = 0, corners_counted = 0;
   // Whether every face line's corners were counted: they are then parsed in place.
@@ -298,12 +309,22 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
 
   RunWithThreads(options.threads, [&] {
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      if (mapped) {
-        PopulateMappedPages(chunks[i].begin,
-                            static_cast<std::size_t>(chunks[i].end - chunks[i].begin));
+      bool parsed = true;
+      if (const std::optional<ChunkCopy> copy = copy_of(i)) {
+        mesh::ChunkInput in = inputs[i];
+        in.file_begin = copy->file_begin;
+        in.begin = copy->chunk.begin;
+        in.end = copy->chunk.end;
+        parsed = mesh::ParseChunk(in, outputs[i]);
+      } else {
+        if (mapped) {
+          PopulateMappedPages(chunks[i].begin,
+                              static_cast<std::size_t>(chunks[i].end - chunks[i].begin));
+        }
+        parsed = mesh::ParseChunk(inputs[i], outputs[i]);
+        if (mapped) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
       }
-      if (!mesh::ParseChunk(inputs[i], outputs[i])) out_of_memory.store(true);
-      if (mapped) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
+      if (!parsed) out_of_memory.store(true);
     });
   });
   if (out_of_memory.load()) return Status::Error(name + ": out of memory while reading");

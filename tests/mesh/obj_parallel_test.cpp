@@ -294,12 +294,12 @@ TEST(ObjParallel, ReadObjMatchesParseObj) {
   std::remove(path.c_str());
 }
 
-// The file path counts its chunks from copies read with pread (the two bytes before each
-// included), the buffer path from the bytes themselves: thousands of chunks, cut beside
+// The file path counts and parses its chunks from copies read with pread (the two bytes before
+// each included), the buffer path from the bytes themselves: thousands of chunks, cut beside
 // continued lines (CRLF too) and comments in face lines, give the same mesh, and an error the
 // same line. (Much smaller chunks of these 3-4 MB files would exceed the process's count of
 // memory maps: each chunk's buffers are maps of their own.)
-TEST(ObjParallel, ReadObjCountsCopiesAsParseObjCountsBytes) {
+TEST(ObjParallel, ReadObjReadsCopiesAsParseObjReadsBytes) {
   for (int seed : {4, 5}) {
     std::string text = seed == 4 ? GenerateTexturedObj(seed) : GenerateObj(seed);
     const std::string path = testing::TempPath(".obj");
@@ -378,7 +378,8 @@ TEST(ObjParallel, FaceCornersCountedAsRunsOfNonBlanks) {
 
 // A file whose face lines hold no comment and no continuation has its face indices parsed in
 // place (counted by the counting pass); one such comment sends them through per-chunk buffers.
-// Both give the same mesh, for any chunking; so do every index form and CRLF lines.
+// Both give the same mesh, for any chunking, from a buffer and from a file; so do every index
+// form and CRLF lines.
 TEST(ObjParallel, FaceIndicesInPlaceEqualBuffered) {
   std::mt19937 rng(11);
   std::string plain;
@@ -411,14 +412,24 @@ TEST(ObjParallel, FaceIndicesInPlaceEqualBuffered) {
   StatusOr<Mesh> reference = ParseObj(plain, "grid.obj", ReadOptions{1, kOneChunk});
   ASSERT_TRUE(reference.ok()) << reference.status().message();
   EXPECT_GT(reference->num_faces(), std::size_t(n - 1) * (n - 1));
-  for (std::size_t chunk : {kOneChunk, std::size_t{0}, std::size_t{1000}, std::size_t{4096}}) {
-    for (const std::string* text : {&plain, &commented}) {
+  const std::string path = testing::TempPath(".obj");
+  for (const std::string* text : {&plain, &commented}) {
+    {
+      std::ofstream out(path, std::ios::binary);
+      out << *text;
+    }
+    for (std::size_t chunk : {kOneChunk, std::size_t{0}, std::size_t{1000}, std::size_t{4096}}) {
+      const std::string what =
+          fmt::format("chunk {}{}", chunk, text == &plain ? ", in place" : ", buffered");
       StatusOr<Mesh> mesh = ParseObj(*text, "grid.obj", ReadOptions{2, chunk});
       ASSERT_TRUE(mesh.ok()) << mesh.status().message();
-      EXPECT_TRUE(testing::SameMesh(*mesh, *reference))
-          << "chunk " << chunk << (text == &plain ? ", in place" : ", buffered");
+      EXPECT_TRUE(testing::SameMesh(*mesh, *reference)) << what;
+      StatusOr<Mesh> read = ReadObj(path, ReadOptions{2, chunk});
+      ASSERT_TRUE(read.ok()) << read.status().message();
+      EXPECT_TRUE(testing::SameMesh(*read, *reference)) << what << ", from the file";
     }
   }
+  std::remove(path.c_str());
 }
 
 }  // namespace
