@@ -248,6 +248,88 @@ INSTANTIATE_TEST_SUITE_P(
                               VectorSpace::kObject}),
     [](const auto& param_info) { return std::string(param_info.param.name); });
 
+// A sculpt face of more than 8 corners (its corners are gathered in storage of their own, not
+// the fixed array of up to 8) is keyed by all of them: moving its 11th corner re-extracts the
+// faces that can reach it, and the map equals a full extraction. Keying only its first 8 corners
+// copies stale faces and fails the comparison. The search distance is given, so that the edit
+// cannot re-extract every face by moving the automatic one.
+TEST(IncrementalMaps, ASculptFaceOfManyCornersIsKeyedByEveryCorner) {
+  TempDir dir;
+  const std::string base = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
+  const std::string refined = dir / "refined.obj", sculpt_path = dir / "sculpt.obj";
+  ASSERT_TRUE(MakeSculpt(testing::SculptOptions(base, refined, 2, Pattern::kDetail, 0.005)).ok());
+  auto read = ReadMesh(refined);
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  Mesh sculpt = std::move(*read);
+  // Quad (a, b, c, d) becomes the 12-gon a, 7 points on edge ab, b, c, m, d, with m the middle
+  // of edge cd: the same surface, fanned from a into (a, b, c), (a, c, m), (a, m, d) and
+  // triangles of no area along ab. Its neighbours keep their edges whole (T-junctions, which
+  // rays do not mind), so m is its own.
+  const std::size_t quad = sculpt.num_faces() / 3;
+  const auto q = sculpt.face(quad);
+  ASSERT_EQ(q.size(), 4u);
+  auto at = [&](std::int32_t v) { return sculpt.positions[static_cast<std::size_t>(v)]; };
+  auto add = [&](const Float3& p, const Float3& r, float t) {
+    sculpt.positions.push_back(
+        {p.x + t * (r.x - p.x), p.y + t * (r.y - p.y), p.z + t * (r.z - p.z)});
+    return static_cast<std::int32_t>(sculpt.positions.size() - 1);
+  };
+  std::vector<std::int32_t> ring = {q[0]};
+  for (int k = 1; k <= 7; ++k) ring.push_back(add(at(q[0]), at(q[1]), k / 8.0f));
+  ring.push_back(q[1]);
+  ring.push_back(q[2]);
+  const std::int32_t m = add(at(q[2]), at(q[3]), 0.5f);
+  ring.push_back(m);
+  ring.push_back(q[3]);
+  Mesh edited;
+  edited.positions = sculpt.positions;
+  edited.face_offsets = {0};
+  for (std::size_t f = 0; f < sculpt.num_faces(); ++f) {
+    const auto face = f == quad ? std::span<const std::int32_t>(ring) : sculpt.face(f);
+    edited.face_indices.insert(edited.face_indices.end(), face.begin(), face.end());
+    edited.face_offsets.push_back(static_cast<std::uint32_t>(edited.face_indices.size()));
+  }
+  ASSERT_TRUE(WriteObj(sculpt_path, edited).ok());
+
+  ExtractOptions o;
+  o.base_path = base;
+  o.sculpt_path = sculpt_path;
+  o.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.01};
+  o.output_path = dir / "inc.ptx";
+  o.incremental = true;
+  auto first = Extract(o);
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  EXPECT_EQ(first->method, ExtractMethod::kRays);  // the sculpt is no longer the base refined
+
+  // m moves half the search distance along the quad's normal.
+  const Float3 a = at(q[0]), b = at(q[1]), c = at(q[2]), d = at(q[3]);
+  const Float3 u{c.x - a.x, c.y - a.y, c.z - a.z}, v{d.x - b.x, d.y - b.y, d.z - b.z};
+  const Float3 n{u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
+  const double scale = 0.005 * first->base_diagonal / std::hypot(n.x, n.y, n.z);
+  Float3& p = edited.positions[static_cast<std::size_t>(m)];
+  p = {static_cast<float>(p.x + scale * n.x), static_cast<float>(p.y + scale * n.y),
+       static_cast<float>(p.z + scale * n.z)};
+  ASSERT_TRUE(WriteObj(sculpt_path, edited).ok());
+  const std::string before = Slurp(o.output_path);
+  auto again = Extract(o);
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  EXPECT_FALSE(again->unchanged);
+  EXPECT_GT(again->faces_extracted, 0);
+  EXPECT_GT(again->faces_copied, 0) << "moving one vertex re-extracted every face";
+
+  ExtractOptions full = o;
+  full.incremental = false;
+  full.output_path = dir / "full.ptx";
+  ASSERT_TRUE(Extract(full).ok());
+  EXPECT_TRUE(Slurp(o.output_path) == Slurp(full.output_path))
+      << "the incremental map differs from a full extraction (" << again->faces_extracted
+      << " faces extracted): " << testing::MapDifference(o.output_path, full.output_path);
+  // The edit shows in the map: a map left as it was would fail the comparison.
+  const std::string old_map = dir / "before.ptx";
+  { std::ofstream(old_map, std::ios::binary) << before; }
+  EXPECT_NE(testing::MapDifference(old_map, full.output_path, /*faces_only=*/true), "");
+}
+
 TEST(IncrementalMaps, AMapNotWrittenByDispexIsIgnoredWithANotice) {
   TempDir dir;
   const std::string base = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
