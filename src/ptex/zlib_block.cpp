@@ -57,6 +57,7 @@ std::size_t CompressAppend(std::span<const std::uint8_t> data, PtexCompressor co
   if (level < 0) level = DefaultCompressionLevel(compressor);
   const std::size_t at = out.size();
   if (compressor == PtexCompressor::kLibdeflate) {
+    if (level == 1 && data.size() < kStoredBelow) level = 0;
     libdeflate_compressor* c = ThreadCompressor(level);
     const std::size_t bound = libdeflate_zlib_compress_bound(c, data.size());
     out.resize(at + bound);

@@ -19,6 +19,12 @@ int DefaultCompressionLevel(PtexCompressor compressor);
 // Empty when `level` is valid for the compressor, else the reason.
 std::string CheckCompressionLevel(PtexCompressor compressor, int level);
 
+// At libdeflate's fastest level (1, the default), data this short is stored (level 0): each call
+// at level 1 first clears the compressor's hash tables, about 5 us (libdeflate 1.14), which is
+// more than what deflating a few hundred bytes of float texels saves (docs/BENCHMARKS.md,
+// "session 19"). The small reductions of every face are such blocks.
+inline constexpr std::size_t kStoredBelow = 512;
+
 // Appends one complete zlib stream holding `data` to `out`; returns its size in bytes.
 // Deterministic: the same input, compressor and level give the same bytes. Uses a
 // per-thread compressor, so it is safe to call from several threads.

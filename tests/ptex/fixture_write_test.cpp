@@ -402,6 +402,32 @@ INSTANTIATE_TEST_SUITE_P(Fixtures, PtexFixtureWrite, ::testing::ValuesIn(Fixture
                            return p.param.file.substr(0, p.param.file.size() - 4);
                          });
 
+// At libdeflate's level 1 a block under ptex::kStoredBelow bytes is stored (a deflate block of
+// type 0, RFC 1951), one at or above it deflated; both inflate back to the data. Other levels
+// and zlib deflate short blocks too.
+TEST(PtexZlibBlock, ShortBlocksAreStoredAtTheFastestLevel) {
+  auto block_type = [](const std::vector<std::uint8_t>& stream) { return (stream[2] >> 1) & 3; };
+  for (const std::size_t size : {std::size_t{64}, ptex::kStoredBelow - 1, ptex::kStoredBelow}) {
+    const std::vector<std::uint8_t> zeros(size, 0);  // deflates to a few bytes
+    for (const auto& [compressor, level] :
+         {std::pair{PtexCompressor::kLibdeflate, 1}, std::pair{PtexCompressor::kLibdeflate, -1},
+          std::pair{PtexCompressor::kLibdeflate, 6}, std::pair{PtexCompressor::kZlib, 1}}) {
+      SCOPED_TRACE(::testing::Message() << size << " bytes, level " << level
+                                        << (compressor == PtexCompressor::kZlib ? ", zlib" : ""));
+      std::vector<std::uint8_t> stream;
+      const std::size_t made = ptex::CompressAppend(zeros, compressor, level, stream);
+      ASSERT_EQ(made, stream.size());
+      const bool stored =
+          compressor == PtexCompressor::kLibdeflate && level <= 1 && size < ptex::kStoredBelow;
+      EXPECT_EQ(block_type(stream) == 0, stored);
+      EXPECT_EQ(stream.size() > size, stored);
+      std::vector<std::uint8_t> back(size, 1);
+      EXPECT_EQ(ptex::Inflate(stream, back), "");
+      EXPECT_EQ(back, zeros);
+    }
+  }
+}
+
 // A face given as texels that are all bit-identical is stored exactly like SetConstantFace.
 TEST(PtexWriterConstant, BitIdenticalTexelsAreAConstantFace) {
   TempDir dir;
