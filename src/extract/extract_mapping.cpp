@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <utility>
 #include <vector>
 
@@ -149,30 +148,28 @@ StatusOr<SearchDistanceEstimate> EstimateSearchDistanceMapped(const ExtractInput
   std::vector<double> abs_t(coarse.ids.size(), -1.0);  // -1: a miss or not decided
   std::vector<std::uint8_t> decided(coarse.ids.size(), 0);
   struct Scratch {
-    std::optional<LimitEvaluator> evaluator;
     MappingScratch mapping;
     MappingCounters counters;
   };
   tbb::enumerable_thread_specific<Scratch> scratches;
-  FirstError error;
   tbb::parallel_for(std::size_t{0}, starts.size() - 1, [&](std::size_t group) {
-    if (error.failed()) return;
     Scratch& w = scratches.local();
-    if (!w.evaluator) w.evaluator.emplace(inputs.surface);
     const std::size_t begin = starts[group], end = starts[group + 1];
     const auto face = static_cast<int>(coarse.ids[begin] / per_face);
-    float positions[3 * per_face], normals[3 * per_face], t[per_face];
+    // The face's grid holds the coarse points (evaluated by SampleCoarsely) at their places;
+    // TraceMapped reads only the samples listed.
+    Float3 positions[per_face], normals[per_face];
+    float t[per_face];
     std::uint8_t flags[per_face], undecided[per_face];
     std::int32_t samples[per_face];
-    const Status s = w.evaluator->EvaluateGrid(PtexFaceId(face), g, g, positions, normals);
-    if (!s.ok()) return error.Record(face, s);
     for (std::size_t k = begin; k < end; ++k) {
-      samples[k - begin] = static_cast<std::int32_t>(coarse.ids[k] % per_face);
+      const auto i = static_cast<std::int32_t>(coarse.ids[k] % per_face);
+      samples[k - begin] = i;
+      positions[i] = coarse.points[k];
+      normals[i] = coarse.normals[k];
     }
     TraceMapped(*inputs.mapping, inputs.sculpt, PtexFaceId(face), g,
-                std::span(samples, end - begin),
-                std::span(reinterpret_cast<const Float3*>(positions), per_face),
-                std::span(reinterpret_cast<const Float3*>(normals), per_face), query,
+                std::span(samples, end - begin), positions, normals, query,
                 NormalHits{t, {}, flags}, undecided, w.mapping, w.counters);
     for (std::size_t k = begin; k < end; ++k) {
       const auto i = static_cast<std::size_t>(samples[k - begin]);
@@ -180,7 +177,6 @@ StatusOr<SearchDistanceEstimate> EstimateSearchDistanceMapped(const ExtractInput
       if (decided[k] && (flags[i] & HitFlags::kHit)) abs_t[k] = std::fabs(double(t[i]));
     }
   });
-  if (error.failed()) return error.status();
   // The samples the mapping left undecided (near folds, or where another sheet may be nearer)
   // go to a BVH of the sculpt their rays can reach, as the ray path answers every sample.
   std::vector<std::size_t> rest;
