@@ -17,7 +17,8 @@
 // Memory: the final arrays plus the index buffers of the chunks not yet appended (none for
 // face indices parsed in place). Both passes over a file read copies of its chunks (pread, a
 // buffer per thread), so the file itself is never resident in the process and its mapping's
-// pages are not touched. The result is identical for any thread count and chunk size.
+// pages are not touched (but for a chunk that cannot be copied). The result is identical for
+// any thread count and chunk size.
 #include <fmt/format.h>
 #include <sys/mman.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -236,19 +237,27 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   // pages are first touched once and reused chunk after chunk, where the mapping's pages were each
   // first touched by a pass (docs/BENCHMARKS.md, sessions 17 and 19). The file is the one mapped
   // (MappedFile::fd), not whatever its path names now. A chunk that cannot be copied is read
-  // through the mapping, whose pages are then dropped after it.
+  // through the mapping, its pages mapped in one call and dropped after it.
+  // with_bytes(i, use) calls use(look_back_start, chunk) on chunk i's bytes.
   tbb::enumerable_thread_specific<std::vector<char>> copies;
-  auto copy_of = [&](std::size_t i) -> std::optional<ChunkCopy> {
-    return mapped ? CopyChunk(mapped_fd, file_begin, chunks[i], copies.local()) : std::nullopt;
+  auto with_bytes = [&](std::size_t i, auto&& use) {
+    const Chunk& chunk = chunks[i];
+    if (mapped) {
+      if (const std::optional<ChunkCopy> copy =
+              CopyChunk(mapped_fd, file_begin, chunk, copies.local())) {
+        use(copy->file_begin, copy->chunk);
+        return;
+      }
+      PopulateMappedPages(chunk.begin, static_cast<std::size_t>(chunk.end - chunk.begin));
+    }
+    use(file_begin, chunk);
+    if (mapped) ReleaseMappedPages(chunk.begin, chunk.end);
   };
   RunWithThreads(options.threads, [&] {
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      if (const std::optional<ChunkCopy> copy = copy_of(i)) {
-        counts[i] = CountChunk(copy->file_begin, copy->chunk);
-        return;
-      }
-      counts[i] = CountChunk(file_begin, chunks[i]);
-      if (mapped) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
+      with_bytes(i, [&](const char* look_back, const Chunk& chunk) {
+        counts[i] = CountChunk(look_back, chunk);
+      });
     });
   });
 
@@ -260,9 +269,6 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     corner_base[i] = corners_counted;
     corners_counted += counts[i].corners;
     in_place = in_place && counts[i].plain;
-    inputs[i].file_begin = file_begin;
-    inputs[i].begin = chunks[i].begin;
-    inputs[i].end = chunks[i].end;
     inputs[i].first_line = lines + 1;
     inputs[i].vertex_base = vertices;
     inputs[i].texcoord_base = texcoords;
@@ -309,22 +315,13 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
 
   RunWithThreads(options.threads, [&] {
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      bool parsed = true;
-      if (const std::optional<ChunkCopy> copy = copy_of(i)) {
-        mesh::ChunkInput in = inputs[i];
-        in.file_begin = copy->file_begin;
-        in.begin = copy->chunk.begin;
-        in.end = copy->chunk.end;
-        parsed = mesh::ParseChunk(in, outputs[i]);
-      } else {
-        if (mapped) {
-          PopulateMappedPages(chunks[i].begin,
-                              static_cast<std::size_t>(chunks[i].end - chunks[i].begin));
-        }
-        parsed = mesh::ParseChunk(inputs[i], outputs[i]);
-        if (mapped) ReleaseMappedPages(chunks[i].begin, chunks[i].end);
-      }
-      if (!parsed) out_of_memory.store(true);
+      with_bytes(i, [&](const char* look_back, const Chunk& chunk) {
+        mesh::ChunkInput& in = inputs[i];
+        in.file_begin = look_back;
+        in.begin = chunk.begin;
+        in.end = chunk.end;
+        if (!mesh::ParseChunk(in, outputs[i])) out_of_memory.store(true);
+      });
     });
   });
   if (out_of_memory.load()) return Status::Error(name + ": out of memory while reading");
