@@ -5,9 +5,9 @@
 #endif
 
 #include <algorithm>
+#include <bit>
 #include <cfloat>
 #include <cmath>
-#include <optional>
 
 namespace dispex::extract {
 
@@ -57,16 +57,30 @@ void Grow(Box& into, const Box& box) {
   }
 }
 
+// Lane l of group g of boxes laid out as MappingScratch::window_boxes.
+void StoreLane(float* boxes, std::size_t g, int l, const Box& box) {
+  float* group = boxes + 24 * g;
+  for (int a = 0; a < 3; ++a) {
+    group[4 * a + l] = box.lower[static_cast<std::size_t>(a)];
+    group[12 + 4 * a + l] = box.upper[static_cast<std::size_t>(a)];
+  }
+}
+
 // The box of the windows of samples `ks` that have one (WindowBox), empty (lower > upper) when
-// none has: the same bounds as WindowBox's, four samples at a time (SSE2, in every x86-64).
+// none has, and each sample's own box into `boxes` (MappingScratch::window_boxes; empty boxes
+// for those with none and for the lanes after the last sample): the same bounds as WindowBox's,
+// four samples at a time (SSE2, in every x86-64).
 Box WindowsBox(std::span<const std::int32_t> ks, std::span<const Float3> origins,
                std::span<const Float3> normals, const NormalQuery& query, bool nearest,
-               const NormalHits& out, std::span<const std::uint8_t> undecided) {
+               const NormalHits& out, std::span<const std::uint8_t> undecided,
+               std::vector<float>& boxes) {
   Box all;
   for (int a = 0; a < 3; ++a) {
     all.lower[a] = INFINITY;
     all.upper[a] = -INFINITY;
   }
+  const std::size_t groups = (ks.size() + 3) / 4;
+  boxes.resize(24 * groups);
   std::size_t s = 0;
 #if defined(__SSE2__)
   __m128 lower[3], upper[3];
@@ -76,7 +90,11 @@ Box WindowsBox(std::span<const std::int32_t> ks, std::span<const Float3> origins
   }
   const __m128 sign = _mm_set1_ps(-0.0f), largest = _mm_set1_ps(FLT_MAX), zero = _mm_setzero_ps();
   const __m128 scale = _mm_set1_ps(0x1p-20f), tiny = _mm_set1_ps(0x1p-126f);
+  const __m128 empty_lower = _mm_set1_ps(INFINITY), empty_upper = _mm_set1_ps(-INFINITY);
   auto finite = [&](__m128 v) { return _mm_cmple_ps(_mm_andnot_ps(sign, v), largest); };
+  auto select = [](__m128 mask, __m128 yes, __m128 no) {
+    return _mm_or_ps(_mm_and_ps(mask, yes), _mm_andnot_ps(mask, no));
+  };
   for (; s + 4 <= ks.size(); s += 4) {
     const std::size_t k[4] = {static_cast<std::size_t>(ks[s]), static_cast<std::size_t>(ks[s + 1]),
                               static_cast<std::size_t>(ks[s + 2]),
@@ -108,14 +126,15 @@ Box WindowsBox(std::span<const std::int32_t> ks, std::span<const Float3> origins
     valid = _mm_and_ps(valid, _mm_and_ps(nonzero, finite(w)));
     // RoundingMargin: (the largest |coordinate| + w) 2^-20 + 2^-126.
     const __m128 e = _mm_add_ps(_mm_mul_ps(_mm_add_ps(magnitude, w), scale), tiny);
+    float* group = boxes.data() + 6 * s;
     for (int a = 0; a < 3; ++a) {
       const __m128 r = _mm_mul_ps(w, _mm_andnot_ps(sign, nv[a]));
-      const __m128 lo = _mm_sub_ps(_mm_sub_ps(cv[a], r), e);
-      const __m128 hi = _mm_add_ps(_mm_add_ps(cv[a], r), e);
-      lower[a] =
-          _mm_or_ps(_mm_and_ps(valid, _mm_min_ps(lo, lower[a])), _mm_andnot_ps(valid, lower[a]));
-      upper[a] =
-          _mm_or_ps(_mm_and_ps(valid, _mm_max_ps(hi, upper[a])), _mm_andnot_ps(valid, upper[a]));
+      const __m128 lo = select(valid, _mm_sub_ps(_mm_sub_ps(cv[a], r), e), empty_lower);
+      const __m128 hi = select(valid, _mm_add_ps(_mm_add_ps(cv[a], r), e), empty_upper);
+      _mm_storeu_ps(group + 4 * a, lo);
+      _mm_storeu_ps(group + 12 + 4 * a, hi);
+      lower[a] = _mm_min_ps(lo, lower[a]);
+      upper[a] = _mm_max_ps(hi, upper[a]);
     }
   }
   for (int a = 0; a < 3; ++a) {
@@ -126,12 +145,45 @@ Box WindowsBox(std::span<const std::int32_t> ks, std::span<const Float3> origins
     all.upper[a] = std::max({hi[0], hi[1], hi[2], hi[3]});
   }
 #endif
+  Box empty;
+  for (int a = 0; a < 3; ++a) {
+    empty.lower[a] = INFINITY;
+    empty.upper[a] = -INFINITY;
+  }
+  for (std::size_t l = s; l < 4 * groups; ++l) StoreLane(boxes.data(), l / 4, int(l % 4), empty);
   Box box;
   for (; s < ks.size(); ++s) {
     const auto k = static_cast<std::size_t>(ks[s]);
-    if (WindowBox(k, origins, normals, query, nearest, out, undecided, box)) Grow(all, box);
+    if (!WindowBox(k, origins, normals, query, nearest, out, undecided, box)) continue;
+    Grow(all, box);
+    StoreLane(boxes.data(), s / 4, int(s % 4), box);
   }
   return all;
+}
+
+// The lanes of group g of `boxes` (MappingScratch::window_boxes) whose box meets `box`, one bit
+// per lane.
+unsigned LanesMeeting(const float* boxes, std::size_t g, const Box& box) {
+  const float* group = boxes + 24 * g;
+#if defined(__SSE2__)
+  __m128 meets = _mm_castsi128_ps(_mm_set1_epi32(-1));
+  for (int a = 0; a < 3; ++a) {
+    const __m128 lo = _mm_loadu_ps(group + 4 * a), hi = _mm_loadu_ps(group + 12 + 4 * a);
+    meets = _mm_and_ps(meets, _mm_and_ps(_mm_cmple_ps(lo, _mm_set1_ps(box.upper[a])),
+                                         _mm_cmple_ps(_mm_set1_ps(box.lower[a]), hi)));
+  }
+  return static_cast<unsigned>(_mm_movemask_ps(meets));
+#else
+  unsigned lanes = 0;
+  for (int l = 0; l < 4; ++l) {
+    bool meets = true;
+    for (int a = 0; a < 3; ++a) {
+      meets = meets && group[4 * a + l] <= box.upper[a] && box.lower[a] <= group[12 + 4 * a + l];
+    }
+    lanes |= meets ? 1u << l : 0u;
+  }
+  return lanes;
+#endif
 }
 
 // Sample k's window, the segment o + t n for |t| <= w, prepared once for its tests: its
@@ -250,7 +302,8 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, i
       const std::span<const std::int32_t> block_samples(
           w.block_samples.data() + w.block_first[at],
           static_cast<std::size_t>(w.block_first[at + 1] - w.block_first[at]));
-      const Box all = WindowsBox(block_samples, origins, normals, query, nearest, out, undecided);
+      const Box all = WindowsBox(block_samples, origins, normals, query, nearest, out, undecided,
+                                 w.window_boxes);
       if (!(all.lower[0] <= all.upper[0])) continue;
       // Its candidates: the sculpt blocks the box meets that are not near.
       if (++w.stamp == 0) {
@@ -270,26 +323,26 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, i
       blocks.ForEachMeeting(all, [&](std::int64_t id) {
         if (w.near_stamp[static_cast<std::size_t>(id)] != w.stamp) w.candidate_ids.push_back(id);
       });
-      if (w.candidate_ids.empty()) continue;
-      // Its samples, one by one.
-      Box window_box;
-      for (const std::int32_t sample : block_samples) {
-        const auto k = static_cast<std::size_t>(sample);
-        if (!WindowBox(k, origins, normals, query, nearest, out, undecided, window_box)) continue;
-        std::optional<Segment> segment;
-        for (const std::int64_t id : w.candidate_ids) {
-          const Box& candidate = blocks.box(id);
-          if (!candidate.Meets(window_box)) continue;
-          const float window = Window(k, query, nearest, out);
-          if (!segment) segment.emplace(origins[k], normals[k], window);
-          if (!segment->Meets(candidate)) continue;
-          // A crossing within rounding beyond the window's end counts: the ray path may find
-          // it inside.
-          const float reach = window + RoundingMargin(origins[k], window);
-          if (WindowCrossesBlock(mapping, sculpt, id, origins[k], normals[k], reach)) {
-            undecided[k] = 1;
-            ++sent;
-            break;
+      // Each candidate against the samples whose window boxes meet its box, four boxes at a
+      // time; a sample undecided by one candidate is not tested against the next.
+      const std::size_t groups = (block_samples.size() + 3) / 4;
+      for (const std::int64_t id : w.candidate_ids) {
+        const Box& candidate = blocks.box(id);
+        for (std::size_t g = 0; g < groups; ++g) {
+          for (unsigned lanes = LanesMeeting(w.window_boxes.data(), g, candidate); lanes != 0;
+               lanes &= lanes - 1) {
+            const auto k = static_cast<std::size_t>(
+                block_samples[4 * g + static_cast<std::size_t>(std::countr_zero(lanes))]);
+            if (undecided[k]) continue;
+            const float window = Window(k, query, nearest, out);
+            if (!Segment(origins[k], normals[k], window).Meets(candidate)) continue;
+            // A crossing within rounding beyond the window's end counts: the ray path may find
+            // it inside.
+            const float reach = window + RoundingMargin(origins[k], window);
+            if (WindowCrossesBlock(mapping, sculpt, id, origins[k], normals[k], reach)) {
+              undecided[k] = 1;
+              ++sent;
+            }
           }
         }
       }

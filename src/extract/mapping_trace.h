@@ -176,6 +176,9 @@ struct MappingScratch {
   std::vector<std::int32_t> sample_block_of;  // per sample column (row): its block of cells
   std::vector<std::int32_t> block_first, block_fill, block_samples;
   std::vector<std::int64_t> candidate_ids;
+  // The window boxes of a block's samples, four samples a group: lower x, y, z then upper x, y,
+  // z, four lanes each (24 floats a group); a sample with no window to check has an empty box.
+  std::vector<float> window_boxes;
   std::vector<std::uint32_t> near_stamp;  // per sculpt block: the stamp of the last block near it
   std::uint32_t stamp = 0;
 };

@@ -806,6 +806,33 @@ TEST(MappingFallback, OnlySamplesWhoseLinesCrossAnotherSheetGoToTheBvh) {
   EXPECT_EQ(mapping.mapping_fallback_samples, 8 * 48);
 }
 
+// The tilted sheets of OnlySamplesWhoseLinesCrossAnotherSheetGoToTheBvh sampled 2 x 2 per face:
+// each block of cells holds one sample, so every window is checked outside the check's groups
+// of four. The lower sheet's samples at x = 0.25 (one column of 2 per face, over 3 faces) meet
+// the upper sheet nearer than their own sculpt: 6 go to the BVH. Rejects a check that drops a
+// block's last samples (0 to the BVH, texels unlike the ray map's).
+TEST(MappingFallback, SamplesAfterTheLastGroupOfFourAreChecked) {
+  TempDir dir;
+  const std::string cage = WriteSheets(dir, [](int i) { return 0.02 + 0.02 * i; });
+  const std::string sculpt = LiftLowerSheet(dir, cage, 0.03f);
+  ASSERT_FALSE(sculpt.empty());
+  auto base = ReadMesh(cage);
+  ASSERT_TRUE(base.ok());
+  auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, [](ExtractOptions o) {
+    o = PerSample(o, 0);
+    o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0.12};
+    return o;
+  });
+  ASSERT_TRUE(mapping.ok()) << mapping.status().message();
+  ASSERT_TRUE(rays.ok()) << rays.status().message();
+  EXPECT_EQ(mapping->method, ExtractMethod::kMapping);
+  EXPECT_EQ(mapping->mapping_fallback_samples, 6);
+  const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
+  EXPECT_TRUE(t.same_resolutions);
+  EXPECT_GT(t.texels, 0u);
+  EXPECT_EQ(t.beyond, 0u) << t.beyond << " of " << t.texels << " texels differ beyond rounding";
+}
+
 // ---- The command line -----------------------------------------------------------------------
 
 // Rejects a --method the command line does not take, or one whose failure is not one line.
