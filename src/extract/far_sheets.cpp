@@ -295,6 +295,7 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, i
   const int width = per + 2;
   const bool nearest = query.policy == HitPolicy::kNearest;
   std::uint64_t sent = 0;
+  BlockQuads quads;
   for (int bj = 0; bj < per; ++bj) {
     for (int bi = 0; bi < per; ++bi) {
       const std::size_t at = static_cast<std::size_t>(bj) * uper + static_cast<std::size_t>(bi);
@@ -328,6 +329,7 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, i
       const std::size_t groups = (block_samples.size() + 3) / 4;
       for (const std::int64_t id : w.candidate_ids) {
         const Box& candidate = blocks.box(id);
+        bool gathered = false;
         for (std::size_t g = 0; g < groups; ++g) {
           for (unsigned lanes = LanesMeeting(w.window_boxes.data(), g, candidate); lanes != 0;
                lanes &= lanes - 1) {
@@ -335,11 +337,22 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, i
                 block_samples[4 * g + static_cast<std::size_t>(std::countr_zero(lanes))]);
             if (undecided[k]) continue;
             const float window = Window(k, query, nearest, out);
-            if (!Segment(origins[k], normals[k], window).Meets(candidate)) continue;
+            const Segment segment(origins[k], normals[k], window);
+            if (!segment.Meets(candidate)) continue;
+            // The quads of the quarters of the block whose boxes the window meets too.
+            if (!gathered) {
+              GatherBlockQuads(mapping, sculpt, id, quads);
+              gathered = true;
+            }
+            unsigned quarters = 0;
+            for (int q = 0; q < quads.quarters; ++q) {
+              quarters |= segment.Meets(quads.quarter_box[q]) ? 1u << q : 0u;
+            }
+            if (quarters == 0) continue;
             // A crossing within rounding beyond the window's end counts: the ray path may find
             // it inside.
             const float reach = window + RoundingMargin(origins[k], window);
-            if (WindowCrossesBlock(mapping, sculpt, id, origins[k], normals[k], reach)) {
+            if (WindowCrossesQuads(quads, sculpt, quarters, origins[k], normals[k], reach)) {
               undecided[k] = 1;
               ++sent;
             }

@@ -14,8 +14,11 @@
 //   the 8 blocks around it, continued across Ptex face edges and extraordinary corners as the
 //   rings are) is a candidate; a sample whose own window meets a candidate's box and crosses
 //   one of its quads (tested as the rings test them, the window widened by rounding) is
-//   undecided. Boxes alone send samples beside thin parts and curved sheets to the BVH
-//   (980,159 of the Blub head benchmark asset's, bench/make-assets, against 0).
+//   undecided. The window is tested against the box first, four samples at a time, then as a
+//   segment against the box and the boxes of the block's quarters (2 x 2 cells), and only the
+//   quads of the quarters it meets are tested (a triangle with no plane counts as crossed
+//   there). Boxes alone send samples beside thin parts and curved sheets to the BVH (980,159
+//   of the Blub head benchmark asset's, bench/make-assets, against 0).
 //
 // Near blocks (the sample's own 3 x 3 blocks: its cell's rings and 1 to 7 cells beyond them)
 // are trusted to the rings and MarkFolds: a sheet that comes back over a sample within them

@@ -1317,45 +1317,82 @@ bool PairedBlocksByDefault() {
   return paired;
 }
 
-bool WindowCrossesBlock(const SculptMapping& mapping, const Mesh& sculpt, std::int64_t block,
-                        const Float3& origin, const Float3& normal, float window) {
+void GatherBlockQuads(const SculptMapping& mapping, const Mesh& sculpt, std::int64_t block,
+                      BlockQuads& out) {
   const SculptBlocks& blocks = mapping.blocks();
   const SculptBlocks::Place at = blocks.block(block);
   const int b = blocks.block_size(at.face);
-  const Line line(origin, FlushTiny(normal));
-  Crossings x;
-  x.distance = window;
-  // The block's lattice points, each vertex projected once (the same doubles as TestQuad's):
-  // cell (i, j)'s face has corner RotationOf + k at the cell's corner k, (i, j), (i + 1, j),
-  // (i + 1, j + 1), (i, j + 1).
+  out.b = b;
+  out.quarters = b == 1 ? 1 : 4;
+  for (Box& box : out.quarter_box) {
+    for (int a = 0; a < 3; ++a) {
+      box.lower[a] = INFINITY;
+      box.upper[a] = -INFINITY;
+    }
+  }
+  // Cell (i, j)'s face has corner RotationOf + k at the cell's corner k, (i, j), (i + 1, j),
+  // (i + 1, j + 1), (i, j + 1); a lattice point names the vertex last seen there.
   constexpr int kSide = SculptBlocks::kBlock + 1;
   static constexpr int kDx[4] = {0, 1, 1, 0}, kDy[4] = {0, 0, 1, 1};
-  double px[kSide][kSide], py[kSide][kSide];
   std::int32_t vertex[kSide][kSide];
+  std::uint8_t point[kSide][kSide];
   for (auto& row : vertex) std::fill(std::begin(row), std::end(row), -1);
   const Float3* p = sculpt.positions.data();
+  out.num_points = 0;
   for (int j = 0; j < b; ++j) {
     for (int i = 0; i < b; ++i) {
+      const int c = j * b + i;
       const std::uint32_t cell = mapping.cell(at.face, at.bi * b + i, at.bj * b + j);
       const std::int32_t face = SculptMapping::FaceOf(cell);
       const int rotation = SculptMapping::RotationOf(cell);
       const std::int32_t* ids = sculpt.face_indices.data() + 4 * static_cast<std::size_t>(face);
-      double cx[4], cy[4];  // per corner of the face
+      const int quarter = b == 1 ? 0 : (2 * j / b) * 2 + 2 * i / b;
+      Box& box = out.quarter_box[quarter];
+      out.face[c] = face;
+      out.quarter_of[c] = static_cast<std::uint8_t>(quarter);
       for (int k = 0; k < 4; ++k) {
-        const int a = i + kDx[k], c = j + kDy[k], corner = (rotation + k) & 3;
-        if (vertex[c][a] == ids[corner]) {
-          cx[corner] = px[c][a];
-          cy[corner] = py[c][a];
-        } else {
-          line.Project(p[ids[corner]], cx[corner], cy[corner]);
-          vertex[c][a] = ids[corner];
-          px[c][a] = cx[corner];
-          py[c][a] = cy[corner];
+        const int x = i + kDx[k], y = j + kDy[k], corner = (rotation + k) & 3;
+        if (vertex[y][x] != ids[corner]) {
+          vertex[y][x] = ids[corner];
+          point[y][x] = static_cast<std::uint8_t>(out.num_points);
+          out.points[out.num_points++] = p[ids[corner]];
+        }
+        out.corner_point[c][corner] = point[y][x];
+        const Float3& v = out.points[point[y][x]];
+        const float xyz[3] = {v.x, v.y, v.z};
+        for (int a = 0; a < 3; ++a) {
+          box.lower[a] = std::min(box.lower[a], xyz[a]);
+          box.upper[a] = std::max(box.upper[a], xyz[a]);
         }
       }
-      TestProjectedQuad(line, sculpt, face, 0, cx[0], cy[0], cx[1], cy[1], cx[2], cy[2], cx[3],
-                        cy[3], x);
     }
+  }
+}
+
+bool WindowCrossesQuads(const BlockQuads& quads, const Mesh& sculpt, unsigned quarters,
+                        const Float3& origin, const Float3& normal, float window) {
+  const Line line(origin, FlushTiny(normal));
+  Crossings x;
+  x.distance = window;
+  // Each point projected once, when a cell of a quarter tested first needs it (the same
+  // doubles as TestQuad's).
+  double px[4 * BlockQuads::kCells], py[4 * BlockQuads::kCells];
+  bool projected[4 * BlockQuads::kCells] = {};
+  const int cells = quads.b * quads.b;
+  for (int c = 0; c < cells; ++c) {
+    if (!(quarters >> quads.quarter_of[c] & 1u)) continue;
+    double cx[4], cy[4];
+    for (int k = 0; k < 4; ++k) {
+      const int at = quads.corner_point[c][k];
+      if (!projected[at]) {
+        line.Project(quads.points[at], px[at], py[at]);
+        projected[at] = true;
+      }
+      cx[k] = px[at];
+      cy[k] = py[at];
+    }
+    TestProjectedQuad(line, sculpt, quads.face[c], 0, cx[0], cy[0], cx[1], cy[1], cx[2], cy[2],
+                      cx[3], cy[3], x);
   }
   return x.degenerate || x.plus.found() || x.minus.found();
 }

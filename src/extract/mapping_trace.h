@@ -188,9 +188,28 @@ struct MappingScratch {
 // extraordinary corner the corner blocks of every face around it.
 void LayOutNearBlocks(const SculptMapping& mapping, int face, MappingScratch& scratch);
 
-// Whether the line origin + t normal crosses a quad of sculpt block `block` (SculptBlocks id)
-// at |t| <= window, tested as the rings test quads (a triangle with no plane counts as crossed).
-bool WindowCrossesBlock(const SculptMapping& mapping, const Mesh& sculpt, std::int64_t block,
+// The quads of one sculpt block (SculptBlocks), gathered once for every window tested against
+// it: per cell (i, j), row by row, its sculpt face and the lattice point at each of the face's
+// corners; the points (each vertex once where neighbouring cells share it); and the boxes of
+// the block's quarters of cells (cell (i, j) in quarter (2 j / b) * 2 + 2 i / b; one quarter
+// when b = 1), exact boxes of their cells' corners.
+struct BlockQuads {
+  static constexpr int kCells = SculptBlocks::kBlock * SculptBlocks::kBlock;
+  int b = 0, quarters = 0;
+  std::int32_t face[kCells];
+  std::uint8_t corner_point[kCells][4];
+  std::uint8_t quarter_of[kCells];
+  int num_points = 0;
+  Float3 points[4 * kCells];
+  Box quarter_box[4];
+};
+void GatherBlockQuads(const SculptMapping& mapping, const Mesh& sculpt, std::int64_t block,
+                      BlockQuads& out);
+
+// Whether the line origin + t normal crosses a quad of the cells of `quads` in the quarters
+// set in `quarters` (bit q for quarter q) at |t| <= window, tested as the rings test quads (a
+// triangle with no plane counts as crossed).
+bool WindowCrossesQuads(const BlockQuads& quads, const Mesh& sculpt, unsigned quarters,
                         const Float3& origin, const Float3& normal, float window);
 
 // The normal queries of samples `samples` (grid indices j * n + i of face `face`'s n x n
