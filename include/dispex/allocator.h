@@ -4,9 +4,11 @@
 namespace dispex {
 
 // Asks glibc to keep the memory the process frees for its next allocations instead of returning
-// it to the system (M_MMAP_MAX 0, a trim threshold of 2 GB): an extraction's phases free large
-// arrays and allocate others, and every page the system hands out again costs a page fault on
-// its first write (docs/BENCHMARKS.md, "session 16: freed memory kept"). Call it before any
+// it to the system (M_MMAP_MAX 0, a trim threshold of 2 GB), in one heap for all threads
+// (M_ARENA_MAX 1: a worker thread's blocks re-use what the main thread freed, instead of
+// growing a heap of its own): an extraction's phases free large arrays and allocate others,
+// and every page the system hands out again costs a page fault on its first write
+// (docs/BENCHMARKS.md, "session 16: freed memory kept", "session 20"). Call it before any
 // thread starts. Does nothing, and returns false, where the C library is not glibc, when
 // GLIBC_TUNABLES sets a malloc tunable (the user's own settings win) or when the environment
 // sets DISPEX_KEEP_FREED_MEMORY=0.

@@ -16,8 +16,10 @@ bool KeepFreedMemory() {
   if (keep != nullptr && std::strcmp(keep, "0") == 0) return false;
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   if (tunables != nullptr && std::strstr(tunables, "glibc.malloc.") != nullptr) return false;
-  // Large blocks from the heap, not from mmap (which free unmaps); the heap's free top kept.
-  return mallopt(M_MMAP_MAX, 0) == 1 && mallopt(M_TRIM_THRESHOLD, INT_MAX) == 1;
+  // Large blocks from the heap, not from mmap (which free unmaps); the heap's free top kept;
+  // one heap for every thread, so that what one thread frees another re-uses.
+  return mallopt(M_MMAP_MAX, 0) == 1 && mallopt(M_TRIM_THRESHOLD, INT_MAX) == 1 &&
+         mallopt(M_ARENA_MAX, 1) == 1;
 #else
   return false;
 #endif
