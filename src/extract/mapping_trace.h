@@ -31,7 +31,8 @@
 // decided samples whose ray window crosses any part of the sculpt outside the blocks of cells
 // near them -- the other side of a thin part, a fold farther than two faces, another part
 // that comes close -- are left undecided too (CheckFarSheets, far_sheets.h: boxes of 4 x 4-cell
-// blocks against the windows up to the hit kept, then the quads of the blocks they meet).
+// blocks against the windows up to the hit kept, then the quads of the blocks' quarters they
+// meet).
 //
 // Speed. The samples of one cell go through rings 0 and 1 together (4 lanes): the cell's 4 x 4
 // lattice of corners projected in float, each edge's value once, and a triangle classified as
