@@ -5,7 +5,7 @@ namespace dispex {
 
 // Asks glibc to keep the memory the process frees for its next allocations instead of returning
 // it to the system (M_MMAP_MAX 0, a trim threshold of 2 GB), in one heap for all threads
-// (M_ARENA_MAX 1: a worker thread's blocks re-use what the main thread freed, instead of
+// (M_ARENA_MAX 1: every thread's blocks re-use what any thread freed, instead of each worker
 // growing a heap of its own): an extraction's phases free large arrays and allocate others,
 // and every page the system hands out again costs a page fault on its first write
 // (docs/BENCHMARKS.md, "session 16: freed memory kept", "session 20"). Call it before any

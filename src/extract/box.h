@@ -12,6 +12,11 @@ namespace dispex::extract {
 
 struct Box {
   std::array<float, 3> lower{}, upper{};
+  // The box of no point (lower > upper): it meets nothing, and growing it by a box gives that box.
+  static Box Empty() {
+    constexpr float kInfinity = __builtin_huge_valf();
+    return {{kInfinity, kInfinity, kInfinity}, {-kInfinity, -kInfinity, -kInfinity}};
+  }
   // Closed: boxes that touch meet; a NaN bound meets nothing.
   bool Meets(const Box& o) const {
 #if defined(__SSE2__)

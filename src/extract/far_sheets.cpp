@@ -74,23 +74,16 @@ Box WindowsBox(std::span<const std::int32_t> ks, std::span<const Float3> origins
                std::span<const Float3> normals, const NormalQuery& query, bool nearest,
                const NormalHits& out, std::span<const std::uint8_t> undecided,
                std::vector<float>& boxes) {
-  Box all;
-  for (int a = 0; a < 3; ++a) {
-    all.lower[a] = INFINITY;
-    all.upper[a] = -INFINITY;
-  }
+  Box all = Box::Empty();
   const std::size_t groups = (ks.size() + 3) / 4;
   boxes.resize(24 * groups);
   std::size_t s = 0;
 #if defined(__SSE2__)
-  __m128 lower[3], upper[3];
-  for (int a = 0; a < 3; ++a) {
-    lower[a] = _mm_set1_ps(INFINITY);
-    upper[a] = _mm_set1_ps(-INFINITY);
-  }
+  const __m128 empty_lower = _mm_set1_ps(INFINITY), empty_upper = _mm_set1_ps(-INFINITY);
+  __m128 lower[3] = {empty_lower, empty_lower, empty_lower};
+  __m128 upper[3] = {empty_upper, empty_upper, empty_upper};
   const __m128 sign = _mm_set1_ps(-0.0f), largest = _mm_set1_ps(FLT_MAX), zero = _mm_setzero_ps();
   const __m128 scale = _mm_set1_ps(0x1p-20f), tiny = _mm_set1_ps(0x1p-126f);
-  const __m128 empty_lower = _mm_set1_ps(INFINITY), empty_upper = _mm_set1_ps(-INFINITY);
   auto finite = [&](__m128 v) { return _mm_cmple_ps(_mm_andnot_ps(sign, v), largest); };
   auto select = [](__m128 mask, __m128 yes, __m128 no) {
     return _mm_or_ps(_mm_and_ps(mask, yes), _mm_andnot_ps(mask, no));
@@ -145,12 +138,9 @@ Box WindowsBox(std::span<const std::int32_t> ks, std::span<const Float3> origins
     all.upper[a] = std::max({hi[0], hi[1], hi[2], hi[3]});
   }
 #endif
-  Box empty;
-  for (int a = 0; a < 3; ++a) {
-    empty.lower[a] = INFINITY;
-    empty.upper[a] = -INFINITY;
+  for (std::size_t l = s; l < 4 * groups; ++l) {
+    StoreLane(boxes.data(), l / 4, int(l % 4), Box::Empty());
   }
-  for (std::size_t l = s; l < 4 * groups; ++l) StoreLane(boxes.data(), l / 4, int(l % 4), empty);
   Box box;
   for (; s < ks.size(); ++s) {
     const auto k = static_cast<std::size_t>(ks[s]);
@@ -345,7 +335,7 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, i
               gathered = true;
             }
             unsigned quarters = 0;
-            for (int q = 0; q < quads.quarters; ++q) {
+            for (int q = 0; q < quads.quarters(); ++q) {
               quarters |= segment.Meets(quads.quarter_box[q]) ? 1u << q : 0u;
             }
             if (quarters == 0) continue;

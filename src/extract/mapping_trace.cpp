@@ -1323,13 +1323,7 @@ void GatherBlockQuads(const SculptMapping& mapping, const Mesh& sculpt, std::int
   const SculptBlocks::Place at = blocks.block(block);
   const int b = blocks.block_size(at.face);
   out.b = b;
-  out.quarters = b == 1 ? 1 : 4;
-  for (Box& box : out.quarter_box) {
-    for (int a = 0; a < 3; ++a) {
-      box.lower[a] = INFINITY;
-      box.upper[a] = -INFINITY;
-    }
-  }
+  std::fill(std::begin(out.quarter_box), std::end(out.quarter_box), Box::Empty());
   // Cell (i, j)'s face has corner RotationOf + k at the cell's corner k, (i, j), (i + 1, j),
   // (i + 1, j + 1), (i, j + 1); a lattice point names the vertex last seen there.
   constexpr int kSide = SculptBlocks::kBlock + 1;

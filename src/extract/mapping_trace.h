@@ -196,7 +196,8 @@ void LayOutNearBlocks(const SculptMapping& mapping, int face, MappingScratch& sc
 // when b = 1), exact boxes of their cells' corners.
 struct BlockQuads {
   static constexpr int kCells = SculptBlocks::kBlock * SculptBlocks::kBlock;
-  int b = 0, quarters = 0;
+  int b = 0;
+  int quarters() const { return b == 1 ? 1 : 4; }
   std::int32_t face[kCells];
   std::uint8_t corner_point[kCells][4];
   std::uint8_t quarter_of[kCells];

@@ -29,11 +29,7 @@ SculptBlocks SculptBlocks::Build(const SculptMapping& mapping, const Mesh& sculp
     const int b = out.sizes_[f], per = out.per_side_[f];
     for (int bj = 0; bj < per; ++bj) {
       for (int bi = 0; bi < per; ++bi) {
-        Box box;
-        for (int a = 0; a < 3; ++a) {
-          box.lower[a] = INFINITY;
-          box.upper[a] = -INFINITY;
-        }
+        Box box = Box::Empty();
         for (int j = bj * b; j < (bj + 1) * b; ++j) {
           for (int i = bi * b; i < (bi + 1) * b; ++i) {
             const std::int32_t* ids =
