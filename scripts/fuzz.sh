@@ -102,8 +102,8 @@ for t in "${targets[@]}"; do
   if [[ $rc -ne 0 || $found -ne 0 ]]; then
     failed+=("$name")
     echo "fuzz: $name failed; from its log ($log):" >&2
-    grep -a -E 'contract broken|runtime error|ERROR:|SUMMARY:|#[0-9]+ 0x[0-9a-f]+ in dispex' \
-      "$log" | head -30 >&2
+    grep -a -m 30 -E 'contract broken|runtime error|ERROR:|SUMMARY:|#[0-9]+ 0x[0-9a-f]+ in dispex' \
+      "$log" >&2 || true
   fi
 done
 

@@ -16,7 +16,10 @@ trap 'rm -rf "$work"' EXIT
 tbb="$root/$build/tbb/install/lib"
 [[ -f "$tbb/libtbb.so.12" ]] || { echo "tsan-extract: no TSan libtbb in $tbb (scripts/build-tsan-tbb.sh)" >&2; exit 1; }
 export LD_LIBRARY_PATH="$tbb${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-ldd "$dispex" | grep -q "$tbb/libtbb.so.12" || { echo "tsan-extract: dispex does not load $tbb/libtbb.so.12" >&2; exit 1; }
+# ldd's list is read whole before it is searched: `ldd | grep -q` fails under pipefail whenever
+# grep's early exit kills ldd with SIGPIPE (1 run in 11 on a busy 2-core machine).
+libs=$(ldd "$dispex")
+[[ $libs == *"=> $tbb/libtbb.so.12 "* ]] || { echo "tsan-extract: dispex does not load $tbb/libtbb.so.12" >&2; exit 1; }
 export TSAN_OPTIONS="halt_on_error=1 exitcode=66 second_deadlock_stack=1"
 cage="$root/tests/data/meshes/keenan_spot/spot_control_mesh.obj"
 "$dispex" make-sculpt "$cage" --levels 3 --pattern detail --amplitude 0.005 \
