@@ -188,12 +188,16 @@ class ChunkParser {
       if (AtStatementEnd()) break;
       const char* token = p_;
       std::int64_t index = 0;
-      // Fast path: a plain index of up to 9 digits that ends at a blank or the line end.
+      // Fast path: a plain index of up to 8 digits that ends at a blank or the line end.
       const char* q = p_;
       std::uint32_t digits = 0;
-      while (q < end_ && q - p_ < 9 && static_cast<unsigned char>(*q - '0') < 10) {
-        digits = digits * 10 + static_cast<std::uint32_t>(*q - '0');
-        ++q;
+      if (end_ - p_ >= 8) {
+        q += LeadingDigits8(p_, digits);
+      } else {
+        while (q < end_ && static_cast<unsigned char>(*q - '0') < 10) {
+          digits = digits * 10 + static_cast<std::uint32_t>(*q - '0');
+          ++q;
+        }
       }
       if (q > p_ && q < end_ && (*q == ' ' || *q == '\n') && digits > 0 &&
           digits <= in_.num_vertices) {

@@ -14,6 +14,7 @@
 #include <emmintrin.h>
 #endif
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -124,6 +125,30 @@ inline std::string TokenForMessage(const char* p, const char* end, std::size_t l
   }
   if (p < end && !IsBlank(*p) && *p != '\n') out += "...";
   return out;
+}
+
+// The decimal digits that start the 8 bytes at `p` (all 8 must be readable): returns how many
+// there are (0 to 8) and stores their value in `value`. One 64-bit word for the 8 bytes instead
+// of a loop over them (face lines are mostly indices of 6 to 8 digits).
+inline int LeadingDigits8(const char* p, std::uint32_t& value) {
+  std::uint64_t word;
+  std::memcpy(&word, p, 8);
+  if constexpr (std::endian::native == std::endian::big) word = __builtin_bswap64(word);
+  // Byte by byte, the first byte of the text the lowest: '0'..'9' become 0..9.
+  const std::uint64_t t = word ^ 0x3030303030303030u;
+  // A byte holds a digit when t <= 9, where neither t nor t + 6 reaches 16. A carry out of a
+  // byte only happens for one that is not a digit and only changes the bytes after it.
+  const std::uint64_t not_digit = (t | (t + 0x0606060606060606u)) & 0xf0f0f0f0f0f0f0f0u;
+  const int n = not_digit == 0 ? 8 : __builtin_ctzll(not_digit) / 8;
+  if (n == 0) return 0;
+  // The n digits moved to the top bytes, zeros (leading digits 0) below, then combined in
+  // pairs, fours and eights of bytes.
+  std::uint64_t v = t << (8 * (8 - n));
+  v = (v * 10 + (v >> 8)) & 0x00ff00ff00ff00ffu;
+  v = (v * 100 + (v >> 16)) & 0x0000ffff0000ffffu;
+  v = (v * 10000 + (v >> 32)) & 0xffffffffu;
+  value = static_cast<std::uint32_t>(v);
+  return n;
 }
 
 // kOutOfRange: an integer too large; kNotFinite: a real that is nan, inf or overflows.

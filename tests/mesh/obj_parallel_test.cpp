@@ -376,6 +376,46 @@ TEST(ObjParallel, FaceCornersCountedAsRunsOfNonBlanks) {
   }
 }
 
+// The word-at-a-time digits of a face index against a byte-by-byte reading: after 0 to 8 digits,
+// every byte value (those just below '0' and above '9' included), and random words of digits,
+// blanks and the other bytes of face lines.
+TEST(ObjParallel, LeadingDigitsReadEightBytesAtOnce) {
+  auto expect_as_bytes = [](const char(&bytes)[8]) {
+    int count = 0;
+    std::uint32_t expected = 0;
+    while (count < 8 && bytes[count] >= '0' && bytes[count] <= '9') {
+      expected = expected * 10 + static_cast<std::uint32_t>(bytes[count++] - '0');
+    }
+    std::uint32_t value = 0;
+    const std::string text(bytes, 8);
+    ASSERT_EQ(mesh::LeadingDigits8(bytes, value), count) << "'" << text << "'";
+    if (count > 0) {
+      EXPECT_EQ(value, expected) << "'" << text << "'";
+    }
+  };
+  for (int digits = 0; digits < 8; ++digits) {
+    for (int c = 0; c < 256; ++c) {
+      char bytes[8] = {'9', '9', '9', '9', '9', '9', '9', '9'};
+      for (int i = 0; i < digits; ++i) bytes[i] = static_cast<char>('9' - i);
+      bytes[digits] = static_cast<char>(c);
+      expect_as_bytes(bytes);
+    }
+  }
+  expect_as_bytes({'9', '8', '7', '6', '5', '4', '3', '2'});
+  expect_as_bytes({'0', '0', '0', '0', '0', '0', '0', '1'});
+  std::mt19937 rng(5);
+  const std::string alphabet = "0123456789 \t\n/-#\r:";
+  for (int trial = 0; trial < 100000; ++trial) {
+    char bytes[8];
+    const int digits = static_cast<int>(rng() % 9);
+    for (int i = 0; i < 8; ++i) {
+      bytes[i] =
+          i < digits ? static_cast<char>('0' + rng() % 10) : alphabet[rng() % alphabet.size()];
+    }
+    expect_as_bytes(bytes);
+  }
+}
+
 // A file whose face lines hold no comment and no continuation has its face indices parsed in
 // place (counted by the counting pass); one such comment sends them through per-chunk buffers.
 // Both give the same mesh, for any chunking, from a buffer and from a file; so do every index
