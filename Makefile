@@ -59,10 +59,16 @@ bench: build
 bench-peers: build
 	@DISPEX_BUILD=$(BUILD) bench/peers/run $(BENCH_ARGS)
 
+# The sanitized builds' optimisation and debug information: line tables only (-g1), which is
+# what the sanitizers' stack traces print (function, file and line); full -g made compiling
+# under AddressSanitizer 1.8x slower (src/verify/verify.cpp: 105 s against 60 s).
+SANITIZE_BUILD_FLAGS = -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG"
+
 # The whole test suite (unit, end-to-end, accuracy) built with AddressSanitizer and
 # UndefinedBehaviorSanitizer.
 test-sanitize: deps
-	@cmake -S . -B $(BUILD)-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDISPEX_SANITIZE=ON \
+	@cmake -S . -B $(BUILD)-sanitize $(SANITIZE_BUILD_FLAGS) -DDISPEX_SANITIZE=ON \
 	  -DDISPEX_BUILD_BENCH=OFF -DDISPEX_WERROR=$(WERROR) $(CMAKE_FLAGS) >/dev/null
 	@cmake --build $(BUILD)-sanitize -j$(JOBS)
 	@cd $(BUILD)-sanitize && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
@@ -71,7 +77,7 @@ test-sanitize: deps
 
 # The extraction pipeline (TBB tasks at 4 threads) under ThreadSanitizer.
 test-tsan: deps
-	@cmake -S . -B $(BUILD)-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDISPEX_TSAN=ON \
+	@cmake -S . -B $(BUILD)-tsan $(SANITIZE_BUILD_FLAGS) -DDISPEX_TSAN=ON \
 	  -DDISPEX_BUILD_TESTS=OFF -DDISPEX_BUILD_BENCH=OFF -DDISPEX_WERROR=$(WERROR) \
 	  $(CMAKE_FLAGS) >/dev/null
 	@cmake --build $(BUILD)-tsan -j$(JOBS) --target dispex

@@ -55,7 +55,9 @@ fi
 # clang and its libFuzzer runtime (Debian: clang, libclang-rt-14-dev), then the build.
 DISPEX_WITH_FUZZ=1 scripts/install-deps.sh
 CC=clang CXX=clang++ cmake -S . -B "$build" -DDISPEX_BUILD_FUZZ=ON -DDISPEX_BUILD_TESTS=OFF \
-  -DDISPEX_BUILD_BENCH=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+  -DDISPEX_BUILD_BENCH=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
+  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" >/dev/null  # line tables: as Makefile's sanitizers
 cmake --build "$build" -j"$jobs" --target "${targets[@]/%/_fuzzer}" >/dev/null
 
 # seed_files TARGET: the seed files of a target, one per line.
