@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 
 #if defined(__SSE2__)
 #include <xmmintrin.h>
@@ -14,7 +15,7 @@ struct Box {
   std::array<float, 3> lower{}, upper{};
   // The box of no point (lower > upper): it meets nothing, and growing it by a box gives that box.
   static Box Empty() {
-    constexpr float kInfinity = __builtin_huge_valf();
+    constexpr float kInfinity = std::numeric_limits<float>::infinity();
     return {{kInfinity, kInfinity, kInfinity}, {-kInfinity, -kInfinity, -kInfinity}};
   }
   // Closed: boxes that touch meet; a NaN bound meets nothing.

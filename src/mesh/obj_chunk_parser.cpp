@@ -188,23 +188,17 @@ class ChunkParser {
       if (AtStatementEnd()) break;
       const char* token = p_;
       std::int64_t index = 0;
-      // Fast path: a plain index of up to 8 digits that ends at a blank or the line end.
-      const char* q = p_;
-      std::uint32_t digits = 0;
-      if (end_ - p_ >= 8) {
-        q += LeadingDigits8(p_, digits);
-      } else {
-        while (q < end_ && static_cast<unsigned char>(*q - '0') < 10) {
-          digits = digits * 10 + static_cast<std::uint32_t>(*q - '0');
-          ++q;
+      // Fast path: a plain index of up to 8 digits that ends at a blank or the line end (within
+      // a chunk's last 8 bytes, ParseInt below reads it).
+      if (end_ - p_ > 8) {
+        std::uint32_t digits = 0;
+        const char* q = p_ + LeadingDigits8(p_, digits);
+        if (digits > 0 && digits <= in_.num_vertices && (*q == ' ' || *q == '\n')) {
+          p_ = q;
+          AddCorner(static_cast<std::int32_t>(digits - 1));
+          ++count;
+          continue;
         }
-      }
-      if (q > p_ && q < end_ && (*q == ' ' || *q == '\n') && digits > 0 &&
-          digits <= in_.num_vertices) {
-        p_ = q;
-        AddCorner(static_cast<std::int32_t>(digits - 1));
-        ++count;
-        continue;
       }
       NumberResult r = ParseInt(p_, end_, index);
       bool has_texture = false;
