@@ -215,9 +215,9 @@ struct VerifyOptions {
   // Per record of a version-2 or -3 truth file: fail when the record's error
   // (VerifyReport::truth_quantity, e.g. |map - h|) > k tau + 2 e_v at any record,
   // k = truth_local_tolerance_factor and e_v the sculpt's linear error near the vertex
-  // (GroundTruth). k > 1: extract holds tau at its samples only; between them (read on a
-  // coarser texel grid) and within half a sample of a face edge (where the read is clamped)
-  // good maps reach 1.3 tau (docs/ACCURACY.md).
+  // (GroundTruth). k > 1: extract holds tau at its samples only; between them, where a
+  // coarser texel grid is read, good maps reach 1.3 tau (docs/ACCURACY.md). A Ptex map is
+  // read there as a renderer reads it: the reference Ptex filter, across face edges.
   bool truth_local_bound = true;
   double truth_local_tolerance_factor = kDefaultTruthLocalToleranceFactor;
   // Fail when the truth RMS exceeds truth_rms_factor x tau, or its 99th percentile exceeds

@@ -84,6 +84,9 @@ struct MapReader {
   const UvMap* uv = nullptr;
   const PtexUvCharts* charts = nullptr;
   std::optional<VectorSpace> space;  // vector maps only (UV-space ones: object)
+  // A scalar Ptex map read by the reference Ptex filter, which blends over face edges as a
+  // renderer does (TruthScalar).
+  const PtexMapSampler* across = nullptr;
 
   float Scalar(PtexFaceId face, float u, float v) const {
     if (ptex != nullptr) return ptex->Sample(face, u, v);
@@ -96,6 +99,16 @@ struct MapReader {
     float c[3] = {0, 0, 0};
     ReadUv(face, u, v, c);
     return VectorFromChannels(*space, frame, c);
+  }
+  // A scalar map as the truth comparison reads it: as a renderer reads it, across face edges
+  // where the map is a Ptex file (a UV map's tiles are read through the cage's UVs, which
+  // cross face edges already). Within a face the two reads agree; within half a texel of a
+  // face edge the per-face read is clamped to the outermost texel centre, a displacement's
+  // slope times that distance off the surface at the edge. Vector maps are read per face, in
+  // the frame at the record (tests/verify/vector_truth_test.cpp).
+  float TruthScalar(PtexFaceId face, float u, float v) const {
+    return across == nullptr ? Scalar(face, u, v)
+                             : static_cast<float>(across->SampleAcrossFaces(face, u, v));
   }
   // The UV map's channels at (u, v) of a Ptex face, through the cage's UVs.
   void ReadUv(PtexFaceId face, float u, float v, std::span<float> out) const {
@@ -285,7 +298,7 @@ StatusOr<TruthComparison> CompareTruth(const LimitSurface& surface, const MapRea
   const bool vector_truth = !truth.d.empty();
   if (!space && !vector_truth) {  // the map's value against h: no frames needed
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      float value = map.Scalar(truth.faces[i], truth.uvs[2 * i], truth.uvs[2 * i + 1]);
+      float value = map.TruthScalar(truth.faces[i], truth.uvs[2 * i], truth.uvs[2 * i + 1]);
       out.map_normal[i] = value;
       out.signed_errors[i] = value - truth.h[i];
       out.errors[i] = std::abs(out.signed_errors[i]);
@@ -340,7 +353,7 @@ StatusOr<TruthComparison> CompareTruth(const LimitSurface& surface, const MapRea
       } else {
         // The normal part from the record's own h, so that a map of a scalar pattern measures
         // as against a scalar truth; the tangential part of D, which h N lacks, on top.
-        map_normal = map.Scalar(face, u, v);
+        map_normal = map.TruthScalar(face, u, v);
         map_d = normal * map_normal;
         signed_error = map_normal - h;
         const double tangential = Length(d - normal * h);
@@ -503,12 +516,11 @@ Status EdgeFields(const LimitSurface& surface, const PtexFile& map,
   return error.failed() ? error.status() : Status::Ok();
 }
 
+// `faces` and `fields` as EdgeFields makes them.
 Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFile& map,
-                    std::optional<VectorSpace> space, const VerifyOptions& options,
-                    VerifyReport& r) {
-  const std::vector<PtexFaceInfo> faces = MapFacesOnSurface(surface, map);
-  std::vector<std::vector<std::vector<float>>> fields;
-  DISPEX_RETURN_IF_ERROR(EdgeFields(surface, map, space, faces, fields));
+                    std::span<const PtexFaceInfo> faces,
+                    std::span<const std::vector<std::vector<float>>> fields,
+                    const VerifyOptions& options, VerifyReport& r) {
   std::vector<std::uint8_t> holes(faces.size());
   for (std::size_t f = 0; f < faces.size(); ++f) {
     holes[f] = surface.is_hole(PtexFaceId(static_cast<std::int32_t>(f)));
@@ -612,6 +624,9 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   std::optional<PtexFile> ptex;
   std::optional<UvMap> uv;
   std::optional<PtexUvCharts> charts;
+  std::vector<PtexFaceInfo> map_faces;
+  std::vector<std::vector<std::vector<float>>> map_fields;
+  std::optional<PtexMapSampler> sampler;
   if (IsUvMapPath(options.map_path)) {
     DISPEX_ASSIGN_OR_RETURN(uv, UvMap::Open(options.map_path));
     if (uv->channels() == 3) {
@@ -670,7 +685,13 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     }
     reader.ptex = &map;
     reader.space = space;
-    DISPEX_RETURN_IF_ERROR(MeasureEdges(base, surface, map, space, options, r));
+    map_faces = MapFacesOnSurface(surface, map);
+    DISPEX_RETURN_IF_ERROR(EdgeFields(surface, map, space, map_faces, map_fields));
+    DISPEX_RETURN_IF_ERROR(MeasureEdges(base, surface, map, map_faces, map_fields, options, r));
+    if (!options.truth_path.empty() && !space) {
+      sampler.emplace(map_faces, map_fields[0]);
+      reader.across = &*sampler;
+    }
   }
   const std::optional<VectorSpace> space = reader.space;
 
