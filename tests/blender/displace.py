@@ -3,7 +3,7 @@
 # mesh as OBJ for `dispex verify --displaced`.
 #
 #   displace.py -- BASE.obj MAP.<UDIM>.exr OUT.obj [--levels L] [--direction normal|rgb]
-#                  [--wrong KIND --work DIR]
+#                  [--wrong KIND[,KIND...] --work DIR]
 #
 # The chain (docs/UV_MAPS.md): the cage built as it is in the OBJ (vertex and corner order
 # kept, UVs per corner), a Subdivision Surface modifier (Catmull-Clark, L levels, limit
@@ -13,11 +13,12 @@
 # level 0, strength 1, texture clamping off so that negative values displace inward, bilinear
 # interpolation, no mipmaps, tiles extended at their borders). `--direction rgb` reads an
 # object-space vector map: Displace "RGB to XYZ" in local space, the tiles' R, G, B being x, y, z.
-# --wrong makes the map wrong on purpose before it is read: zero (every texel 0), flip-v
-# (rows upside down), transpose (u and v swapped within each tile), swap-tiles (each tile
-# holding the next one's texels), swap-rg (a vector map's x and y exchanged); `copy` re-saves it
-# as it is
-# (the control: the same path of saving and loading, with the map right).
+# --wrong: after OUT, the same object displaced by each map made wrong on purpose (its tiles
+# saved under DIR/KIND/, the mesh written to DIR/KIND.obj), the texture's image swapped and
+# nothing else changed: zero (every texel 0), x0.8 (every value scaled by 0.8), sign (negated),
+# flip-v (rows upside down), transpose (u and v swapped within each tile), swap-tiles (each
+# tile holding the next one's texels), swap-rg (a vector map's x and y exchanged); `copy`
+# re-saves it as it is (the control: the same path of saving and loading, with the map right).
 import sys
 
 import bpy
@@ -89,9 +90,16 @@ def tile_paths(pattern):
     return found
 
 
+WRONG_KINDS = ("zero", "x0.8", "sign", "flip-v", "transpose", "swap-tiles", "swap-rg", "copy")
+
+
 def wrong_map(pattern, kind, work):
-    """The tiles made wrong, saved as EXR under `work`; returns the new pattern."""
+    """The tiles made wrong, saved as EXR under `work`; returns the new pattern. (Python arrays
+    and slices: Blender's Python may not find NumPy.)"""
     import os
+    from array import array
+    if kind not in WRONG_KINDS:
+        sys.exit("displace.py: --wrong " + ", ".join(WRONG_KINDS))
     os.makedirs(work, exist_ok=True)
     tiles = tile_paths(pattern)
     for t, (udim, path) in enumerate(tiles):
@@ -99,47 +107,65 @@ def wrong_map(pattern, kind, work):
             path = tiles[(t + 1) % len(tiles)][1]
         img = bpy.data.images.load(path)
         n = img.size[0]
-        px = list(img.pixels[:])
-        out = [0.0] * len(px)
-        for j in range(n):
-            for i in range(n):
-                if kind == "zero":
-                    src = None
-                elif kind in ("copy", "swap-tiles"):
-                    src = j * n + i
-                elif kind == "flip-v":
-                    src = (n - 1 - j) * n + i
-                elif kind == "transpose":
-                    src = i * n + j
-                elif kind == "swap-rg":
-                    src = j * n + i
-                else:
-                    sys.exit("displace.py: --wrong zero, flip-v, transpose, swap-tiles, swap-rg "
-                             "or copy")
-                d = 4 * (j * n + i)
-                if src is None:
-                    out[d:d + 4] = [0.0, 0.0, 0.0, 1.0]
-                elif kind == "swap-rg":
-                    r, g, b, a = px[4 * src:4 * src + 4]
-                    out[d:d + 4] = [g, r, b, a]
-                else:
-                    out[d:d + 4] = px[4 * src:4 * src + 4]
+        row = 4 * n  # RGBA texels, row j (v up) at row * j
+        px = array("f", bytes(4 * row * n))
+        img.pixels.foreach_get(px)
+        out = array("f", px)
+        if kind == "zero":
+            for c in range(3):
+                out[c::4] = array("f", bytes(4 * n * n))
+        elif kind in ("x0.8", "sign"):
+            scale = 0.8 if kind == "x0.8" else -1.0
+            out = array("f", (v * scale for v in px))
+            out[3::4] = px[3::4]  # alpha kept
+        elif kind == "flip-v":
+            for j in range(n):
+                out[j * row:(j + 1) * row] = px[(n - 1 - j) * row:(n - j) * row]
+        elif kind == "transpose":  # texel (i, j) from (j, i)
+            for j in range(n):
+                for c in range(4):
+                    out[j * row + c:(j + 1) * row:4] = px[4 * j + c::row]
+        elif kind == "swap-rg":
+            out[0::4], out[1::4] = px[1::4], px[0::4]
         new = bpy.data.images.new("wrong%d" % udim, n, n, alpha=True, float_buffer=True)
         new.colorspace_settings.name = "Non-Color"  # else saving encodes the values as sRGB
-        new.pixels[:] = out
+        new.pixels.foreach_set(out)
         new.filepath_raw = os.path.join(work, "wrong.%d.exr" % udim)
         new.file_format = "OPEN_EXR"
         new.save()
+        bpy.data.images.remove(img)
+        bpy.data.images.remove(new)
     return os.path.join(work, "wrong.<UDIM>.exr")
+
+
+def load_tiles(pattern):
+    """The UDIM tiles as one tiled image, read as data (no colour transform)."""
+    tiles = tile_paths(pattern)
+    if not tiles:
+        sys.exit("displace.py: no tiles " + pattern)
+    img = bpy.data.images.load(tiles[0][1])
+    img.source = "TILED"
+    img.colorspace_settings.name = "Non-Color"
+    return img
+
+
+def write_wrong(obj, texture, pattern, kinds, work, what):
+    """For each kind: `texture` reading the map made wrong, `obj` written to WORK/KIND.obj."""
+    import os
+    for kind in kinds:
+        wrong = wrong_map(pattern, kind, os.path.join(work, kind))
+        texture.image = load_tiles(wrong)
+        write_evaluated(obj, os.path.join(work, kind + ".obj"), "%s, the map made wrong: %s" % (
+            what, kind))
+        print("displace.py: %s -> %s" % (kind, os.path.join(work, kind + ".obj")))
 
 
 def main():
     (base, pattern, out), opts = parse_args(sys.argv)
-    if opts["wrong"] != "none":
-        pattern = wrong_map(pattern, opts["wrong"], opts["work"])
-    tiles = tile_paths(pattern)
-    if not tiles:
-        sys.exit("displace.py: no tiles " + pattern)
+    kinds = [k for k in opts["wrong"].split(",") if k and k != "none"]
+    if kinds and not opts["work"]:
+        sys.exit("displace.py: --wrong needs --work DIR")
+    img = load_tiles(pattern)
     obj = build_object(base)
 
     sub = obj.modifiers.new("Subdivision", "SUBSURF")
@@ -152,9 +178,6 @@ def main():
     sub.boundary_smooth = "PRESERVE_CORNERS"
     sub.use_creases = True
 
-    img = bpy.data.images.load(tiles[0][1])
-    img.source = "TILED"
-    img.colorspace_settings.name = "Non-Color"
     tex = bpy.data.textures.new("dispex", "IMAGE")
     tex.image = img
     tex.use_interpolation = True
@@ -174,9 +197,10 @@ def main():
     disp.mid_level = 0.0
     disp.strength = 1.0
 
-    write_evaluated(obj, out, "%s displaced in Blender %s by %s" % (
-        base, bpy.app.version_string, pattern))
-    print("displace.py: %d tiles -> %s" % (len(tiles), out))
+    what = "%s displaced in Blender %s by %s" % (base, bpy.app.version_string, pattern)
+    write_evaluated(obj, out, what)
+    print("displace.py: %d tiles -> %s" % (len(tile_paths(pattern)), out))
+    write_wrong(obj, tex, pattern, kinds, opts["work"], what)
 
 
 def write_evaluated(obj, out, comment):
