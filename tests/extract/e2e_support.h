@@ -188,10 +188,13 @@ struct CommandResult {
   std::string out, err;
 };
 
-// Runs the dispex binary with `args` (already shell-quoted where needed).
-inline CommandResult RunDispex(const std::string& args, const TempDir& dir) {
+// Runs the dispex binary with `args` (already shell-quoted where needed), through `wrapper`
+// (a command that runs the rest of its line, e.g. setpriv) when one is given.
+inline CommandResult RunDispex(const std::string& args, const TempDir& dir,
+                               const std::string& wrapper = "") {
   std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
-  std::string command = std::string(DISPEX_EXE) + " " + args + " >" + out + " 2>" + err;
+  std::string command =
+      wrapper + (wrapper.empty() ? "" : " ") + DISPEX_EXE + " " + args + " >" + out + " 2>" + err;
   int status = std::system(command.c_str());
   CommandResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
