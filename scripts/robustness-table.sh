@@ -1,14 +1,27 @@
 #!/usr/bin/env bash
 # Prints, for each class of bad input or option, the command run, its exit status and the
-# one line dispex prints (the table of docs/ROBUSTNESS.md).
-#   scripts/robustness-table.sh [build-dir]
+# one line dispex prints, then the count of the mesh readers' malformed test files: the block
+# of docs/ROBUSTNESS.md between `<!-- robustness-table:begin` and `<!-- robustness-table:end -->`.
+#   scripts/robustness-table.sh [--write] [build-dir]
+# --write replaces that block of docs/ROBUSTNESS.md instead of printing it.
 set -uo pipefail
-build="${1:-build}"
+write=0
+build=build
+for arg in "$@"; do
+  case "$arg" in
+    --write) write=1 ;;
+    -*) echo "robustness-table: unknown option $arg" >&2; exit 2 ;;
+    *) build="$arg" ;;
+  esac
+done
 root="$(cd "$(dirname "$0")/.." && pwd)"
+doc="$root/docs/ROBUSTNESS.md"
+begin_marker='<!-- robustness-table:begin'
+end_marker='<!-- robustness-table:end -->'
 dispex="$root/$build/tools/dispex"
 w="$(mktemp -d)"
 trap 'chmod -R u+w "$w"; rm -rf "$w"' EXIT
-cd "$w"
+cd "$w" || exit 1
 cage="$root/tests/data/meshes/keenan_blub/blub_control_mesh.obj"
 "$dispex" make-sculpt "$cage" --levels 2 --amplitude 0.004 -o sculpt.obj -q
 printf '' > empty.obj
@@ -44,6 +57,7 @@ run() {
   fi
   rm -f out.ptx
 }
+table() {
 echo "| input class | command | exit | message |"
 echo "|---|---|---|---|"
 run "missing file" extract "$cage" missing.obj -o out.ptx
@@ -76,4 +90,38 @@ if [[ $(id -u) -ne 0 ]]; then
   chmod 555 adir
   run "read-only output directory" extract "$cage" sculpt.obj -o adir/out.ptx
 fi
-exit $leftovers
+# The malformed files tests/mesh/malformed_test.cpp reads, one expected message each (its
+# EveryFileHasACase fails when a file there has none), counted rather than written down.
+local malformed="$root/tests/data/malformed" total=0 obj=0 ply=0 f
+for f in "$malformed"/*; do
+  case "$f" in
+    */README.md) continue ;;
+    *.obj) obj=$((obj + 1)) ;;
+    *.ply) ply=$((ply + 1)) ;;
+  esac
+  total=$((total + 1))
+done
+echo
+echo "The mesh readers have their own suite of $total hand-made broken files in"
+echo "\`tests/data/malformed/\` ($obj OBJ, $ply PLY, $((total - obj - ply)) of another format), each read at 1 and 2"
+echo "threads and checked for its one-line message (\`tests/mesh/malformed_test.cpp\`)."
+}
+
+if [[ $write == 0 ]]; then
+  table
+  exit $leftovers
+fi
+if [[ $(grep -c "^$begin_marker" "$doc") != 1 || $(grep -c "^$end_marker" "$doc") != 1 ]]; then
+  echo "robustness-table: $doc: needs one line starting '$begin_marker' and one '$end_marker'" >&2
+  exit 1
+fi
+table >"$w/block.md"
+[[ $leftovers == 0 ]] || exit $leftovers
+new="$(mktemp "$doc.tmp.XXXXXX")"
+awk -v begin="$begin_marker" -v end="$end_marker" -v block="$w/block.md" '
+  index($0, begin) == 1 { print; print ""; while ((getline line < block) > 0) print line; print ""; skip = 1; next }
+  skip && index($0, end) == 1 { skip = 0 }
+  !skip { print }' "$doc" >"$new"
+chmod --reference="$doc" "$new"
+mv "$new" "$doc"
+echo "robustness-table: $doc rewritten" >&2
