@@ -200,7 +200,7 @@ row() {
   tol=$(json "$work/r.json" "d['statistics']['tolerance']")
   misses=$(json "$work/r.json" "d['statistics']['misses']")
   rule=$(json "$work/r.json" "d['statistics']['oversample_rule']")
-  method=$(json "$work/r.json" "d['method']")
+  method=$(json "$work/r.json" "d['method']['used']")
   texels=$(json "$work/r.json" "'%d → %d (%.0f%%)' % (d['statistics']['texels']['oversampled'], d['statistics']['texels']['written'], 100*d['statistics']['texels']['written_fraction'])")
   tmax=$(json "$work/v.json" "'%.3g' % d['truth']['max']")
   trms=$(json "$work/v.json" "'%.2f' % (d['truth']['rms'] / d['truth']['bound']['tolerance'])")
