@@ -235,7 +235,7 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
   // Both passes read a mapped file's chunks as copies, each with the two bytes before it that a
   // continued newline looks back at, into a buffer of its thread's (CopyChunk): the buffers'
   // pages are first touched once and reused chunk after chunk, where the mapping's pages were each
-  // first touched by a pass (docs/BENCHMARKS.md, sessions 17 and 19). The file is the one mapped
+  // first touched by a pass (docs/BENCHMARKS.md, "Memory"). The file is the one mapped
   // (MappedFile::fd), not whatever its path names now. A chunk that cannot be copied is read
   // through the mapping, its pages mapped in one call and dropped after it.
   // with_bytes(i, use) calls use(look_back_start, chunk) on chunk i's bytes.

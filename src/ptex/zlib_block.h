@@ -22,7 +22,7 @@ std::string CheckCompressionLevel(PtexCompressor compressor, int level);
 // At libdeflate's fastest level (1, the default), data this short is stored (level 0): each call
 // at level 1 first clears the compressor's hash tables, about 5 us (libdeflate 1.14), which is
 // more than what deflating a few hundred bytes of float texels saves (docs/BENCHMARKS.md,
-// "session 19"). The small reductions of every face are such blocks.
+// "Compression"). The small reductions of every face are such blocks.
 inline constexpr std::size_t kStoredBelow = 512;
 
 // Appends one complete zlib stream holding `data` to `out`; returns its size in bytes.
