@@ -1,7 +1,7 @@
 // How `verify --truth` reads a scalar Ptex map: as a renderer reads it, with the reference Ptex
 // filter that blends over face edges. The per-face read is clamped to the outermost texel
 // centre within half a texel of a face edge, so a steep displacement there is off by its slope
-// times that distance: a good map failed its per-vertex bound at face corners of the bench
+// times that distance: a good map failed its per-vertex bound on face edges of the bench
 // assets (cape 1 record, head 20) though every record away from the borders was within it.
 #include <gtest/gtest.h>
 
