@@ -325,9 +325,12 @@ void SetupExtract(CLI::App& app, int& exit_code) {
                   "second search (0..1; 1: never)")
       ->capture_default_str();
   cmd->add_option("--method", args->method,
-                  "how rays are answered: auto (through the subdivision correspondence when "
-                  "the sculpt is the base refined, else rays), rays (a BVH of the sculpt), "
-                  "mapping (the correspondence; an error when there is none)")
+                  "where values come from: auto (interpolate when the sculpt is the base "
+                  "refined, else rays), interpolate (the sculpt's vertex displacements "
+                  "interpolated through the subdivision correspondence, no rays), mapping "
+                  "(rays through the correspondence: the map follows the sculpt's flat quads), "
+                  "rays (a BVH of the sculpt); interpolate and mapping fail when the sculpt is "
+                  "not the base refined")
       ->capture_default_str();
   cmd->add_option("--bvh-quality", args->bvh_quality, "BVH build quality: low, medium, high")
       ->capture_default_str();

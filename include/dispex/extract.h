@@ -52,18 +52,26 @@ enum class WatertightEdges : std::uint8_t {
 std::string_view WatertightEdgesName(WatertightEdges mode);  // "all", "filter", "off"
 StatusOr<WatertightEdges> ParseWatertightEdges(std::string_view name);
 
-// How the samples' rays are answered.
+// Where a map's values come from.
 enum class ExtractMethod : std::uint8_t {
-  // Through the subdivision correspondence when the sculpt is the base refined
-  // (MatchRefinedSculpt), else rays.
+  // kInterpolate when the sculpt is the base refined (MatchRefinedSculpt), else kRays.
   kAuto,
-  kRays,  // a BVH of the whole sculpt
-  // Through the correspondence: each sample's rays against the sculpt quads in the rings of
-  // cells around it, the few it cannot decide by a BVH built afterwards (docs/ARCHITECTURE.md);
-  // an error when the sculpt is not the base refined.
+  kRays,  // a BVH of the whole sculpt: rays along the limit normal
+  // Rays through the correspondence: each sample's rays against the sculpt quads in the rings
+  // of cells around it, the few it cannot decide by a BVH built afterwards (docs/
+  // ARCHITECTURE.md); the map follows the sculpt's flat quads. Vector maps: the sculpt's
+  // quads read bilinearly at each sample minus the limit point. An error when the sculpt is
+  // not the base refined.
   kMapping,
+  // The sculpt's vertex displacements (each vertex minus the limit point it sits over)
+  // interpolated bilinearly over the correspondence's cells, no rays (docs/ACCURACY.md,
+  // "Interpolated vertex displacements"): exact at the sculpt's vertices, what a renderer's
+  // subdivided base displaced at its vertices shows. A scalar map holds their part along the
+  // limit normal. An error when the sculpt is not the base refined.
+  kInterpolate,
 };
-std::string_view ExtractMethodName(ExtractMethod method);  // "auto", "rays", "mapping"
+std::string_view ExtractMethodName(
+    ExtractMethod method);  // "auto", "rays", "mapping", "interpolate"
 StatusOr<ExtractMethod> ParseExtractMethod(std::string_view name);
 
 // What a farm shard keeps of the sculpt (ExtractOptions::shard_sculpt).
@@ -220,7 +228,8 @@ struct ExtractReport {
   double t_read_base = 0, t_read_sculpt = 0, t_topology = 0, t_bvh = 0, t_search = 0,
          t_sample_trace = 0, t_write = 0, t_total = 0;
 
-  // Scalar maps (ExtractMethod): the method that ran (kRays or kMapping); when the
+  // The method that ran (ExtractMethod: kRays, kMapping or kInterpolate; vector maps one of
+  // the last two); when the
   // correspondence was looked for, the match as below (mapping_levels, offsets, t_match), or
   // why the sculpt is not the base refined.
   ExtractMethod method = ExtractMethod::kRays;
@@ -228,6 +237,11 @@ struct ExtractReport {
   // Samples the mapping could not decide, answered by a BVH of the sculpt within their reach,
   // and the Ptex faces they are in (of the faces extracted in this run).
   std::int64_t mapping_fallback_samples = 0, mapping_fallback_faces = 0;
+  // Through the correspondence with rays (kMapping): the longest hit kept, twice the match's
+  // largest vertex offset (mapping_max_offset) plus the sculpt's median edge; a hit beyond it
+  // is another sheet of the sculpt and counts as a miss. The search distances are cut to it.
+  // 0: none.
+  double mapping_sheet_bound = 0;
   // Within sample+trace, CPU time of the worker threads (each thread's own clock, summed):
   // limit evaluation, rays, spectral analysis, compression and writing.
   double cpu_limit = 0, cpu_trace = 0, cpu_spectral = 0, cpu_compress = 0;

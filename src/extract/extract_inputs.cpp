@@ -121,6 +121,7 @@ StatusOr<ExtractInputs> FinishInputs(const ExtractOptions& options, MeshesRead m
                        false,
                        {},
                        nullptr,
+                       false,
                        nullptr,
                        0};
 }

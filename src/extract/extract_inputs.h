@@ -36,6 +36,9 @@ struct ExtractInputs {
   // through it, and `tracer` is built only for those it leaves undecided (TraceFallback), over
   // the sculpt within reach of their faces (`face_keys`, the run's).
   std::unique_ptr<SculptMapping> mapping;
+  // With `mapping`: the sculpt's vertex displacements are interpolated (vertex_displacements.h)
+  // instead of traced; no tracer, no search distance.
+  bool interpolate = false;
   const FaceKeys* face_keys = nullptr;
   double fallback_bvh_seconds = 0;  // building those tracers
 };

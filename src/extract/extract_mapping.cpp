@@ -35,16 +35,24 @@ StatusOr<SculptCorrespondence> MatchSculpt(MatchOptions match, ExtractInputs& in
 Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report) {
   report.method = ExtractMethod::kRays;
   if (options.method == ExtractMethod::kRays) return Status::Ok();
+  const bool interpolate = options.method != ExtractMethod::kMapping;
   Stopwatch clock;
   MatchOptions match;
   match.threads = report.threads;
   match.face_tables = false;  // the mapping reads the cells
+  // Interpolated, a given search distance bounds how far a vertex may lie from its point, as
+  // for vector maps.
+  if (interpolate && options.search_distance.kind != SearchDistanceSpec::Kind::kAuto) {
+    DISPEX_ASSIGN_OR_RETURN(match.max_offset,
+                            ResolveSearchDistance(options.search_distance, report.base_diagonal));
+  }
   StatusOr<SculptCorrespondence> correspondence = MatchSculpt(match, inputs, report);
   if (!correspondence.ok()) {
     report.t_match = clock.seconds();
     report.mapping_reason = correspondence.status().message();
-    if (options.method == ExtractMethod::kMapping) {
-      return Status::Error(fmt::format("method mapping: {}", report.mapping_reason));
+    if (options.method != ExtractMethod::kAuto) {
+      return Status::Error(
+          fmt::format("method {}: {}", ExtractMethodName(options.method), report.mapping_reason));
     }
     return CancelRequested() ? Cancelled() : Status::Ok();
   }
@@ -53,11 +61,14 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   report.mapping_rms_offset = correspondence->rms_offset;
   DISPEX_ASSIGN_OR_RETURN(SculptMapping mapping, SculptMapping::Build(std::move(*correspondence),
                                                                       inputs.sculpt, inputs.faces));
-  DISPEX_RETURN_IF_ERROR(mapping.MarkFolds(inputs.surface, inputs.sculpt, inputs.faces));
-  mapping.BuildBlocks(inputs.sculpt);
+  if (!interpolate) {  // what the rays through the cells need
+    DISPEX_RETURN_IF_ERROR(mapping.MarkFolds(inputs.surface, inputs.sculpt, inputs.faces));
+    mapping.BuildBlocks(inputs.sculpt);
+  }
   inputs.mapping = std::make_unique<SculptMapping>(std::move(mapping));
+  inputs.interpolate = interpolate;
   report.t_match = clock.seconds();
-  report.method = ExtractMethod::kMapping;
+  report.method = interpolate ? ExtractMethod::kInterpolate : ExtractMethod::kMapping;
   return CancelRequested() ? Cancelled() : Status::Ok();
 }
 
@@ -246,6 +257,13 @@ void ReportMapping(const ExtractInputs& inputs, const ProcessedFaces& faces,
   report.mapping_fallback_samples = faces.fallback_samples;
   report.mapping_fallback_faces = faces.fallback_faces;
   report.t_bvh += inputs.fallback_bvh_seconds;
+  if (inputs.interpolate) {
+    report.tracer = fmt::format(
+        "none: the sculpt's vertex displacements interpolated through the subdivision "
+        "correspondence (level {})",
+        report.mapping_levels);
+    return;
+  }
   report.tracer = fmt::format("subdivision correspondence (level {}; {})", report.mapping_levels,
                               PairedBlocksByDefault() ? "cells traced two at a time, AVX2"
                                                       : "cells traced one at a time, SSE2");

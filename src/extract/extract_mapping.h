@@ -21,10 +21,11 @@ namespace dispex::extract {
 StatusOr<SculptCorrespondence> MatchSculpt(MatchOptions match, ExtractInputs& inputs,
                                            ExtractReport& report);
 
-// Under kAuto and kMapping, matches the sculpt to the base (MatchSculpt) and on a match
-// sets inputs.mapping (no BVH is built up front then). Records the method that will run and
-// the match (time, level, offsets, or why there is none) in the report. kMapping fails with
-// the match's reason; kAuto then runs rays.
+// Unless the method is kRays, matches the sculpt to the base (MatchSculpt) and on a match sets
+// inputs.mapping (no BVH is built up front then) and, under kAuto and kInterpolate,
+// inputs.interpolate. Records the method that will run and the match (time, level, offsets,
+// or why there is none) in the report. kMapping and kInterpolate fail with the match's
+// reason; kAuto then runs rays.
 Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report);
 
 // The automatic search distance through the mapping: EstimateSearchDistance's rule (1.5 x the

@@ -137,7 +137,7 @@ StatusOr<ExtractOptions> ExtractOptionsFromJson(const nlohmann::json& j) {
 
 nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
   nlohmann::json j;
-  if (r.vector_space.empty()) j["method"] = std::string(ExtractMethodName(r.method));
+  j["method"] = std::string(ExtractMethodName(r.method));
   j["tolerance"] = r.tolerance;
   j["tolerance_auto"] = r.tolerance_auto;
   j["sculpt_median_edge"] = r.sculpt_median_edge;

@@ -58,15 +58,19 @@ std::string_view ExtractMethodName(ExtractMethod method) {
       return "rays";
     case ExtractMethod::kMapping:
       return "mapping";
+    case ExtractMethod::kInterpolate:
+      return "interpolate";
   }
   return "auto";
 }
 
 StatusOr<ExtractMethod> ParseExtractMethod(std::string_view name) {
-  for (ExtractMethod m : {ExtractMethod::kAuto, ExtractMethod::kRays, ExtractMethod::kMapping}) {
+  for (ExtractMethod m : {ExtractMethod::kAuto, ExtractMethod::kRays, ExtractMethod::kMapping,
+                          ExtractMethod::kInterpolate}) {
     if (name == ExtractMethodName(m)) return m;
   }
-  return Status::Error(fmt::format("unknown method '{}' (expected auto, rays or mapping)", name));
+  return Status::Error(
+      fmt::format("unknown method '{}' (expected auto, rays, mapping or interpolate)", name));
 }
 
 std::string_view ShardSculptName(ShardSculpt s) {

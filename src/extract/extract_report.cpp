@@ -46,15 +46,14 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
                             {"floored", e.floored},
                             {"capped", e.capped}};
   }
-  if (r.vector_space.empty()) {
-    j["method"] = {{"used", std::string(ExtractMethodName(r.method))},
-                   {"levels", r.mapping_levels},
-                   {"max_offset", r.mapping_max_offset},
-                   {"rms_offset", r.mapping_rms_offset},
-                   {"reason", r.mapping_reason},
-                   {"fallback_samples", r.mapping_fallback_samples},
-                   {"fallback_faces", r.mapping_fallback_faces}};
-  }
+  j["method"] = {{"used", std::string(ExtractMethodName(r.method))},
+                 {"levels", r.mapping_levels},
+                 {"max_offset", r.mapping_max_offset},
+                 {"rms_offset", r.mapping_rms_offset},
+                 {"reason", r.mapping_reason},
+                 {"sheet_bound", r.mapping_sheet_bound},
+                 {"fallback_samples", r.mapping_fallback_samples},
+                 {"fallback_faces", r.mapping_fallback_faces}};
   j["phases_seconds"] = {{"read_base", r.t_read_base},
                          {"read_sculpt", r.t_read_sculpt},
                          {"topology", r.t_topology},
@@ -179,20 +178,29 @@ std::string ExtractReportSummary(const ExtractReport& r) {
     out += fmt::format("  tolerance {:.4g}{}  samples {}  matched in {:.2f}s\n", r.tolerance,
                        r.tolerance_auto ? " (auto)" : "", r.samples, r.t_match);
   } else {
-    if (r.method == ExtractMethod::kMapping) {
+    if (r.method == ExtractMethod::kInterpolate) {
       out += fmt::format(
-          "  through the subdivision correspondence (level {}, {:.2f}s); {} samples of {} faces "
-          "left to a BVH\n",
-          r.mapping_levels, r.t_match, r.mapping_fallback_samples, r.mapping_fallback_faces);
+          "  the sculpt's vertex displacements interpolated through the subdivision "
+          "correspondence (level {}, {:.2f}s; vertices up to {:.4g} from their points)\n",
+          r.mapping_levels, r.t_match, r.mapping_max_offset);
+      out += fmt::format("  tolerance {:.4g}{}  samples {}\n", r.tolerance,
+                         r.tolerance_auto ? " (auto)" : "", r.samples);
+    } else {
+      if (r.method == ExtractMethod::kMapping) {
+        out += fmt::format(
+            "  through the subdivision correspondence (level {}, {:.2f}s); {} samples of {} "
+            "faces left to a BVH\n",
+            r.mapping_levels, r.t_match, r.mapping_fallback_samples, r.mapping_fallback_faces);
+      }
+      out += fmt::format("  tolerance {:.4g}{}  search distance {:.4g}{}\n", r.tolerance,
+                         r.tolerance_auto ? " (auto)" : "", r.search_distance,
+                         r.search_distance_auto ? " (auto)" : "");
+      out += fmt::format(
+          "  samples {}  rays {}  misses {} ({} filled in-face, {} faces from "
+          "neighbours; {} more found by the {:.4g} search)\n",
+          r.samples, r.rays_cast, r.misses, r.holes_filled, r.faces_filled_from_neighbours,
+          r.misses_recovered, r.retry_search_distance);
     }
-    out += fmt::format("  tolerance {:.4g}{}  search distance {:.4g}{}\n", r.tolerance,
-                       r.tolerance_auto ? " (auto)" : "", r.search_distance,
-                       r.search_distance_auto ? " (auto)" : "");
-    out += fmt::format(
-        "  samples {}  rays {}  misses {} ({} filled in-face, {} faces from "
-        "neighbours; {} more found by the {:.4g} search)\n",
-        r.samples, r.rays_cast, r.misses, r.holes_filled, r.faces_filled_from_neighbours,
-        r.misses_recovered, r.retry_search_distance);
   }
   if (r.hits_opposed > 0) {
     out += fmt::format(

@@ -16,6 +16,9 @@ namespace {
 
 // The longer search for samples that missed: this many times the automatic search distance.
 constexpr double kRetryFactor = 4.0;
+// Through the correspondence, the longest hit kept over the largest vertex offset the match
+// measured (ExtractReport::mapping_sheet_bound).
+constexpr double kSheetFactor = 2.0;
 
 // Automatic values measured over the whole sculpt are kept to a few significant bits, so that
 // an edit of a small part of the sculpt leaves them, and with them every face it does not
@@ -69,6 +72,14 @@ Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs
     DISPEX_ASSIGN_OR_RETURN(report.search_distance,
                             ResolveSearchDistance(options.search_distance, report.base_diagonal));
   }
+  // Through the correspondence, a hit farther than the match's own offsets is another sheet of
+  // the sculpt (a crease corner's far side, a fold), not the one over the sample: a miss.
+  // (Plus a median sculpt edge: the flat quads sag from their vertices by a fraction of one.)
+  if (inputs.mapping != nullptr) {
+    report.mapping_sheet_bound =
+        kSheetFactor * report.mapping_max_offset + report.sculpt_median_edge;
+    report.search_distance = std::min(report.search_distance, report.mapping_sheet_bound);
+  }
   // With an automatic search distance, samples that missed get a second, longer search: the
   // sparse estimate can miss thin or strongly curved parts where the sculpt is farther from
   // the limit surface than almost everywhere else.
@@ -77,6 +88,10 @@ Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs
           ? std::max(report.search_distance, std::min(kRetryFactor * report.search_distance,
                                                       report.search_estimate.ray_length))
           : 0.0;
+  if (report.mapping_sheet_bound > 0) {
+    report.retry_search_distance =
+        std::min(report.retry_search_distance, report.mapping_sheet_bound);
+  }
   return Status::Ok();
 }
 
@@ -89,8 +104,9 @@ StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
   ExtractSettings settings;
   {
     DISPEX_ASSIGN_OR_RETURN(CoarseSampling coarse, SampleCoarsely(inputs.surface));
-    // Vector maps read the sculpt through its correspondence: no rays, no search distance.
-    if (!options.vector) {
+    // Vector maps and interpolated ones read the sculpt through its correspondence: no rays,
+    // no search distance.
+    if (!options.vector && !inputs.interpolate) {
       DISPEX_RETURN_IF_ERROR(ResolveSearchDistances(options, inputs, coarse, report));
     }
     settings.plan =
@@ -106,6 +122,7 @@ StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
   settings.retry_query = settings.query;
   settings.retry_query.distance = static_cast<float>(report.retry_search_distance);
   settings.mapping = inputs.mapping != nullptr;
+  settings.interpolate = inputs.interpolate;
   settings.spectral.rule = options.resolution_rule;
   settings.spectral.tolerance = report.tolerance;
   settings.spectral.nonzero_threshold = options.nonzero_threshold;

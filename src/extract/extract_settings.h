@@ -29,6 +29,8 @@ struct ExtractSettings {
   // resolution than its planned samples hold (log2; max_oversample).
   int max_samples_log2 = 0;
   bool mapping = false;  // samples traced through the subdivision correspondence
+  // With `mapping`: the sculpt's vertex displacements interpolated instead (ExtractInputs).
+  bool interpolate = false;
 };
 
 // Tolerance (from the sculpt's median edge length unless given), search distance (estimated

@@ -2,6 +2,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/combinable.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -258,13 +259,64 @@ Hash128 SettingsKey(const ExtractSettings& s) {
   h.Add(static_cast<int>(s.watertight)).Add(s.edge_step_budget).Add(s.max_samples_log2);
   // Rays' keys stay as they were; a map of either method re-uses only its own faces.
   if (s.mapping) h.Add(std::string_view("mapping"));
+  if (s.interpolate) h.Add(std::string_view("interpolate"));
   return h.Digest();
 }
+
+namespace {
+
+// Interpolated (ExtractSettings::interpolate), a face reads only its own grid of sculpt
+// vertices: its key holds their positions in grid order, and its reach is their box.
+FaceKeys GridFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings,
+                      const std::vector<BaseFacePatch>& patches) {
+  const LimitSurface& surface = inputs.surface;
+  const SculptMapping& mapping = *inputs.mapping;
+  const auto num_faces = static_cast<std::size_t>(surface.num_ptex_faces());
+  const Hash128 settings_key = SettingsKey(settings);
+  FaceKeys out;
+  out.keys.resize(num_faces);
+  out.reach_boxes.assign(num_faces, Box::Empty());
+  out.reach_faces.assign(num_faces, 0);
+  struct Scratch {
+    std::vector<VertexId> ids;
+    std::vector<Float3> points;
+  };
+  tbb::enumerable_thread_specific<Scratch> scratches;
+  tbb::parallel_for(std::size_t{0}, num_faces, [&](std::size_t f) {
+    Hasher h;
+    h.Add(settings_key);
+    AddFacePatchKey(h, surface, patches, settings, f);
+    const int m = mapping.grid_size(static_cast<int>(f));
+    h.Add(m);
+    if (m > 0) {
+      Scratch& w = scratches.local();
+      mapping.GridVertices(static_cast<int>(f), inputs.sculpt, w.ids);
+      w.points.clear();
+      Box& box = out.reach_boxes[f];
+      for (const VertexId id : w.ids) {
+        const Float3& p = inputs.sculpt.positions[static_cast<std::size_t>(id.value)];
+        w.points.push_back(p);
+        const float xyz[3] = {p.x, p.y, p.z};
+        for (int a = 0; a < 3; ++a) {
+          box.lower[a] = std::min(box.lower[a], xyz[a]);
+          box.upper[a] = std::max(box.upper[a], xyz[a]);
+        }
+      }
+      h.AddArray(std::span<const Float3>(w.points));
+      out.reach_faces[f] = std::int64_t{m} * m;
+    }
+    out.keys[f] = h.Digest();
+  });
+  return out;
+}
+
+}  // namespace
 
 FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings) {
   const LimitSurface& surface = inputs.surface;
   const auto num_faces = static_cast<std::size_t>(surface.num_ptex_faces());
   const std::vector<BaseFacePatch> patches = BaseFacePatches(surface);
+  if (settings.interpolate) return GridFaceKeys(inputs, settings, patches);
   FaceKeys out;
   out.reach_boxes = ReachBoxes(surface, patches, Reach(settings));
   std::vector<std::uint8_t> skip(num_faces);

@@ -31,7 +31,9 @@ void AddFacePatchKey(Hasher& h, const LimitSurface& surface, std::span<const Bas
 // (BaseFacePatches) and sub-face, its planned samples, and every sculpt face its rays can reach:
 // those whose bounding box meets the face's reach box (the patch's box grown by the longest search
 // distance and a margin), as an order-free sum of each sculpt face's key (its corners' positions,
-// in order). The keys do not depend on the thread count.
+// in order). Interpolated (ExtractSettings::interpolate), the sculpt part is the face's own
+// grid of sculpt vertices, their positions in grid order, and the reach box is theirs. The keys
+// do not depend on the thread count.
 
 struct FaceKeys {
   std::vector<Hash128> keys;     // per Ptex face

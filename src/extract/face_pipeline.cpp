@@ -84,6 +84,29 @@ std::int32_t TraceMappedSamples(PtexFaceId face, int n, const ExtractInputs& inp
   return recovered;
 }
 
+// The sculpt's vertex heights interpolated at the n x n texel centres, as hits: no misses,
+// none opposed.
+Status InterpolateHeights(PtexFaceId face, int n, const ExtractInputs& inputs, FaceScratch& w) {
+  const SculptMapping& mapping = *inputs.mapping;
+  if (w.grid.face() != face.value) {
+    mapping.GridVertices(face.value, inputs.sculpt, w.grid_vertices);
+  }
+  DISPEX_RETURN_IF_ERROR(w.grid.Evaluate(face, mapping.grid_size(face.value), w.grid_vertices,
+                                         inputs.sculpt, w.evaluator, /*normals=*/true));
+  for (int j = 0; j < n; ++j) {
+    const double v = (j + 0.5) / n;
+    for (int i = 0; i < n; ++i) {
+      const auto k =
+          static_cast<std::size_t>(j) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i);
+      const float t = static_cast<float>(w.grid.HeightAt((i + 0.5) / n, v));
+      w.t[k] = t;
+      // As a ray meets a sculpt facing the limit normal's way (TakeDistances).
+      w.flags[k] = HitFlags::kHit | (t < 0 ? HitFlags::kNegative : HitFlags::kBackFace);
+    }
+  }
+  return Status::Ok();
+}
+
 // Signed distances from the hits (0 where a ray missed), and the hit counts.
 void TakeDistances(std::size_t count, FaceScratch& w, FaceStats& stats) {
   stats.samples = static_cast<std::int64_t>(count);
@@ -157,16 +180,21 @@ StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
   w.valid.resize(count);
 
   ThreadCpuStopwatch step;
-  DISPEX_RETURN_IF_ERROR(w.evaluator.EvaluateGrid(face, n, n, w.positions, w.normals));
-  w.cpu_limit += step.seconds();
-  step.Reset();
-  if (inputs.mapping) {
-    r.recovered = TraceMappedSamples(face, n, inputs, settings, count, w, result);
+  if (settings.interpolate) {
+    DISPEX_RETURN_IF_ERROR(InterpolateHeights(face, n, inputs, w));
+    w.cpu_limit += step.seconds();
   } else {
-    r.recovered = TraceRays(*inputs.tracer, settings, AsFloat3(w.positions, count),
-                            AsFloat3(w.normals, count), w.t, w.flags, w);
+    DISPEX_RETURN_IF_ERROR(w.evaluator.EvaluateGrid(face, n, n, w.positions, w.normals));
+    w.cpu_limit += step.seconds();
+    step.Reset();
+    if (inputs.mapping) {
+      r.recovered = TraceMappedSamples(face, n, inputs, settings, count, w, result);
+    } else {
+      r.recovered = TraceRays(*inputs.tracer, settings, AsFloat3(w.positions, count),
+                              AsFloat3(w.normals, count), w.t, w.flags, w);
+    }
+    w.cpu_trace += step.seconds();
   }
-  w.cpu_trace += step.seconds();
   if (result.needs_tracer) return result;
   r.rays = static_cast<std::int64_t>(w.counters.rays_cast - rays_before);
   r.fallback_normals =

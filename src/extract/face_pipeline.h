@@ -1,7 +1,9 @@
 // One Ptex face through the pipeline: limit points and normals on its grid of texel centres
 // -> rays along +-n (and a longer second search for the samples that missed) -> signed
-// distances -> holes -> the DCT resolution. ProcessFace can be run for any face, any number of
-// times, on any thread that has its own FaceScratch; it does not write the map.
+// distances -> holes -> the DCT resolution; interpolated (ExtractSettings::interpolate), the
+// signed distances are the sculpt's vertex heights over the limit surface interpolated at the
+// texel centres instead (vertex_displacements.h). ProcessFace can be run for any face, any number
+// of times, on any thread that has its own FaceScratch; it does not write the map.
 #pragma once
 
 #include <array>
@@ -15,6 +17,7 @@
 #include "extract/extract_settings.h"
 #include "extract/hole_fill.h"
 #include "extract/mapping_trace.h"
+#include "extract/vertex_displacements.h"
 
 namespace dispex::extract {
 
@@ -70,6 +73,9 @@ struct FaceScratch {
   std::vector<std::int32_t> mapped_index;
   std::vector<float> mapped_t, fallback_t;
   std::vector<Float3> fallback_origins, fallback_normals;
+  // Interpolated (ExtractSettings::interpolate): the face's grid of vertex displacements.
+  std::vector<VertexId> grid_vertices;
+  GridDisplacements grid;
   PullPushScratch pull_push;
   TraceCounters counters;
   double cpu_limit = 0, cpu_trace = 0, cpu_spectral = 0, cpu_write = 0;  // this thread's seconds

@@ -218,6 +218,27 @@ StatusOr<SculptMapping> SculptMapping::Build(SculptCorrespondence&& corresponden
   return out;
 }
 
+void SculptMapping::GridVertices(int face, const Mesh& sculpt, std::vector<VertexId>& out) const {
+  const int m = grid_size(face);
+  const auto side = static_cast<std::size_t>(m) + 1;
+  out.resize(side * side);
+  // The corner of cell (i, j) at its (i + di, j + dj) corner: the cell's corners (i, j),
+  // (i + 1, j), (i + 1, j + 1), (i, j + 1) are its sculpt face's corners r, r + 1, r + 2, r + 3.
+  const auto corner = [&](int i, int j, int k) {
+    const std::uint32_t c = cell(face, i, j);
+    const auto f = static_cast<std::size_t>(FaceOf(c));
+    return VertexId(sculpt.face_indices[4 * f + static_cast<std::size_t>((RotationOf(c) + k) & 3)]);
+  };
+  for (int b = 0; b <= m; ++b) {
+    for (int a = 0; a <= m; ++a) {
+      const int i = std::min(a, m - 1), j = std::min(b, m - 1);
+      static constexpr int kCorner[2][2] = {{0, 3}, {1, 2}};  // [a > i][b > j]
+      out[static_cast<std::size_t>(b) * side + static_cast<std::size_t>(a)] =
+          corner(i, j, kCorner[a > i][b > j]);
+    }
+  }
+}
+
 std::size_t SculptMapping::bytes() const {
   return grid_sizes_.capacity() * sizeof(std::int32_t) +
          cell_offsets_.capacity() * sizeof(std::int64_t) +

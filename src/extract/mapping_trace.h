@@ -83,6 +83,9 @@ class SculptMapping {
   }
   static int FaceOf(std::uint32_t cell) { return static_cast<int>(cell & 0x3fffffffu); }
   static int RotationOf(std::uint32_t cell) { return static_cast<int>(cell >> 30); }
+  // The (m + 1)^2 sculpt vertices of face `face`'s grid (m = grid_size(face) > 0) row by row,
+  // vertex (a, b) at b (m + 1) + a, read from its cells' corners.
+  void GridVertices(int face, const Mesh& sculpt, std::vector<VertexId>& out) const;
   std::size_t bytes() const;
 
   // Ptex faces whose samples all go to a BVH: within two faces of a sculpt quad turned over

@@ -134,7 +134,7 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
   DISPEX_ASSIGN_OR_RETURN(PtexUvCharts charts, PtexUvCharts::Build(inputs.base, inputs.surface));
   DISPEX_ASSIGN_OR_RETURN(UvRaster raster,
                           RasterizeUvCharts(charts, inputs.surface, options.uv_resolution));
-  if (!vector &&
+  if (!vector && !settings.interpolate &&
       (inputs.mapping != nullptr || inputs.tracer == nullptr || !inputs.traced.empty())) {
     DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
   }
@@ -167,6 +167,36 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
           const UvTexelPlace& p = raster.tiles[tile].places[texel];
           w.uv[2 * k] = p.u;
           w.uv[2 * k + 1] = p.v;
+        }
+        if (settings.interpolate) {  // no rays: the face's grid of vertex displacements
+          const int m =
+              vector ? correspondence->grid_size(face) : inputs.mapping->grid_size(face.value);
+          const auto side = static_cast<std::size_t>(m) + 1;
+          std::span<const VertexId> vertices;
+          if (vector) {
+            vertices = std::span(correspondence->grid_vertices)
+                           .subspan(static_cast<std::size_t>(correspondence->grid_offsets[f]),
+                                    side * side);
+          } else {
+            inputs.mapping->GridVertices(face.value, inputs.sculpt, w.face.grid_vertices);
+            vertices = w.face.grid_vertices;
+          }
+          DISPEX_RETURN_IF_ERROR(w.face.grid.Evaluate(face, m, vertices, inputs.sculpt,
+                                                      w.face.evaluator, /*normals=*/!vector));
+          for (std::size_t k = 0; k < count; ++k) {
+            const auto [tile, texel] = by_face.texels[begin + k];
+            const double u = w.uv[2 * k], v = w.uv[2 * k + 1];
+            if (vector) {
+              double d[3];
+              w.face.grid.DisplacementAt(u, v, d);
+              float* out = &values[tile][3 * static_cast<std::size_t>(texel)];
+              for (int a = 0; a < 3; ++a) out[a] = static_cast<float>(d[a]);
+            } else {
+              values[tile][texel] = static_cast<float>(w.face.grid.HeightAt(u, v));
+            }
+            filled[tile][texel] = 1;
+          }
+          return Status::Ok();
         }
         w.positions.resize(3 * count);
         if (vector) {  // no rays: the limit points alone
@@ -204,7 +234,7 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
         return Status::Ok();
       });
   DISPEX_RETURN_IF_ERROR(traced);
-  if (!vector) DISPEX_RETURN_IF_ERROR(inputs.tracer->status());
+  if (!vector && !settings.interpolate) DISPEX_RETURN_IF_ERROR(inputs.tracer->status());
   for (std::int64_t m : face_misses) report.uv_texels_missed += m;
   report.uv_texels_inside = raster.inside;
   report.uv_overlap_texels = raster.overlap_texels;

@@ -13,8 +13,10 @@ namespace dispex::extract {
 
 // Writes uv_maps_dir/<shape>.<UDIM>.exr for every tile and removes tiles of the same shape a
 // previous run left there that this one did not write. Builds the whole sculpt's tracer when
-// the run's tracer holds only part of it (scalar maps). A vector map (ExtractOptions::vector,
-// object space) passes the correspondence its Ptex map was read through. Fills the report's
+// the run's tracer holds only part of it (scalar maps traced by rays). Interpolated
+// (ExtractSettings::interpolate) each texel is the sculpt's vertex displacements interpolated
+// where it lies, as in the Ptex map. A vector map (ExtractOptions::vector, object space)
+// passes the correspondence its Ptex map was read through. Fills the report's
 // uv_* fields and warnings.
 Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
                    const ExtractSettings& settings, ExtractReport& report,

@@ -27,6 +27,7 @@
 #include "extract/parallel_errors.h"
 #include "extract/process_faces.h"
 #include "extract/uv_maps.h"
+#include "extract/vertex_displacements.h"
 
 namespace dispex::extract {
 
@@ -37,20 +38,31 @@ struct VectorScratch {
   LimitEvaluator evaluator;
   SpectralVectorAnalyzer analyzer;
   std::vector<float> positions, normals, du, dv, channels;
-  KeptFace face;  // the face made, when it is written at once
+  GridDisplacements grid;  // ExtractSettings::interpolate: the face's vertex displacements
+  KeptFace face;           // the face made, when it is written at once
   double cpu_limit = 0, cpu_spectral = 0, cpu_write = 0;
 };
 
-// D at the face's n x n texel centres, in the map's space, into w.channels.
-Status SampleFace(PtexFaceId face, int n, VectorSpace space, const ExtractInputs& inputs,
-                  const SculptCorrespondence& correspondence, VectorScratch& w,
-                  VectorFaceStats& stats) {
+// D at the face's n x n texel centres, in the map's space, into w.channels: the sculpt's vertex
+// displacements interpolated (`interpolate`, vertex_displacements.h), or the sculpt's quads
+// read bilinearly minus the limit point.
+Status SampleFace(PtexFaceId face, int n, VectorSpace space, bool interpolate,
+                  const ExtractInputs& inputs, const SculptCorrespondence& correspondence,
+                  VectorScratch& w, VectorFaceStats& stats) {
   const std::size_t count = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
   for (auto* buffer : {&w.positions, &w.normals, &w.du, &w.dv, &w.channels}) {
     buffer->resize(3 * count);
   }
   DISPEX_RETURN_IF_ERROR(
       w.evaluator.EvaluateGridFrames(face, n, n, {w.positions, w.normals, w.du, w.dv}));
+  if (interpolate) {
+    const int m = correspondence.grid_size(face);
+    const auto first = static_cast<std::size_t>(correspondence.grid_offsets[face.value]);
+    const auto side = static_cast<std::size_t>(m) + 1;
+    DISPEX_RETURN_IF_ERROR(w.grid.Evaluate(
+        face, m, std::span(correspondence.grid_vertices).subspan(first, side * side), inputs.sculpt,
+        w.evaluator, /*normals=*/false));
+  }
   stats.samples = static_cast<std::int64_t>(count);
   stats.normal_min = std::numeric_limits<float>::infinity();
   stats.normal_max = -std::numeric_limits<float>::infinity();
@@ -59,12 +71,19 @@ Status SampleFace(PtexFaceId face, int n, VectorSpace space, const ExtractInputs
     for (int i = 0; i < n; ++i) {
       const float u = (static_cast<float>(i) + 0.5f) / static_cast<float>(n);
       const std::size_t k = 3 * (static_cast<std::size_t>(j) * n + i);
-      const Float3 sculpt = SculptPointAt(correspondence, inputs.sculpt, face, u, v);
-      const Float3 limit{w.positions[k], w.positions[k + 1], w.positions[k + 2]};
       const SurfaceFrame frame{{w.du[k], w.du[k + 1], w.du[k + 2]},
                                {w.dv[k], w.dv[k + 1], w.dv[k + 2]},
                                {w.normals[k], w.normals[k + 1], w.normals[k + 2]}};
-      const Vec3d d = ToVec3d(sculpt) - ToVec3d(limit);
+      Vec3d d;
+      if (interpolate) {
+        double xyz[3];
+        w.grid.DisplacementAt((i + 0.5) / n, (j + 0.5) / n, xyz);
+        d = {xyz[0], xyz[1], xyz[2]};
+      } else {
+        const Float3 sculpt = SculptPointAt(correspondence, inputs.sculpt, face, u, v);
+        const Float3 limit{w.positions[k], w.positions[k + 1], w.positions[k + 2]};
+        d = ToVec3d(sculpt) - ToVec3d(limit);
+      }
       VectorToChannels(space, frame, FromVec3d<Float3>(d), &w.channels[k]);
       const double along = Dot(d, ToVec3d(frame.normal));
       const double length2 = Dot(d, d);
@@ -133,7 +152,8 @@ Status ProcessVectorFace(PtexFaceId face, VectorSpace space, const ExtractInputs
   for (int log2 = std::max({planned, least_log2[0], least_log2[1]});; ++log2) {
     const int n = 1 << log2;
     ThreadCpuStopwatch limit_clock;
-    DISPEX_RETURN_IF_ERROR(SampleFace(face, n, space, inputs, correspondence, w, stats));
+    DISPEX_RETURN_IF_ERROR(
+        SampleFace(face, n, space, settings.interpolate, inputs, correspondence, w, stats));
     w.cpu_limit += limit_clock.seconds();
     ThreadCpuStopwatch spectral_clock;
     scale = space == VectorSpace::kParametric ? ParametricScale(w) : 1.0f;
@@ -416,6 +436,8 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
   report.mapping_max_offset = correspondence->max_offset;
   report.mapping_rms_offset = correspondence->rms_offset;
   report.search_distance = match.max_offset;
+  inputs.interpolate = options.method != ExtractMethod::kMapping;
+  report.method = inputs.interpolate ? ExtractMethod::kInterpolate : ExtractMethod::kMapping;
   DISPEX_ASSIGN_OR_RETURN(ExtractSettings settings, ResolveSettings(options, inputs, report));
   if (CancelRequested()) return Cancelled();
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateVectorMap(options, inputs));

@@ -84,11 +84,10 @@ TEST_P(ExtractRealCages, MapMatchesTheKnownDisplacementAndTheReportAddsUp) {
   }
   EXPECT_EQ(report->samples, samples);
   EXPECT_EQ(report->spectral.texels_before, samples);
-  // A refined sculpt goes through the subdivision correspondence (ExtractMethod::kAuto), which
-  // casts rays only for the samples it leaves undecided.
-  EXPECT_EQ(report->method, density == 0 ? ExtractMethod::kMapping : ExtractMethod::kRays);
-  const std::int64_t traced =
-      report->method == ExtractMethod::kRays ? samples : report->mapping_fallback_samples;
+  // A refined sculpt's vertex displacements are interpolated through the subdivision
+  // correspondence (ExtractMethod::kAuto): no rays.
+  EXPECT_EQ(report->method, density == 0 ? ExtractMethod::kInterpolate : ExtractMethod::kRays);
+  const std::int64_t traced = report->method == ExtractMethod::kRays ? samples : 0;
   EXPECT_GE(report->rays_cast, static_cast<std::uint64_t>(traced));
   EXPECT_LE(report->rays_cast, static_cast<std::uint64_t>(3 * traced));
   EXPECT_EQ(report->hits_positive + report->hits_negative + report->misses, samples);
@@ -288,6 +287,7 @@ TEST(ExtractFolds, HitsOnAFoldedSculptAreCounted) {
   options.base_path = cage;
   options.sculpt_path = make.output_path;
   options.output_path = dir / "map.ptx";
+  options.method = ExtractMethod::kMapping;  // rays (interpolated vertices meet no sheet)
   auto report = Extract(options);
   ASSERT_TRUE(report.ok()) << report.status().message();
   EXPECT_GT(report->hits_opposed, 0);
@@ -315,7 +315,10 @@ TEST_F(ExtractTest, CommandLineWritesMapAndJsonReport) {
   auto report = nlohmann::json::parse(testing::Slurp(json));
   EXPECT_EQ(report["statistics"]["tolerance"].get<double>(), 0.0002);
   EXPECT_FALSE(report["statistics"]["tolerance_auto"].get<bool>());
-  EXPECT_TRUE(report["statistics"]["search_distance_auto"].get<bool>());
+  // The sculpt is the cage refined: its vertex displacements are interpolated, with no rays
+  // and so no search distance.
+  EXPECT_EQ(report["statistics"]["method"], "interpolate");
+  EXPECT_FALSE(report["statistics"]["search_distance_auto"].get<bool>());
   for (const char* phase :
        {"read_base", "read_sculpt", "topology", "bvh", "sample_trace", "write", "total"}) {
     EXPECT_TRUE(report["phases_seconds"].contains(phase)) << phase;

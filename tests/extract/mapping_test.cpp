@@ -402,7 +402,7 @@ INSTANTIATE_TEST_SUITE_P(
 // resolution hold those samples as they are, others a linear resampling of them. Rejects any
 // other difference: a resolution chosen differently, a texel beyond rounding, a search distance
 // or a second search that differs.
-TEST(MappingMaps, DefaultMapsAgreeWithTheRayMaps) {
+TEST(MappingMaps, MappingMapsAgreeWithTheRayMaps) {
   for (const MapCase& c : {MapCase{"ngons", "catmark_nonquads.obj", 3, Pattern::kDetail},
                            MapCase{"creases", "catmark_cube_creases0.obj", 3, Pattern::kRidges},
                            MapCase{"holes", "catmark_hole_test1.obj", 3, Pattern::kDetail}}) {
@@ -412,7 +412,7 @@ TEST(MappingMaps, DefaultMapsAgreeWithTheRayMaps) {
     const std::string sculpt = MakeRefined(dir, cage, c.levels, c.pattern);
     auto base = ReadMesh(cage);
     ASSERT_TRUE(base.ok());
-    auto mapping = Extract(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kAuto));
+    auto mapping = Extract(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kMapping));
     auto rays = Extract(Options(cage, sculpt, dir / "rays.ptx", ExtractMethod::kRays));
     ASSERT_TRUE(mapping.ok() && rays.ok())
         << (mapping.ok() ? rays.status().message() : mapping.status().message());
@@ -452,6 +452,11 @@ TEST(MappingMethod, AutoFallsBackToRaysAndMappingFailsWithTheReason) {
   EXPECT_EQ(forced.status().message(), "method mapping: " + automatic->mapping_reason);
   EXPECT_EQ(forced.status().message().find('\n'), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir / "mapping.ptx"));
+  auto interpolated =
+      Extract(Options(cage, sculpt, dir / "interpolated.ptx", ExtractMethod::kInterpolate));
+  ASSERT_FALSE(interpolated.ok());
+  EXPECT_EQ(interpolated.status().message(), "method interpolate: " + automatic->mapping_reason);
+  EXPECT_FALSE(std::filesystem::exists(dir / "interpolated.ptx"));
 
   // Rays on a refined sculpt when asked, and the option recorded only when given.
   const std::string refined = MakeRefined(dir, cage, 2, Pattern::kSmooth, "refined.obj");
@@ -461,7 +466,8 @@ TEST(MappingMethod, AutoFallsBackToRaysAndMappingFailsWithTheReason) {
   EXPECT_EQ(rays->t_match, 0.0);
   auto chosen = Extract(Options(cage, refined, dir / "chosen.ptx", ExtractMethod::kAuto));
   ASSERT_TRUE(chosen.ok());
-  EXPECT_EQ(chosen->method, ExtractMethod::kMapping);
+  EXPECT_EQ(chosen->method, ExtractMethod::kInterpolate);
+  EXPECT_EQ(chosen->rays_cast, 0u);
   auto options_of = [](const std::string& path) {
     auto map = PtexFile::Open(path);
     EXPECT_TRUE(map.ok());
@@ -473,7 +479,7 @@ TEST(MappingMethod, AutoFallsBackToRaysAndMappingFailsWithTheReason) {
   ASSERT_TRUE(statistics.ok());
   EXPECT_EQ(
       nlohmann::json::parse(statistics->FindMetaData("dispex:statistics")->AsString())["method"],
-      "mapping");
+      "interpolate");
 }
 
 // A sculpt exported with every face wound the other way (flipped normals) is still the base
@@ -504,7 +510,7 @@ TEST(MappingMethod, SculptWoundTheOtherWayIsReadReversed) {
     const ExtractReport& flipped = *reports[1];
     EXPECT_EQ(flipped.mapping_levels, 3);
     if (!vector) {
-      EXPECT_EQ(flipped.method, ExtractMethod::kMapping);
+      EXPECT_EQ(flipped.method, ExtractMethod::kInterpolate);
       EXPECT_EQ(flipped.hits_opposed, 0);
       EXPECT_EQ(flipped.edges_discontinuous, 0);
     }
@@ -530,14 +536,15 @@ TEST(MappingMethod, SculptWoundTheOtherWayIsReadReversed) {
 
 // Rejects a name table that loses a method, and a parser that takes what it should not.
 TEST(MappingMethod, NamesRoundTrip) {
-  for (ExtractMethod m : {ExtractMethod::kAuto, ExtractMethod::kRays, ExtractMethod::kMapping}) {
+  for (ExtractMethod m : {ExtractMethod::kAuto, ExtractMethod::kRays, ExtractMethod::kMapping,
+                          ExtractMethod::kInterpolate}) {
     auto parsed = ParseExtractMethod(ExtractMethodName(m));
     ASSERT_TRUE(parsed.ok());
     EXPECT_EQ(*parsed, m);
   }
   auto bad = ParseExtractMethod("bvh");
   ASSERT_FALSE(bad.ok());
-  EXPECT_NE(bad.status().message().find("auto, rays or mapping"), std::string::npos);
+  EXPECT_NE(bad.status().message().find("auto, rays, mapping or interpolate"), std::string::npos);
 }
 
 // Rejects a manifest that ignores "method" or accepts an unknown one.
@@ -671,11 +678,14 @@ TEST(MappingFallback, FoldsGoToTheBvh) {
   ASSERT_TRUE(base.ok());
   auto given = [&](ExtractOptions o) {
     o = PerSample(o, 3);
-    o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0.2};
+    // Within the mapping's sheet bound (ExtractReport::mapping_sheet_bound, 0.08 here), which
+    // cuts longer distances: hits beyond it are other sheets.
+    o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0.05};
     return o;
   };
   auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, given);
   ASSERT_TRUE(mapping.ok() && rays.ok());
+  EXPECT_GT(mapping->mapping_sheet_bound, 0.05);
   EXPECT_GT(mapping->mapping_fallback_faces, 0);
   EXPECT_EQ(mapping->search_distance, rays->search_distance);
   EXPECT_EQ(mapping->misses, rays->misses);
@@ -879,7 +889,7 @@ TEST(MappingCli, MethodFlag) {
   auto bad = dispex::testing::RunDispex(
       "extract " + cage + " " + sculpt + " -o " + (dir / "b.ptx") + " --method bvh", dir);
   EXPECT_NE(bad.exit_code, 0);
-  EXPECT_NE(bad.err.find("auto, rays or mapping"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("auto, rays, mapping or interpolate"), std::string::npos) << bad.err;
   auto unmatched =
       dispex::testing::RunDispex("extract " + cage + " " + Cage("catmark_nonquads.obj") + " -o " +
                                      (dir / "u.ptx") + " --method mapping",

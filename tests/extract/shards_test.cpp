@@ -167,7 +167,8 @@ INSTANTIATE_TEST_SUITE_P(
         Variant{"spot_rays_given_distance_filter", "keenan_spot/spot_control_mesh.obj", 3,
                 PtexDataType::kFloat, WatertightEdges::kFilter, false, ExtractMethod::kRays},
         // Automatic settings measured by every shard over the whole sculpt; the correspondence.
-        Variant{"spot_auto_half_all", "keenan_spot/spot_control_mesh.obj", 3, PtexDataType::kHalf,
+        // (Level 4: at level 3 the interpolated map meets at every edge with no face raised.)
+        Variant{"spot_auto_half_all", "keenan_spot/spot_control_mesh.obj", 4, PtexDataType::kHalf,
                 WatertightEdges::kAll, true, ExtractMethod::kAuto},
         // N-gons, boundaries, no edge pass.
         Variant{"car_ngons_boundary_off", "opensubdiv/catmark_car.obj", 3, PtexDataType::kFloat,

@@ -15,6 +15,7 @@
 //    and writes nothing; the file does not depend on the thread count.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <map>
 #include <tuple>
@@ -66,24 +67,27 @@ ReferenceGrid BuildReference(const LimitSurface& surface, int levels, const Mesh
   return ref;
 }
 
-// D at (u, v) of `face`: the sculpt quad there, bilinear, minus the limit point.
+// D at (u, v) of `face` (ExtractMethod::kInterpolate): the displacements of the sculpt quad's
+// corners from the limit points at their grid places, bilinear over the quad.
 Float3 ExpectedD(const ReferenceGrid& ref, const Mesh& sculpt, LimitEvaluator& eval, int face,
                  float u, float v) {
   const int n = ref.cells[static_cast<std::size_t>(face)];
   const int i = std::min(static_cast<int>(u * n), n - 1),
             j = std::min(static_cast<int>(v * n), n - 1);
   const double s = u * n - i, t = v * n - j;
-  auto at = [&](int di, int dj) { return sculpt.positions[ref.vertex.at({face, i + di, j + dj})]; };
-  const Float3 a = at(0, 0), b = at(1, 0), c = at(1, 1), d = at(0, 1);
-  const float uv[2] = {u, v};
-  float p[3];
-  EXPECT_TRUE(eval.EvaluatePoints(PtexFaceId(face), uv, p, {}).ok());
-  auto lerp = [&](float xa, float xb, float xc, float xd) {
-    return (1 - s) * (1 - t) * xa + s * (1 - t) * xb + s * t * xc + (1 - s) * t * xd;
+  auto at = [&](int di, int dj) {
+    const Float3 q = sculpt.positions[ref.vertex.at({face, i + di, j + dj})];
+    const float uv[2] = {static_cast<float>(i + di) / n, static_cast<float>(j + dj) / n};
+    float p[3];
+    EXPECT_TRUE(eval.EvaluatePoints(PtexFaceId(face), uv, p, {}).ok());
+    return std::array<double, 3>{double(q.x) - p[0], double(q.y) - p[1], double(q.z) - p[2]};
   };
-  return {static_cast<float>(lerp(a.x, b.x, c.x, d.x) - p[0]),
-          static_cast<float>(lerp(a.y, b.y, c.y, d.y) - p[1]),
-          static_cast<float>(lerp(a.z, b.z, c.z, d.z) - p[2])};
+  const auto a = at(0, 0), b = at(1, 0), c = at(1, 1), d = at(0, 1);
+  double out[3];
+  for (int k = 0; k < 3; ++k) {
+    out[k] = (1 - s) * (1 - t) * a[k] + s * (1 - t) * b[k] + s * t * c[k] + (1 - s) * t * d[k];
+  }
+  return {static_cast<float>(out[0]), static_cast<float>(out[1]), static_cast<float>(out[2])};
 }
 
 // The object-space D a map holds at texel (i, j) of `face`'s samples: the channels read by

@@ -17,8 +17,9 @@
 //    of its own positions in Ptex (u, v) are 2 on sub-faces and 1 on quads, and halved they
 //    match the differences (so the oracle itself does not assume the factor);
 //  - every texel of a full-resolution map, turned into D by the frame docs/VECTOR.md states
-//    (built from the oracle's P, dP/du, dP/dv, N), is the sculpt at the texel centre minus the
-//    limit point there, to float rounding; the sculpt's vertices are found by their limit
+//    (built from the oracle's P, dP/du, dP/dv, N), is the displacements of the sculpt's
+//    vertices from their limit points interpolated bilinearly at the texel centre (the default
+//    method, interpolate), to float rounding; the sculpt's vertices are found by their limit
 //    points (oracle) and checked against the truth's D;
 //  - the same check rejects each wrong frame on the sub-faces: derivatives x2 (OpenSubdiv's
 //    own) or x0.5, u and v swapped, tangent channels scaled; a tangent frame does not depend
@@ -437,8 +438,8 @@ SculptGrid BuildSculptGrid(const FarLimit& far, const std::string& sculpt_path, 
   return grid;
 }
 
-// D at (u, v) of face f as docs/VECTOR.md defines it: the sculpt there (bilinear over the cell
-// of the face's grid that holds (u, v)) minus the limit point.
+// D at (u, v) of face f as docs/VECTOR.md defines it: the displacements of the corners of the
+// cell of the face's grid that holds (u, v) from their limit points, bilinear over the cell.
 V3 SculptD(const FarLimit& far, const SculptGrid& grid, int f, double u, double v) {
   const int n = grid.cells[static_cast<std::size_t>(f)];
   const int i = std::min(static_cast<int>(u * n), n - 1),
@@ -446,11 +447,11 @@ V3 SculptD(const FarLimit& far, const SculptGrid& grid, int f, double u, double 
   const double s = u * n - i, t = v * n - j;
   const std::vector<V3>& c = grid.corners[static_cast<std::size_t>(f)];
   auto at = [&](int di, int dj) {
-    return c[static_cast<std::size_t>((j + dj) * (n + 1) + i + di)];
+    return c[static_cast<std::size_t>((j + dj) * (n + 1) + i + di)] -
+           far.Evaluate(f, static_cast<double>(i + di) / n, static_cast<double>(j + dj) / n);
   };
-  const V3 sculpt = at(0, 0) * ((1 - s) * (1 - t)) + at(1, 0) * (s * (1 - t)) + at(1, 1) * (s * t) +
-                    at(0, 1) * ((1 - s) * t);
-  return sculpt - far.Evaluate(f, u, v);
+  return at(0, 0) * ((1 - s) * (1 - t)) + at(1, 0) * (s * (1 - t)) + at(1, 1) * (s * t) +
+         at(0, 1) * ((1 - s) * t);
 }
 
 struct MapCheck {
