@@ -17,6 +17,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "dispex/ids.h"
@@ -87,6 +88,12 @@ struct SculptCorrespondence {
 
   int grid_size(PtexFaceId face) const { return grid_sizes[face.value]; }
   // Precondition: 0 <= i, j <= grid_size(face).
+  // Face `face`'s grid of (n+1)^2 vertices, row by row (empty for a hole).
+  std::span<const VertexId> grid(PtexFaceId face) const {
+    const auto first = static_cast<std::size_t>(grid_offsets[face.value]);
+    return std::span(grid_vertices)
+        .subspan(first, static_cast<std::size_t>(grid_offsets[face.value + 1]) - first);
+  }
   VertexId vertex(PtexFaceId face, int i, int j) const {
     const int n = grid_sizes[face.value];
     return grid_vertices[grid_offsets[face.value] + static_cast<std::int64_t>(j) * (n + 1) + i];

@@ -237,8 +237,9 @@ struct ExtractReport {
   // Samples the mapping could not decide, answered by a BVH of the sculpt within their reach,
   // and the Ptex faces they are in (of the faces extracted in this run).
   std::int64_t mapping_fallback_samples = 0, mapping_fallback_faces = 0;
-  // Through the correspondence with rays (kMapping): the longest hit kept, twice the match's
-  // largest vertex offset (mapping_max_offset) plus the sculpt's median edge; a hit beyond it
+  // Through the correspondence with rays (kMapping): the longest hit kept, twice the largest
+  // vertex offset the match measured (mapping_max_offset, over the vertices it checks: all of
+  // them on grids up to 8 x 8) plus the sculpt's median edge; a hit beyond it
   // is another sheet of the sculpt and counts as a miss. The search distances are cut to it.
   // 0: none.
   double mapping_sheet_bound = 0;

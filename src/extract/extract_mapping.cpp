@@ -32,6 +32,11 @@ StatusOr<SculptCorrespondence> MatchSculpt(MatchOptions match, ExtractInputs& in
   return correspondence;
 }
 
+StatusOr<double> OffsetBound(const ExtractOptions& options, double base_diagonal) {
+  if (options.search_distance.kind == SearchDistanceSpec::Kind::kAuto) return 0.0;
+  return ResolveSearchDistance(options.search_distance, base_diagonal);
+}
+
 Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report) {
   report.method = ExtractMethod::kRays;
   if (options.method == ExtractMethod::kRays) return Status::Ok();
@@ -40,11 +45,8 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   MatchOptions match;
   match.threads = report.threads;
   match.face_tables = false;  // the mapping reads the cells
-  // Interpolated, a given search distance bounds how far a vertex may lie from its point, as
-  // for vector maps.
-  if (interpolate && options.search_distance.kind != SearchDistanceSpec::Kind::kAuto) {
-    DISPEX_ASSIGN_OR_RETURN(match.max_offset,
-                            ResolveSearchDistance(options.search_distance, report.base_diagonal));
+  if (interpolate) {          // the bound vector maps take too
+    DISPEX_ASSIGN_OR_RETURN(match.max_offset, OffsetBound(options, report.base_diagonal));
   }
   StatusOr<SculptCorrespondence> correspondence = MatchSculpt(match, inputs, report);
   if (!correspondence.ok()) {

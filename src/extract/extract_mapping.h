@@ -21,6 +21,12 @@ namespace dispex::extract {
 StatusOr<SculptCorrespondence> MatchSculpt(MatchOptions match, ExtractInputs& inputs,
                                            ExtractReport& report);
 
+// What a given search distance bounds when the map reads the sculpt through its
+// correspondence alone (interpolated or vector maps): how far a sculpt vertex may lie from its
+// point on the limit surface (MatchOptions::max_offset); 0, the match's default, when the
+// distance is automatic.
+StatusOr<double> OffsetBound(const ExtractOptions& options, double base_diagonal);
+
 // Unless the method is kRays, matches the sculpt to the base (MatchSculpt) and on a match sets
 // inputs.mapping (no BVH is built up front then) and, under kAuto and kInterpolate,
 // inputs.interpolate. Records the method that will run and the match (time, level, offsets,

@@ -72,14 +72,6 @@ Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs
     DISPEX_ASSIGN_OR_RETURN(report.search_distance,
                             ResolveSearchDistance(options.search_distance, report.base_diagonal));
   }
-  // Through the correspondence, a hit farther than the match's own offsets is another sheet of
-  // the sculpt (a crease corner's far side, a fold), not the one over the sample: a miss.
-  // (Plus a median sculpt edge: the flat quads sag from their vertices by a fraction of one.)
-  if (inputs.mapping != nullptr) {
-    report.mapping_sheet_bound =
-        kSheetFactor * report.mapping_max_offset + report.sculpt_median_edge;
-    report.search_distance = std::min(report.search_distance, report.mapping_sheet_bound);
-  }
   // With an automatic search distance, samples that missed get a second, longer search: the
   // sparse estimate can miss thin or strongly curved parts where the sculpt is farther from
   // the limit surface than almost everywhere else.
@@ -88,7 +80,13 @@ Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs
           ? std::max(report.search_distance, std::min(kRetryFactor * report.search_distance,
                                                       report.search_estimate.ray_length))
           : 0.0;
-  if (report.mapping_sheet_bound > 0) {
+  // Through the correspondence, a hit farther than the match's own offsets is another sheet of
+  // the sculpt (a crease corner's far side, a fold), not the one over the sample: a miss.
+  // (Plus a median sculpt edge: the flat quads sag from their vertices by a fraction of one.)
+  if (inputs.mapping != nullptr) {
+    report.mapping_sheet_bound =
+        kSheetFactor * report.mapping_max_offset + report.sculpt_median_edge;
+    report.search_distance = std::min(report.search_distance, report.mapping_sheet_bound);
     report.retry_search_distance =
         std::min(report.retry_search_distance, report.mapping_sheet_bound);
   }

@@ -263,10 +263,20 @@ Hash128 SettingsKey(const ExtractSettings& s) {
   return h.Digest();
 }
 
+void AddGridKey(Hasher& h, const Mesh& sculpt, int m, std::span<const VertexId> grid,
+                std::vector<Float3>& scratch) {
+  h.Add(m);
+  scratch.clear();
+  for (const VertexId id : grid) {
+    scratch.push_back(sculpt.positions[static_cast<std::size_t>(id.value)]);
+  }
+  h.AddArray(std::span<const Float3>(scratch));
+}
+
 namespace {
 
 // Interpolated (ExtractSettings::interpolate), a face reads only its own grid of sculpt
-// vertices: its key holds their positions in grid order, and its reach is their box.
+// vertices: its key holds their positions in grid order (AddGridKey). No rays: no reach boxes.
 FaceKeys GridFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings,
                       const std::vector<BaseFacePatch>& patches) {
   const LimitSurface& surface = inputs.surface;
@@ -275,8 +285,7 @@ FaceKeys GridFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settin
   const Hash128 settings_key = SettingsKey(settings);
   FaceKeys out;
   out.keys.resize(num_faces);
-  out.reach_boxes.assign(num_faces, Box::Empty());
-  out.reach_faces.assign(num_faces, 0);
+  out.reach_faces.resize(num_faces);
   struct Scratch {
     std::vector<VertexId> ids;
     std::vector<Float3> points;
@@ -287,24 +296,11 @@ FaceKeys GridFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settin
     h.Add(settings_key);
     AddFacePatchKey(h, surface, patches, settings, f);
     const int m = mapping.grid_size(static_cast<int>(f));
-    h.Add(m);
-    if (m > 0) {
-      Scratch& w = scratches.local();
-      mapping.GridVertices(static_cast<int>(f), inputs.sculpt, w.ids);
-      w.points.clear();
-      Box& box = out.reach_boxes[f];
-      for (const VertexId id : w.ids) {
-        const Float3& p = inputs.sculpt.positions[static_cast<std::size_t>(id.value)];
-        w.points.push_back(p);
-        const float xyz[3] = {p.x, p.y, p.z};
-        for (int a = 0; a < 3; ++a) {
-          box.lower[a] = std::min(box.lower[a], xyz[a]);
-          box.upper[a] = std::max(box.upper[a], xyz[a]);
-        }
-      }
-      h.AddArray(std::span<const Float3>(w.points));
-      out.reach_faces[f] = std::int64_t{m} * m;
-    }
+    Scratch& w = scratches.local();
+    w.ids.clear();
+    if (m > 0) mapping.GridVertices(static_cast<int>(f), inputs.sculpt, w.ids);
+    AddGridKey(h, inputs.sculpt, m, w.ids, w.points);
+    out.reach_faces[f] = std::int64_t{m} * m;
     out.keys[f] = h.Digest();
   });
   return out;

@@ -17,6 +17,12 @@ namespace dispex::extract {
 // (not its groups, UVs or file name).
 Hash128 MeshContentKey(const Mesh& mesh);
 
+// Adds to `h` what a face that reads only its own grid of sculpt vertices (interpolated or
+// vector maps) is made from: the grid size m and the (m + 1)^2 vertices' positions in grid
+// order. `scratch`: reused storage.
+void AddGridKey(Hasher& h, const Mesh& sculpt, int m, std::span<const VertexId> grid,
+                std::vector<Float3>& scratch);
+
 // The settings every face's first pass reads (distances, spectral options, holes, data type,
 // watertight mode, sampling caps) and the version of the pipeline.
 Hash128 SettingsKey(const ExtractSettings& settings);
@@ -32,12 +38,12 @@ void AddFacePatchKey(Hasher& h, const LimitSurface& surface, std::span<const Bas
 // those whose bounding box meets the face's reach box (the patch's box grown by the longest search
 // distance and a margin), as an order-free sum of each sculpt face's key (its corners' positions,
 // in order). Interpolated (ExtractSettings::interpolate), the sculpt part is the face's own
-// grid of sculpt vertices, their positions in grid order, and the reach box is theirs. The keys
-// do not depend on the thread count.
+// grid of sculpt vertices (AddGridKey), reach_faces its cells, and there are no reach boxes.
+// The keys do not depend on the thread count.
 
 struct FaceKeys {
   std::vector<Hash128> keys;     // per Ptex face
-  std::vector<Box> reach_boxes;  // per Ptex face: where its rays can go
+  std::vector<Box> reach_boxes;  // per Ptex face: where its rays can go (empty: no rays)
   float sculpt_half_extent = 0;  // the largest half-size of a sculpt face's bounding box
   // Per Ptex face: the sculpt faces in the grid cells its key sums (about those its rays reach).
   std::vector<std::int64_t> reach_faces;

@@ -171,18 +171,11 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
         if (settings.interpolate) {  // no rays: the face's grid of vertex displacements
           const int m =
               vector ? correspondence->grid_size(face) : inputs.mapping->grid_size(face.value);
-          const auto side = static_cast<std::size_t>(m) + 1;
-          std::span<const VertexId> vertices;
-          if (vector) {
-            vertices = std::span(correspondence->grid_vertices)
-                           .subspan(static_cast<std::size_t>(correspondence->grid_offsets[f]),
-                                    side * side);
-          } else {
+          if (!vector)
             inputs.mapping->GridVertices(face.value, inputs.sculpt, w.face.grid_vertices);
-            vertices = w.face.grid_vertices;
-          }
-          DISPEX_RETURN_IF_ERROR(w.face.grid.Evaluate(face, m, vertices, inputs.sculpt,
-                                                      w.face.evaluator, /*normals=*/!vector));
+          DISPEX_RETURN_IF_ERROR(w.face.grid.Evaluate(
+              face, m, vector ? correspondence->grid(face) : w.face.grid_vertices, inputs.sculpt,
+              w.face.evaluator, /*normals=*/!vector));
           for (std::size_t k = 0; k < count; ++k) {
             const auto [tile, texel] = by_face.texels[begin + k];
             const double u = w.uv[2 * k], v = w.uv[2 * k + 1];

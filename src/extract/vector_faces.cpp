@@ -56,12 +56,9 @@ Status SampleFace(PtexFaceId face, int n, VectorSpace space, bool interpolate,
   DISPEX_RETURN_IF_ERROR(
       w.evaluator.EvaluateGridFrames(face, n, n, {w.positions, w.normals, w.du, w.dv}));
   if (interpolate) {
-    const int m = correspondence.grid_size(face);
-    const auto first = static_cast<std::size_t>(correspondence.grid_offsets[face.value]);
-    const auto side = static_cast<std::size_t>(m) + 1;
-    DISPEX_RETURN_IF_ERROR(w.grid.Evaluate(
-        face, m, std::span(correspondence.grid_vertices).subspan(first, side * side), inputs.sculpt,
-        w.evaluator, /*normals=*/false));
+    DISPEX_RETURN_IF_ERROR(w.grid.Evaluate(face, correspondence.grid_size(face),
+                                           correspondence.grid(face), inputs.sculpt, w.evaluator,
+                                           /*normals=*/false));
   }
   stats.samples = static_cast<std::int64_t>(count);
   stats.normal_min = std::numeric_limits<float>::infinity();
@@ -204,15 +201,9 @@ std::vector<Hash128> VectorFaceKeys(const ExtractInputs& inputs, const ExtractSe
     Hasher h;
     h.Add(settings_key);
     AddFacePatchKey(h, surface, patches, settings, f);
-    h.Add(correspondence.grid_size(PtexFaceId(static_cast<int>(f))));
-    std::vector<Float3>& grid = grids.local();
-    grid.clear();
-    for (std::int64_t k = correspondence.grid_offsets[f]; k < correspondence.grid_offsets[f + 1];
-         ++k) {
-      grid.push_back(inputs.sculpt.positions[static_cast<std::size_t>(
-          correspondence.grid_vertices[static_cast<std::size_t>(k)].value)]);
-    }
-    h.AddArray(std::span<const Float3>(grid));
+    const PtexFaceId face(static_cast<int>(f));
+    AddGridKey(h, inputs.sculpt, correspondence.grid_size(face), correspondence.grid(face),
+               grids.local());
     keys[f] = h.Digest();
   });
   return keys;
@@ -420,10 +411,7 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
   Stopwatch match_clock;
   MatchOptions match;
   match.threads = report.threads;
-  if (options.search_distance.kind != SearchDistanceSpec::Kind::kAuto) {
-    DISPEX_ASSIGN_OR_RETURN(match.max_offset,
-                            ResolveSearchDistance(options.search_distance, report.base_diagonal));
-  }
+  DISPEX_ASSIGN_OR_RETURN(match.max_offset, OffsetBound(options, report.base_diagonal));
   auto correspondence = MatchSculpt(match, inputs, report);
   if (!correspondence.ok()) {
     return Status::Error(fmt::format(

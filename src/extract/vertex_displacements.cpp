@@ -27,13 +27,11 @@ Status GridDisplacements::Evaluate(PtexFaceId face, int m, std::span<const Verte
   DISPEX_RETURN_IF_ERROR(evaluator.EvaluatePoints(face, uv_, positions_, limit_normals_));
   d_.resize(3 * count);
   h_.resize(normals ? count : 0);
-  max_length_ = 0;
   for (std::size_t k = 0; k < count; ++k) {
     const Float3& s = sculpt.positions[static_cast<std::size_t>(vertices[k].value)];
     const double d[3] = {double(s.x) - positions_[3 * k], double(s.y) - positions_[3 * k + 1],
                          double(s.z) - positions_[3 * k + 2]};
     std::copy(d, d + 3, &d_[3 * k]);
-    max_length_ = std::max(max_length_, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
     if (normals) {
       h_[k] = d[0] * limit_normals_[3 * k] + d[1] * limit_normals_[3 * k + 1] +
               d[2] * limit_normals_[3 * k + 2];

@@ -27,17 +27,12 @@ class GridDisplacements {
   // while the same face is asked for again (the edge rounds sample a face more than once).
   Status Evaluate(PtexFaceId face, int m, std::span<const VertexId> vertices, const Mesh& sculpt,
                   LimitEvaluator& evaluator, bool normals);
-  // Forgets the face held, e.g. when the sculpt changes.
-  void Clear() { face_ = -1; }
-
   int face() const { return face_; }
   int m() const { return m_; }
   // At Ptex (u, v) in [0, 1] of the face evaluated: the cell i = min(floor(u m), m - 1),
   // s = u m - i (likewise j, t), and D or h bilinear over its corners, in double.
   void DisplacementAt(double u, double v, double out[3]) const;
   double HeightAt(double u, double v) const;
-  // The largest |D| over the grid's vertices.
-  double max_length() const { return max_length_; }
 
  private:
   struct Cell {
@@ -51,7 +46,6 @@ class GridDisplacements {
   std::vector<float> uv_, positions_, limit_normals_;
   std::vector<double> d_;  // 3 per vertex
   std::vector<double> h_;  // 1 per vertex, with normals
-  double max_length_ = 0;
 };
 
 }  // namespace dispex::extract

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "dispex/extract.h"
 #include "dispex/ptex.h"
 #include "dispex/verify.h"
 
@@ -26,6 +27,17 @@ inline std::string DataPath(const std::string& relative) {
 }
 
 // A ground-truth sculpt of `cage`: refined `levels` times, displaced by `pattern`.
+// An extraction of `sculpt` onto `base` into `output` by `method`, other options at default.
+inline ExtractOptions MethodOptions(const std::string& base, const std::string& sculpt,
+                                    const std::string& output, ExtractMethod method) {
+  ExtractOptions o;
+  o.base_path = base;
+  o.sculpt_path = sculpt;
+  o.output_path = output;
+  o.method = method;
+  return o;
+}
+
 inline MakeSculptOptions SculptOptions(const std::string& cage, const std::string& output,
                                        int levels, Pattern pattern, double amplitude) {
   MakeSculptOptions options;

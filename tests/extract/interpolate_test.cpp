@@ -31,6 +31,7 @@ namespace dispex {
 namespace {
 
 using testing::DataPath;
+using testing::MethodOptions;
 using testing::TempDir;
 
 std::string Cage(const char* name) {
@@ -48,16 +49,6 @@ double Percentile99(std::vector<double> v) {
   const std::size_t k = (v.size() * 99) / 100;
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
   return v[k];
-}
-
-ExtractOptions Options(const std::string& cage, const std::string& sculpt,
-                       const std::string& output, ExtractMethod method) {
-  ExtractOptions o;
-  o.base_path = cage;
-  o.sculpt_path = sculpt;
-  o.output_path = output;
-  o.method = method;
-  return o;
 }
 
 // The largest |value| (scalar) or channel vector length over every texel of `path`.
@@ -94,13 +85,14 @@ TEST(Interpolate, SculptOnTheLimitSurfaceGivesZeroMaps) {
     const double diagonal = Diagonal(cage);
     ASSERT_TRUE(
         MakeSculpt(testing::SculptOptions(cage, dir / "zero.obj", 3, Pattern::kNone, 0)).ok());
-    auto scalar = Extract(Options(cage, dir / "zero.obj", dir / "h.ptx", ExtractMethod::kAuto));
+    auto scalar =
+        Extract(MethodOptions(cage, dir / "zero.obj", dir / "h.ptx", ExtractMethod::kAuto));
     ASSERT_TRUE(scalar.ok()) << scalar.status().message();
     EXPECT_EQ(scalar->method, ExtractMethod::kInterpolate);
     EXPECT_EQ(scalar->rays_cast, 0u);
     EXPECT_LE(LargestTexel(dir / "h.ptx"), 1e-5 * diagonal);
     for (VectorSpace space : {VectorSpace::kObject, VectorSpace::kTangent}) {
-      ExtractOptions o = Options(cage, dir / "zero.obj", dir / "d.ptx", ExtractMethod::kAuto);
+      ExtractOptions o = MethodOptions(cage, dir / "zero.obj", dir / "d.ptx", ExtractMethod::kAuto);
       o.vector = space;
       auto vector = Extract(o);
       ASSERT_TRUE(vector.ok()) << vector.status().message();
@@ -112,7 +104,7 @@ TEST(Interpolate, SculptOnTheLimitSurfaceGivesZeroMaps) {
     // vertices than the texels, is shorter than the sag.)
     if (std::string(name) == "catmark_torus_creases0.obj") continue;
     auto facets =
-        Extract(Options(cage, dir / "zero.obj", dir / "facets.ptx", ExtractMethod::kMapping));
+        Extract(MethodOptions(cage, dir / "zero.obj", dir / "facets.ptx", ExtractMethod::kMapping));
     ASSERT_TRUE(facets.ok()) << facets.status().message();
     EXPECT_GT(LargestTexel(dir / "facets.ptx"), 1e-4 * diagonal);
   }
@@ -192,7 +184,7 @@ TEST(Interpolate, VectorMapsReachTheVertexInterpolationFloor) {
     ASSERT_TRUE(made.ok()) << made.status().message();
     double ratio[2] = {0, 0};
     for (ExtractMethod method : {ExtractMethod::kAuto, ExtractMethod::kMapping}) {
-      ExtractOptions o = Options(cage, dir / "sculpt.obj", dir / "d.ptx", method);
+      ExtractOptions o = MethodOptions(cage, dir / "sculpt.obj", dir / "d.ptx", method);
       o.vector = VectorSpace::kObject;
       o.oversample = 2 << kLevels;  // every sample stored as it is
       o.resolution_rule = ResolutionRule::kFixed;
@@ -223,7 +215,7 @@ TEST(Interpolate, SharpCreaseCornersHoldNoOtherSheet) {
     double ratio[2] = {0, 0};
     for (ExtractMethod method : {ExtractMethod::kAuto, ExtractMethod::kRays}) {
       const std::string map = dir / "map.ptx";
-      auto report = Extract(Options(cage, dir / "sculpt.obj", map, method));
+      auto report = Extract(MethodOptions(cage, dir / "sculpt.obj", map, method));
       ASSERT_TRUE(report.ok()) << report.status().message();
       const VerifyReport checked = testing::CheckTruth(cage, map, truth, report->tolerance);
       ratio[method == ExtractMethod::kRays] = checked.truth.max / checked.truth.p99;
@@ -251,7 +243,8 @@ TEST(Interpolate, MapsAreTheSameAtAnyThreadCount) {
   for (const bool vector : {false, true}) {
     std::string bytes[2];
     for (const int threads : {1, 3}) {
-      ExtractOptions o = Options(cage, dir / "sculpt.obj", dir / "map.ptx", ExtractMethod::kAuto);
+      ExtractOptions o =
+          MethodOptions(cage, dir / "sculpt.obj", dir / "map.ptx", ExtractMethod::kAuto);
       if (vector) o.vector = VectorSpace::kTangent;
       o.threads = threads;
       ASSERT_TRUE(Extract(o).ok());

@@ -271,11 +271,7 @@ TEST(MappingKernels, PairedBlocksAnswerAsSingleBlocks) {
 
 ExtractOptions Options(const std::string& base, const std::string& sculpt,
                        const std::string& output, ExtractMethod method) {
-  ExtractOptions o;
-  o.base_path = base;
-  o.sculpt_path = sculpt;
-  o.output_path = output;
-  o.method = method;
+  ExtractOptions o = dispex::testing::MethodOptions(base, sculpt, output, method);
   o.threads = 2;
   return o;
 }
