@@ -274,6 +274,7 @@ struct VerifyReport {
   double truth_worst_ratio = 0;             // the largest error / (k tau + 2 e_v)
   double truth_local_tolerance_factor = 0;  // k
   std::size_t truth_unbounded = 0;  // records near folded sculpt faces (e_v infinite): unchecked
+  ErrorStats truth_local_error;     // e_v over the bounded records: what the sculpt's facets add
   struct TruthRecord {
     std::size_t index = 0;
     int face = -1;

@@ -13,6 +13,7 @@
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
 #include "extract/mapping_trace.h"
+#include "extract/vertex_displacements.h"
 
 namespace dispex::extract {
 
@@ -39,6 +40,9 @@ struct ExtractInputs {
   // With `mapping`: the sculpt's vertex displacements are interpolated (vertex_displacements.h)
   // instead of traced; no tracer, no search distance.
   bool interpolate = false;
+  // With `interpolate`: the grids the displacements are read from, over `mapping` or, for
+  // vector maps, the correspondence the run holds.
+  std::unique_ptr<GridSource> grids;
   const FaceKeys* face_keys = nullptr;
   double fallback_bvh_seconds = 0;  // building those tracers
 };

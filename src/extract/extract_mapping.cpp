@@ -68,6 +68,7 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
     mapping.BuildBlocks(inputs.sculpt);
   }
   inputs.mapping = std::make_unique<SculptMapping>(std::move(mapping));
+  if (interpolate) inputs.grids = std::make_unique<MappingGrids>(*inputs.mapping);
   inputs.interpolate = interpolate;
   report.t_match = clock.seconds();
   report.method = interpolate ? ExtractMethod::kInterpolate : ExtractMethod::kMapping;

@@ -273,14 +273,26 @@ void AddGridKey(Hasher& h, const Mesh& sculpt, int m, std::span<const VertexId> 
   h.AddArray(std::span<const Float3>(scratch));
 }
 
+void AddFieldKey(Hasher& h, const ExtractInputs& inputs, std::span<const BaseFacePatch> patches,
+                 int f, std::vector<VertexId>& ids, std::vector<int>& faces,
+                 std::vector<Float3>& points) {
+  FaceFieldVertices(*inputs.grids, f, inputs.sculpt, ids, faces);
+  AddGridKey(h, inputs.sculpt, inputs.grids->grid_size(f), ids, points);
+  for (const int g : faces) {
+    const PtexFaceId face(g);
+    const BaseFacePatch& patch =
+        patches[static_cast<std::size_t>(inputs.surface.base_face(face).value)];
+    h.Add(g).Add(patch.key[0]).Add(patch.key[1]).Add(inputs.surface.sub_face(face));
+  }
+}
+
 namespace {
 
-// Interpolated (ExtractSettings::interpolate), a face reads only its own grid of sculpt
-// vertices: its key holds their positions in grid order (AddGridKey). No rays: no reach boxes.
+// Interpolated (ExtractSettings::interpolate), a face reads its grid of sculpt vertices and the
+// row beyond each edge: its key holds their positions (AddGridKey). No rays: no reach boxes.
 FaceKeys GridFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings,
                       const std::vector<BaseFacePatch>& patches) {
   const LimitSurface& surface = inputs.surface;
-  const SculptMapping& mapping = *inputs.mapping;
   const auto num_faces = static_cast<std::size_t>(surface.num_ptex_faces());
   const Hash128 settings_key = SettingsKey(settings);
   FaceKeys out;
@@ -288,6 +300,7 @@ FaceKeys GridFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settin
   out.reach_faces.resize(num_faces);
   struct Scratch {
     std::vector<VertexId> ids;
+    std::vector<int> faces;
     std::vector<Float3> points;
   };
   tbb::enumerable_thread_specific<Scratch> scratches;
@@ -295,11 +308,9 @@ FaceKeys GridFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settin
     Hasher h;
     h.Add(settings_key);
     AddFacePatchKey(h, surface, patches, settings, f);
-    const int m = mapping.grid_size(static_cast<int>(f));
+    const int m = inputs.grids->grid_size(static_cast<int>(f));
     Scratch& w = scratches.local();
-    w.ids.clear();
-    if (m > 0) mapping.GridVertices(static_cast<int>(f), inputs.sculpt, w.ids);
-    AddGridKey(h, inputs.sculpt, m, w.ids, w.points);
+    AddFieldKey(h, inputs, patches, static_cast<int>(f), w.ids, w.faces, w.points);
     out.reach_faces[f] = std::int64_t{m} * m;
     out.keys[f] = h.Digest();
   });

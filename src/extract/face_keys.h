@@ -17,11 +17,19 @@ namespace dispex::extract {
 // (not its groups, UVs or file name).
 Hash128 MeshContentKey(const Mesh& mesh);
 
-// Adds to `h` what a face that reads only its own grid of sculpt vertices (interpolated or
-// vector maps) is made from: the grid size m and the (m + 1)^2 vertices' positions in grid
-// order. `scratch`: reused storage.
+// Adds to `h` what a face that reads a grid of sculpt vertices (interpolated or vector maps) is
+// made from: the grid size m and the vertices' positions in order (the (m + 1)^2 of its grid,
+// and for interpolated faces its apron's, FaceFieldVertices). `scratch`: reused storage.
 void AddGridKey(Hasher& h, const Mesh& sculpt, int m, std::span<const VertexId> grid,
                 std::vector<Float3>& scratch);
+
+// Adds to `h` what face `f` of an interpolated map reads besides its own patch
+// (AddFacePatchKey): its grid and apron vertices' positions (AddGridKey, FaceFieldVertices)
+// and the limit patches of the faces its apron lies on. `ids`, `faces`, `points`: reused
+// storage.
+void AddFieldKey(Hasher& h, const ExtractInputs& inputs, std::span<const BaseFacePatch> patches,
+                 int f, std::vector<VertexId>& ids, std::vector<int>& faces,
+                 std::vector<Float3>& points);
 
 // The settings every face's first pass reads (distances, spectral options, holes, data type,
 // watertight mode, sampling caps) and the version of the pipeline.
@@ -37,8 +45,9 @@ void AddFacePatchKey(Hasher& h, const LimitSurface& surface, std::span<const Bas
 // (BaseFacePatches) and sub-face, its planned samples, and every sculpt face its rays can reach:
 // those whose bounding box meets the face's reach box (the patch's box grown by the longest search
 // distance and a margin), as an order-free sum of each sculpt face's key (its corners' positions,
-// in order). Interpolated (ExtractSettings::interpolate), the sculpt part is the face's own
-// grid of sculpt vertices (AddGridKey), reach_faces its cells, and there are no reach boxes.
+// in order). Interpolated (ExtractSettings::interpolate), the sculpt part is the face's grid of
+// sculpt vertices and its apron (AddGridKey, FaceFieldVertices), reach_faces its cells, and
+// there are no reach boxes.
 // The keys do not depend on the thread count.
 
 struct FaceKeys {

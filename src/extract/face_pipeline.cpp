@@ -87,12 +87,9 @@ std::int32_t TraceMappedSamples(PtexFaceId face, int n, const ExtractInputs& inp
 // The sculpt's vertex heights interpolated at the n x n texel centres, as hits: no misses,
 // none opposed.
 Status InterpolateHeights(PtexFaceId face, int n, const ExtractInputs& inputs, FaceScratch& w) {
-  const SculptMapping& mapping = *inputs.mapping;
-  if (w.grid.face() != face.value) {
-    mapping.GridVertices(face.value, inputs.sculpt, w.grid_vertices);
-  }
-  DISPEX_RETURN_IF_ERROR(w.grid.Evaluate(face, mapping.grid_size(face.value), w.grid_vertices,
-                                         inputs.sculpt, w.evaluator, /*normals=*/true));
+  DISPEX_RETURN_IF_ERROR(
+      w.grid.Evaluate(face, *inputs.grids, inputs.sculpt, w.evaluator, /*normals=*/true));
+  w.grid.SetSampling(n);
   for (int j = 0; j < n; ++j) {
     const double v = (j + 0.5) / n;
     for (int i = 0; i < n; ++i) {

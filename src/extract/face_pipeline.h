@@ -74,7 +74,6 @@ struct FaceScratch {
   std::vector<float> mapped_t, fallback_t;
   std::vector<Float3> fallback_origins, fallback_normals;
   // Interpolated (ExtractSettings::interpolate): the face's grid of vertex displacements.
-  std::vector<VertexId> grid_vertices;
   GridDisplacements grid;
   PullPushScratch pull_push;
   TraceCounters counters;

@@ -207,34 +207,47 @@ StatusOr<SculptMapping> SculptMapping::Build(SculptCorrespondence&& corresponden
                         out.cells_[c] = label >> 2 | (label & 3u) << 30;
                       }
                     });
-  out.crossings_.resize(4 * num_ptex);
-  for (std::size_t f = 0; f < num_ptex; ++f) {
-    if (out.grid_sizes_[f] == 0) continue;
+  out.crossings_ = Crossings(faces, out.grid_sizes_);
+  return out;
+}
+
+std::vector<SculptMapping::Crossing> SculptMapping::Crossings(std::span<const PtexFaceInfo> faces,
+                                                              std::span<const std::int32_t> sizes) {
+  std::vector<Crossing> out(4 * sizes.size());
+  for (std::size_t f = 0; f < sizes.size(); ++f) {
+    if (sizes[f] == 0) continue;
     for (int e = 0; e < 4; ++e) {
-      out.crossings_[4 * f + static_cast<std::size_t>(e)] =
-          EdgeCrossing(faces, out.grid_sizes_, static_cast<int>(f), e);
+      out[4 * f + static_cast<std::size_t>(e)] = EdgeCrossing(faces, sizes, static_cast<int>(f), e);
     }
   }
   return out;
+}
+
+std::array<int, 2> SculptMapping::CrossEdge(const Crossing& crossing, int x, int y) {
+  const Point p = Apply(Iso{crossing.q, crossing.tx, crossing.ty}, {x, y});
+  return {p.x, p.y};
+}
+
+VertexId SculptMapping::GridVertex(int face, int a, int b, const Mesh& sculpt) const {
+  // The vertex is the (a > i, b > j) corner of cell (i, j); the cell's corners (i, j),
+  // (i + 1, j), (i + 1, j + 1), (i, j + 1) are its sculpt face's corners r, r + 1, r + 2, r + 3.
+  const int m = grid_size(face);
+  const int i = std::min(a, m - 1), j = std::min(b, m - 1);
+  static constexpr int kCorner[2][2] = {{0, 3}, {1, 2}};  // [a > i][b > j]
+  const std::uint32_t c = cell(face, i, j);
+  const auto f = static_cast<std::size_t>(FaceOf(c));
+  const int k = (RotationOf(c) + kCorner[a > i][b > j]) & 3;
+  return VertexId(sculpt.face_indices[4 * f + static_cast<std::size_t>(k)]);
 }
 
 void SculptMapping::GridVertices(int face, const Mesh& sculpt, std::vector<VertexId>& out) const {
   const int m = grid_size(face);
   const auto side = static_cast<std::size_t>(m) + 1;
   out.resize(side * side);
-  // The corner of cell (i, j) at its (i + di, j + dj) corner: the cell's corners (i, j),
-  // (i + 1, j), (i + 1, j + 1), (i, j + 1) are its sculpt face's corners r, r + 1, r + 2, r + 3.
-  const auto corner = [&](int i, int j, int k) {
-    const std::uint32_t c = cell(face, i, j);
-    const auto f = static_cast<std::size_t>(FaceOf(c));
-    return VertexId(sculpt.face_indices[4 * f + static_cast<std::size_t>((RotationOf(c) + k) & 3)]);
-  };
   for (int b = 0; b <= m; ++b) {
     for (int a = 0; a <= m; ++a) {
-      const int i = std::min(a, m - 1), j = std::min(b, m - 1);
-      static constexpr int kCorner[2][2] = {{0, 3}, {1, 2}};  // [a > i][b > j]
       out[static_cast<std::size_t>(b) * side + static_cast<std::size_t>(a)] =
-          corner(i, j, kCorner[a > i][b > j]);
+          GridVertex(face, a, b, sculpt);
     }
   }
 }

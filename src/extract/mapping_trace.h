@@ -41,6 +41,7 @@
 // decide, go ring by ring in double.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -86,6 +87,8 @@ class SculptMapping {
   // The (m + 1)^2 sculpt vertices of face `face`'s grid (m = grid_size(face) > 0) row by row,
   // vertex (a, b) at b (m + 1) + a, read from its cells' corners.
   void GridVertices(int face, const Mesh& sculpt, std::vector<VertexId>& out) const;
+  // Vertex (a, b) of that grid alone, 0 <= a, b <= m.
+  VertexId GridVertex(int face, int a, int b, const Mesh& sculpt) const;
   std::size_t bytes() const;
 
   // Ptex faces whose samples all go to a BVH: within two faces of a sculpt quad turned over
@@ -117,6 +120,13 @@ class SculptMapping {
   const Crossing& crossing(int face, int edge) const {
     return crossings_[4 * static_cast<std::size_t>(face) + static_cast<std::size_t>(edge)];
   }
+  // Where point (x, y) of a face's grid, in half-cell units, lies in the grid of the face
+  // `crossing` leads to.
+  static std::array<int, 2> CrossEdge(const Crossing& crossing, int x, int y);
+  // The crossings of every Ptex face's edges for grids of these sizes, 4 per face (the
+  // default Crossing for a hole face): what Build keeps, for users of a correspondence alone.
+  static std::vector<Crossing> Crossings(std::span<const PtexFaceInfo> faces,
+                                         std::span<const std::int32_t> sizes);
 
  private:
   int levels_ = 0;

@@ -169,13 +169,9 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
           w.uv[2 * k + 1] = p.v;
         }
         if (settings.interpolate) {  // no rays: the face's grid of vertex displacements
-          const int m =
-              vector ? correspondence->grid_size(face) : inputs.mapping->grid_size(face.value);
-          if (!vector)
-            inputs.mapping->GridVertices(face.value, inputs.sculpt, w.face.grid_vertices);
-          DISPEX_RETURN_IF_ERROR(w.face.grid.Evaluate(
-              face, m, vector ? correspondence->grid(face) : w.face.grid_vertices, inputs.sculpt,
-              w.face.evaluator, /*normals=*/!vector));
+          DISPEX_RETURN_IF_ERROR(w.face.grid.Evaluate(face, *inputs.grids, inputs.sculpt,
+                                                      w.face.evaluator, /*normals=*/!vector));
+          w.face.grid.SetSampling(0);  // UV texels sit at no fixed place against the vertices
           for (std::size_t k = 0; k < count; ++k) {
             const auto [tile, texel] = by_face.texels[begin + k];
             const double u = w.uv[2 * k], v = w.uv[2 * k + 1];

@@ -56,9 +56,9 @@ Status SampleFace(PtexFaceId face, int n, VectorSpace space, bool interpolate,
   DISPEX_RETURN_IF_ERROR(
       w.evaluator.EvaluateGridFrames(face, n, n, {w.positions, w.normals, w.du, w.dv}));
   if (interpolate) {
-    DISPEX_RETURN_IF_ERROR(w.grid.Evaluate(face, correspondence.grid_size(face),
-                                           correspondence.grid(face), inputs.sculpt, w.evaluator,
-                                           /*normals=*/false));
+    DISPEX_RETURN_IF_ERROR(
+        w.grid.Evaluate(face, *inputs.grids, inputs.sculpt, w.evaluator, /*normals=*/false));
+    w.grid.SetSampling(n);
   }
   stats.samples = static_cast<std::int64_t>(count);
   stats.normal_min = std::numeric_limits<float>::infinity();
@@ -196,14 +196,24 @@ std::vector<Hash128> VectorFaceKeys(const ExtractInputs& inputs, const ExtractSe
   global.Add(SettingsKey(settings)).Add(std::string_view("vector")).Add(VectorSpaceName(space));
   const Hash128 settings_key = global.Digest();
   std::vector<Hash128> keys(static_cast<std::size_t>(surface.num_ptex_faces()));
-  tbb::enumerable_thread_specific<std::vector<Float3>> grids;
+  struct Scratch {
+    std::vector<VertexId> ids;
+    std::vector<int> faces;
+    std::vector<Float3> points;
+  };
+  tbb::enumerable_thread_specific<Scratch> scratches;
   tbb::parallel_for(std::size_t{0}, keys.size(), [&](std::size_t f) {
     Hasher h;
     h.Add(settings_key);
     AddFacePatchKey(h, surface, patches, settings, f);
     const PtexFaceId face(static_cast<int>(f));
-    AddGridKey(h, inputs.sculpt, correspondence.grid_size(face), correspondence.grid(face),
-               grids.local());
+    Scratch& w = scratches.local();
+    if (settings.interpolate) {
+      AddFieldKey(h, inputs, patches, face.value, w.ids, w.faces, w.points);
+    } else {
+      AddGridKey(h, inputs.sculpt, correspondence.grid_size(face), correspondence.grid(face),
+                 w.points);
+    }
     keys[f] = h.Digest();
   });
   return keys;
@@ -425,6 +435,10 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
   report.mapping_rms_offset = correspondence->rms_offset;
   report.search_distance = match.max_offset;
   inputs.interpolate = options.method != ExtractMethod::kMapping;
+  // `correspondence` outlives every use of the grids: the run ends in this function.
+  if (inputs.interpolate) {
+    inputs.grids = std::make_unique<CorrespondenceGrids>(*correspondence, inputs.faces);
+  }
   report.method = inputs.interpolate ? ExtractMethod::kInterpolate : ExtractMethod::kMapping;
   DISPEX_ASSIGN_OR_RETURN(ExtractSettings settings, ResolveSettings(options, inputs, report));
   if (CancelRequested()) return Cancelled();

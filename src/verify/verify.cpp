@@ -718,6 +718,8 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
       // Sequential, so the worst record is the first of the largest ratio.
       r.truth_local_checked = true;
       r.truth_local_tolerance_factor = options.truth_local_tolerance_factor;
+      std::vector<float> local_errors;
+      local_errors.reserve(truth.size());
       for (std::size_t i = 0; i < truth.size(); ++i) {
         double bound = options.truth_local_tolerance_factor * r.truth_tolerance +
                        2.0 * double(truth.local_error[i]);
@@ -725,6 +727,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
           ++r.truth_unbounded;
           continue;
         }
+        local_errors.push_back(truth.local_error[i]);
         double ratio = double(errors[i]) / bound;
         if (ratio > 1) ++r.truth_over_bound;
         if (ratio > r.truth_worst_ratio || !std::isfinite(ratio)) {
@@ -740,6 +743,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
           }
         }
       }
+      r.truth_local_error = Summarise(local_errors);
     }
     r.truth = Summarise(errors);
     r.measured_truth = true;
@@ -878,6 +882,7 @@ std::string VerifyReportJson(const VerifyReport& r) {
       bound["records_over"] = r.truth_over_bound;
       bound["records_unbounded"] = r.truth_unbounded;
       bound["worst_ratio"] = r.truth_worst_ratio;
+      bound["local_error"] = StatsJson(r.truth_local_error, r.diagonal);
       bound["worst_record"] = {{"index", w.index},
                                {"face", w.face},
                                {"u", w.u},

@@ -1,7 +1,10 @@
 // Vector displacement maps: D = sculpt - limit surface, read through the correspondence.
 // The expected D at a sample comes from OpenSubdiv's own uniform refinement (RefineUniform
 // with face charts: every sculpt quad's Ptex face and corner (u, v)), not from the
-// correspondence: bilinear over the sculpt quad holding the sample, minus the limit point.
+// correspondence: the displacements of the sculpt quad's corners from their limit points,
+// corrected for the blend of the samples around each vertex (D - (m / 4n) L D, L D the sum of
+// the vertex's four neighbours in the sculpt's own edges - 4 D; none at a grid corner or on an
+// open border: src/extract/vertex_displacements.h), bilinear over the quad.
 //  - At full resolution every texel equals it to float rounding, in every space (rejects a
 //    wrong cell, a rotated or mirrored grid, a wrong frame, derivatives on the wrong scale).
 //  - Under the bound rule every sample's per-face read-back is within the tolerance of it
@@ -17,7 +20,9 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <map>
+#include <set>
 #include <tuple>
 
 #include "dispex/extract.h"
@@ -40,7 +45,46 @@ using testing::TempDir;
 struct ReferenceGrid {
   std::map<std::tuple<int, int, int>, int> vertex;
   std::vector<int> cells;  // per Ptex face: n
+  // Per sculpt vertex: L D from the sculpt's edges, each vertex's D at its limit point.
+  std::vector<std::array<double, 3>> bend;
 };
+
+// L D per sculpt vertex: its four edge neighbours' D - 4 D, D = the vertex minus its limit
+// point (at one of its grid places); 0 at a corner of any face's grid and where the vertex has
+// another number of neighbours (an open border).
+std::vector<std::array<double, 3>> Bends(const ReferenceGrid& ref, const LimitSurface& surface,
+                                         const Mesh& sculpt) {
+  const std::size_t count = sculpt.positions.size();
+  std::vector<std::array<double, 3>> d(count), bend(count, {0, 0, 0});
+  std::vector<std::uint8_t> corner(count, 0);
+  LimitEvaluator eval(surface);
+  for (const auto& [place, id] : ref.vertex) {
+    const auto [f, i, j] = place;
+    const int n = ref.cells[static_cast<std::size_t>(f)];
+    if ((i == 0 || i == n) && (j == 0 || j == n)) corner[static_cast<std::size_t>(id)] = 1;
+    const float uv[2] = {static_cast<float>(i) / n, static_cast<float>(j) / n};
+    float p[3];
+    EXPECT_TRUE(eval.EvaluatePoints(PtexFaceId(f), uv, p, {}).ok());
+    const Float3 q = sculpt.positions[static_cast<std::size_t>(id)];
+    d[static_cast<std::size_t>(id)] = {double(q.x) - p[0], double(q.y) - p[1], double(q.z) - p[2]};
+  }
+  std::vector<std::set<int>> neighbours(count);
+  for (std::size_t q = 0; q < sculpt.num_faces(); ++q) {
+    for (std::size_t c = 0; c < 4; ++c) {
+      const int a = sculpt.face_indices[4 * q + c], b = sculpt.face_indices[4 * q + (c + 1) % 4];
+      neighbours[static_cast<std::size_t>(a)].insert(b);
+      neighbours[static_cast<std::size_t>(b)].insert(a);
+    }
+  }
+  for (std::size_t v = 0; v < count; ++v) {
+    if (corner[v] || neighbours[v].size() != 4) continue;
+    for (int k = 0; k < 3; ++k) {
+      bend[v][k] = -4 * d[v][k];
+      for (const int w : neighbours[v]) bend[v][k] += d[static_cast<std::size_t>(w)][k];
+    }
+  }
+  return bend;
+}
 
 ReferenceGrid BuildReference(const LimitSurface& surface, int levels, const Mesh& sculpt) {
   ReferenceGrid ref;
@@ -64,23 +108,30 @@ ReferenceGrid BuildReference(const LimitSurface& surface, int levels, const Mesh
       ref.vertex[{f, i, j}] = sculpt.face_indices[4 * q + static_cast<std::size_t>(c)];
     }
   }
+  ref.bend = Bends(ref, surface, sculpt);
   return ref;
 }
 
-// D at (u, v) of `face` (ExtractMethod::kInterpolate): the displacements of the sculpt quad's
-// corners from the limit points at their grid places, bilinear over the quad.
+// D at (u, v) of `face` sampled `samples` a side (ExtractMethod::kInterpolate): the
+// displacements of the sculpt quad's corners from the limit points at their grid places,
+// corrected for the blend, bilinear over the quad.
 Float3 ExpectedD(const ReferenceGrid& ref, const Mesh& sculpt, LimitEvaluator& eval, int face,
-                 float u, float v) {
+                 float u, float v, int samples) {
   const int n = ref.cells[static_cast<std::size_t>(face)];
+  const double sharpen = double(n) / (4.0 * samples);
   const int i = std::min(static_cast<int>(u * n), n - 1),
             j = std::min(static_cast<int>(v * n), n - 1);
   const double s = u * n - i, t = v * n - j;
   auto at = [&](int di, int dj) {
-    const Float3 q = sculpt.positions[ref.vertex.at({face, i + di, j + dj})];
+    const int id = ref.vertex.at({face, i + di, j + dj});
+    const Float3 q = sculpt.positions[static_cast<std::size_t>(id)];
     const float uv[2] = {static_cast<float>(i + di) / n, static_cast<float>(j + dj) / n};
     float p[3];
     EXPECT_TRUE(eval.EvaluatePoints(PtexFaceId(face), uv, p, {}).ok());
-    return std::array<double, 3>{double(q.x) - p[0], double(q.y) - p[1], double(q.z) - p[2]};
+    const std::array<double, 3>& bend = ref.bend[static_cast<std::size_t>(id)];
+    return std::array<double, 3>{double(q.x) - p[0] - sharpen * bend[0],
+                                 double(q.y) - p[1] - sharpen * bend[1],
+                                 double(q.z) - p[2] - sharpen * bend[2]};
   };
   const auto a = at(0, 0), b = at(1, 0), c = at(1, 1), d = at(0, 1);
   double out[3];
@@ -183,7 +234,7 @@ TEST_P(VectorMapTest, FullResolutionHoldsTheSculptAtEverySample) {
       for (int j = 0; j < n; ++j) {
         for (int i = 0; i < n; ++i) {
           const float u = (i + 0.5f) / n, v = (j + 0.5f) / n;
-          const Float3 want = ExpectedD(ref_, sculpt_, eval, f, u, v);
+          const Float3 want = ExpectedD(ref_, sculpt_, eval, f, u, v, n);
           worst = std::max(worst, Distance(MapD(*map, space, eval, f, u, v), want));
           largest = std::max(largest, Distance(want, {0, 0, 0}));
         }
@@ -226,7 +277,7 @@ void VectorMapTest::ExpectWithinTolerance(VectorSpace space) {
       for (int i = 0; i < n; ++i) {
         const float u = (i + 0.5f) / n, v = (j + 0.5f) / n;
         worst = std::max(worst, Distance(MapD(*map, space, eval, f, u, v),
-                                         ExpectedD(ref_, sculpt_, eval, f, u, v)));
+                                         ExpectedD(ref_, sculpt_, eval, f, u, v, n)));
       }
     }
   }
@@ -321,7 +372,7 @@ TEST(VectorMapEdges, AllPinsEdgesSoThePerFaceReaderMeetsTheTruthAtBorders) {
 }
 
 // Under the cross-face filter a face coarser than its neighbour steps where they meet: Spot's
-// overhang without the rounds steps by 1.8 (object) and 2.6 (tangent) tolerances, measured.
+// overhang without the rounds steps by 1.85 (object) and 1.06 (tangent) tolerances, measured.
 // The default (`filter`) raises faces until D's step in object space is within the tolerance
 // on every edge, as verify measures it (rejects rounds that do not run; the step checked is
 // verify's, of D, whatever the rounds measure).
@@ -353,7 +404,9 @@ TEST(VectorMapEdges, FilterHoldsTheCrossFaceStepsOfD) {
       const double tau = report->tolerance;
       const double step = verified->edge_across_faces.max;
       if (mode == WatertightEdges::kOff) {
-        EXPECT_GT(step, 1.5 * tau) << "the case must step";
+        std::printf("%s without the rounds: step %.3g tolerances\n",
+                    std::string(VectorSpaceName(space)).c_str(), step / tau);
+        EXPECT_GT(step, tau) << "the case must step";
         continue;
       }
       EXPECT_GT(report->edge_raised_faces, 0);

@@ -18,9 +18,11 @@
 //    match the differences (so the oracle itself does not assume the factor);
 //  - every texel of a full-resolution map, turned into D by the frame docs/VECTOR.md states
 //    (built from the oracle's P, dP/du, dP/dv, N), is the displacements of the sculpt's
-//    vertices from their limit points interpolated bilinearly at the texel centre (the default
-//    method, interpolate), to float rounding; the sculpt's vertices are found by their limit
-//    points (oracle) and checked against the truth's D;
+//    vertices from their limit points, corrected for the blend of the samples around each
+//    vertex (D - (m / 4n) L D, L D from the sculpt's own edges: the sum of a vertex's four
+//    neighbours - 4 D, none at a grid corner or on an open border) and interpolated bilinearly
+//    at the texel centre (the default method, interpolate), to float rounding; the sculpt's
+//    vertices are found by their limit points (oracle) and checked against the truth's D;
 //  - the same check rejects each wrong frame on the sub-faces: derivatives x2 (OpenSubdiv's
 //    own) or x0.5, u and v swapped, tangent channels scaled; a tangent frame does not depend
 //    on the derivatives' length (the x2 and x0.5 frames give the same D);
@@ -42,6 +44,7 @@
 #include <functional>
 #include <memory>
 #include <ostream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -400,6 +403,7 @@ TEST_P(NonQuadVector, OracleDerivativesArePtexDerivatives) {
 struct SculptGrid {
   std::vector<int> cells;                // per Ptex face
   std::vector<std::vector<V3>> corners;  // per Ptex face, (n + 1)^2, row by row
+  std::vector<std::vector<V3>> bends;    // the same places: L D of the vertex there
   double match_max = 0;                  // the farthest match (limit points), object units
   double truth_max = 0;                  // max |sculpt vertex - (limit point + truth D)|
 };
@@ -417,10 +421,13 @@ SculptGrid BuildSculptGrid(const FarLimit& far, const std::string& sculpt_path, 
     const V3 d{truth->d[3 * i], truth->d[3 * i + 1], truth->d[3 * i + 2]};
     grid.truth_max = std::max(grid.truth_max, Length(position[i] - (limit[i] + d)));
   }
+  std::vector<std::vector<std::size_t>> ids;  // per Ptex face, the vertex at each grid place
+  std::vector<std::uint8_t> grid_corner(limit.size(), 0);
   for (int f = 0; f < far.num_ptex_faces(); ++f) {
     const int n = far.sub_face(f) ? 1 << (levels - 1) : 1 << levels;
     grid.cells.push_back(n);
     std::vector<V3>& corners = grid.corners.emplace_back();
+    std::vector<std::size_t>& face_ids = ids.emplace_back();
     for (int j = 0; j <= n; ++j) {
       for (int i = 0; i <= n; ++i) {
         const V3 p = far.Evaluate(f, double(i) / n, double(j) / n);
@@ -432,22 +439,51 @@ SculptGrid BuildSculptGrid(const FarLimit& far, const std::string& sculpt_path, 
         }
         grid.match_max = std::max(grid.match_max, best_d);
         corners.push_back(position[best]);
+        face_ids.push_back(best);
+        if ((i == 0 || i == n) && (j == 0 || j == n)) grid_corner[best] = 1;
       }
     }
+  }
+  // L D from the sculpt's edges: a vertex's four neighbours' D - 4 D, D = vertex - limit point.
+  std::vector<std::set<int>> neighbours(limit.size());
+  for (std::size_t q = 0, first = 0; q < sculpt.sizes.size(); first += sculpt.sizes[q++]) {
+    const std::size_t size = static_cast<std::size_t>(sculpt.sizes[q]);
+    for (std::size_t c = 0; c < size; ++c) {
+      const int a = sculpt.indices[first + c], b = sculpt.indices[first + (c + 1) % size];
+      neighbours[static_cast<std::size_t>(a)].insert(b);
+      neighbours[static_cast<std::size_t>(b)].insert(a);
+    }
+  }
+  std::vector<V3> bend(limit.size(), V3{0, 0, 0});
+  for (std::size_t v = 0; v < limit.size(); ++v) {
+    if (grid_corner[v] || neighbours[v].size() != 4) continue;
+    bend[v] = (position[v] - limit[v]) * -4.0;
+    for (const int w : neighbours[v]) {
+      bend[v] =
+          bend[v] + (position[static_cast<std::size_t>(w)] - limit[static_cast<std::size_t>(w)]);
+    }
+  }
+  for (const std::vector<std::size_t>& face_ids : ids) {
+    std::vector<V3>& bends = grid.bends.emplace_back();
+    for (const std::size_t id : face_ids) bends.push_back(bend[id]);
   }
   return grid;
 }
 
-// D at (u, v) of face f as docs/VECTOR.md defines it: the displacements of the corners of the
-// cell of the face's grid that holds (u, v) from their limit points, bilinear over the cell.
-V3 SculptD(const FarLimit& far, const SculptGrid& grid, int f, double u, double v) {
+// D at (u, v) of face f sampled `samples` a side, as docs/VECTOR.md defines it: the
+// displacements of the corners of the cell of the face's grid that holds (u, v) from their
+// limit points, corrected for the blend, bilinear over the cell.
+V3 SculptD(const FarLimit& far, const SculptGrid& grid, int f, double u, double v, int samples) {
   const int n = grid.cells[static_cast<std::size_t>(f)];
+  const double sharpen = double(n) / (4.0 * samples);
   const int i = std::min(static_cast<int>(u * n), n - 1),
             j = std::min(static_cast<int>(v * n), n - 1);
   const double s = u * n - i, t = v * n - j;
   const std::vector<V3>& c = grid.corners[static_cast<std::size_t>(f)];
+  const std::vector<V3>& bends = grid.bends[static_cast<std::size_t>(f)];
   auto at = [&](int di, int dj) {
-    return c[static_cast<std::size_t>((j + dj) * (n + 1) + i + di)] -
+    const auto k = static_cast<std::size_t>((j + dj) * (n + 1) + i + di);
+    return c[k] - bends[k] * sharpen -
            far.Evaluate(f, static_cast<double>(i + di) / n, static_cast<double>(j + dj) / n);
   };
   return at(0, 0) * ((1 - s) * (1 - t)) + at(1, 0) * (s * (1 - t)) + at(1, 1) * (s * t) +
@@ -473,7 +509,7 @@ MapCheck CheckMap(const FarLimit& far, const SculptGrid& grid, const PtexFile& m
       for (int i = 0; i < info.ures(); ++i) {
         const double u = (i + 0.5) / info.ures(), v = (j + 0.5) / info.vres();
         const FarLimit::Frame frame = far.At(f, u, v);
-        const V3 want = SculptD(far, grid, f, u, v);
+        const V3 want = SculptD(far, grid, f, u, v, info.ures());
         const float* c = &texels[3 * (static_cast<std::size_t>(j) * info.ures() + i)];
         const V3 got = DocumentedD(space, frame, c, sub == 1, error);
         out.max_error[sub] = std::max(out.max_error[sub], Length(got - want));
