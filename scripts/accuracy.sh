@@ -11,7 +11,7 @@
 # between its "accuracy-table" markers (only when every row is within its bounds).
 # Negative controls: on every row the same verify --truth must fail (exit 3) each of the map's
 # wrong copies that the row lists (zero: every texel 0; x0.8: scaled by 0.8; sign: negated;
-# written by the Python below, which rewrites the Ptex file's texels and keeps the rest); the
+# written by scripts/scale-ptex.py, which rewrites the Ptex file's texels and keeps the rest); the
 # script exits 1 naming any wrong map that passes, and marks its row.
 # --quick: a reduced set (one refined and one jittered sculpt per small cage) for CI.
 # ACCURACY_VERIFY_ARGS: more options for verify (e.g. "--truth-rms-factor 0.1" to see it fail).
@@ -84,73 +84,6 @@ table="$work/table.md"
 failures=()
 control_failures=()
 
-# scale_ptex.py IN OUT S: the Ptex map IN with every texel (level 0, reductions, constant
-# values, tiles) multiplied by S, float or half; face records, adjacency and meta data kept.
-cat >"$work/scale_ptex.py" <<'EOF'
-import struct, sys, zlib
-src, dst, scale = sys.argv[1], sys.argv[2], float(sys.argv[3])
-b = open(src, "rb").read()
-head = bytearray(b[:64])  # sizes: extended header, face info, constant data, level info
-dtype, nlev, ext, fiz, cz, lis = (struct.unpack_from("<I", b, 12)[0],
-                                  struct.unpack_from("<H", b, 22)[0],
-                                  *struct.unpack_from("<4I", b, 28))
-code, size = {2: ("e", 2), 3: ("f", 4)}[dtype]  # half, float
-xh = bytearray(b[64:64 + ext])
-if ext >= 32 and struct.unpack_from("<Q", xh, 24)[0]:
-    sys.exit("scale_ptex.py: %s has edit blocks" % src)
-
-
-def values(raw):
-    n = len(raw) // size
-    return struct.pack("<%d%s" % (n, code), *(v * scale for v in struct.unpack(
-        "<%d%s" % (n, code), raw)))
-
-
-def blocks(data, fdhs):  # the blocks after a header of face data headers, rewritten
-    out, at, headers = [], 0, []
-    for fdh in fdhs:
-        n, enc = fdh & 0x3FFFFFFF, fdh >> 30
-        block = data[at:at + n]
-        at += n
-        if n and enc == 0:  # constant
-            block = values(block)
-        elif n and enc == 1:  # zipped
-            block = zlib.compress(values(zlib.decompress(block)))
-        elif n and enc == 3:  # tiled: u8 u8 tile log2s, u32 header size, header, tiles
-            hz = struct.unpack_from("<I", block, 2)[0]
-            raw = zlib.decompress(block[6:6 + hz])
-            th, tiles = blocks(block[6 + hz:], struct.unpack("<%dI" % (len(raw) // 4), raw))
-            th = zlib.compress(th)
-            block = block[:2] + struct.pack("<I", len(th)) + th + tiles
-        elif n:
-            sys.exit("scale_ptex.py: %s: encoding %d" % (src, enc))
-        headers.append(len(block) | enc << 30)
-        out.append(block)
-    return struct.pack("<%dI" % len(headers), *headers), b"".join(out)
-
-
-pos = 64 + ext + fiz
-const = zlib.compress(values(zlib.decompress(b[pos:pos + cz])))
-pos += cz
-level_infos = [struct.unpack_from("<QII", b, pos + 16 * l) for l in range(nlev)]
-pos += lis
-infos, levels = b"", b""
-for level_size, hz, entries in level_infos:
-    h, data = blocks(b[pos + hz:pos + level_size],
-                     struct.unpack("<%dI" % entries, zlib.decompress(b[pos:pos + hz])))
-    h = zlib.compress(h)
-    infos += struct.pack("<QII", len(h) + len(data), len(h), entries)
-    levels += h + data
-    pos += level_size
-rest = b[pos:]  # meta data, kept
-struct.pack_into("<I", head, 36, len(const))
-struct.pack_into("<Q", head, 48, len(levels))
-size = 64 + ext + fiz + len(const) + lis + len(levels) + len(rest)
-if ext >= 40 and struct.unpack_from("<Q", xh, 32)[0]:  # editdatapos: the end of the file
-    struct.pack_into("<Q", xh, 32, size)
-open(dst, "wb").write(head + xh + b[64 + ext:64 + ext + fiz] + const + infos + levels + rest)
-EOF
-
 # One row: row NAME CAGE-PATH LAYOUT AMPLITUDE PATTERN LABEL CONTROLS
 row() {
   local name="$1" cage="$2" layout="$3" amplitude="$4" pattern="$5" label="$6" controls="$7"
@@ -184,7 +117,7 @@ row() {
       sign) scale=-1 ;;
       *) echo "accuracy.sh: unknown control $control" >&2; exit 2 ;;
     esac
-    python3 "$work/scale_ptex.py" "$work/map.ptx" "$work/wrong.ptx" "$scale"
+    python3 "$root/scripts/scale-ptex.py" "$work/map.ptx" "$work/wrong.ptx" "$scale"
     code=0
     # shellcheck disable=SC2086
     "$dispex" verify "$cage" "$work/wrong.ptx" --truth "$sculpt.truth" -q \
