@@ -45,6 +45,8 @@ int RunConvert(const ConvertArgs& args) {
     return ReportFailure(
         Status::Error(fmt::format("{}: the output must differ from the input", args.output)));
   }
+  const Status outputs = CheckOutputs({{"OUTPUT", args.output}});
+  if (!outputs.ok()) return ReportFailure(outputs, 2);
   const auto read_start = std::chrono::steady_clock::now();
   auto mesh = ReadMesh(args.input);
   if (!mesh.ok()) return ReportFailure(mesh.status());

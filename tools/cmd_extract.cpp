@@ -183,6 +183,9 @@ Status Resolve(ExtractArgs& a) {
     return Status::Error(
         fmt::format("--report {}: must differ from the inputs and the output", a.report_path));
   }
+  DISPEX_RETURN_IF_ERROR(CheckOutputs({{"--report", a.report_path},
+                                       {"--preview", a.preview_dir, /*folder=*/true},
+                                       {"--out-dir", a.output_dir, /*folder=*/true}}));
   if (a.asset()) {
     if (!o.output_path.empty()) return Status::Error("give -o or --out-dir/--manifest, not both");
     if (!a.manifest_path.empty() && !a.shapes.empty()) {

@@ -40,6 +40,8 @@ int RunMakeSculpt(MakeSculptArgs& args) {
     return ReportFailure(
         Status::Error(fmt::format("--density {}: must be 2..256", args.options.density)), 2);
   }
+  const Status outputs = CheckOutputs({{"-o", args.options.output_path}});
+  if (!outputs.ok()) return ReportFailure(outputs, 2);
   auto report = MakeSculpt(args.options);
   if (!report.ok()) return ReportFailure(report.status(), kMakeSculptFlags);
   if (!args.quiet) {

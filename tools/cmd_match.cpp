@@ -51,6 +51,8 @@ std::string MatchJson(const MatchArgs& args, const LimitSurface& surface, const 
 }
 
 int RunMatch(MatchArgs& args) {
+  const Status outputs = CheckOutputs({{"--json", args.json_path}});
+  if (!outputs.ok()) return ReportFailure(outputs, 2);
   ReadOptions read;
   read.threads = args.options.threads;
   auto base = ReadMesh(args.base_path, read);

@@ -29,6 +29,8 @@ int RunMerge(MergeArgs& args) {
   if (!args.report_path.empty() && args.report_path == args.options.output_path) {
     return ReportFailure(Status::Error("--report: must differ from the output"), 2);
   }
+  const Status outputs = CheckOutputs({{"--report", args.report_path}});
+  if (!outputs.ok()) return ReportFailure(outputs, 2);
   InstallCancelSignalHandlers();
   StatusOr<ExtractReport> report = MergeShards(args.options);
   if (!report.ok()) {

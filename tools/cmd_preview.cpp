@@ -53,6 +53,8 @@ Status Resolve(PreviewArgs& a) {
 int RunPreview(PreviewArgs& args) {
   Status resolved = Resolve(args);
   if (!resolved.ok()) return ReportFailure(resolved, kPreviewFlags, 2);
+  const Status outputs = CheckOutputs({{"-o", args.output_path}});
+  if (!outputs.ok()) return ReportFailure(outputs, 2);
   auto map = PtexFile::Open(args.map_path);
   if (!map.ok()) return ReportFailure(map.status());
   if (args.mode == "auto") args.options.mode = DefaultAtlasMode(*map);

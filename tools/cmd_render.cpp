@@ -65,6 +65,8 @@ Status Resolve(RenderArgs& a) {
 int RunRender(RenderArgs& args) {
   Status resolved = Resolve(args);
   if (!resolved.ok()) return ReportFailure(resolved, kRenderFlags, 2);
+  const Status outputs = CheckOutputs({{"-o", args.output_path}});
+  if (!outputs.ok()) return ReportFailure(outputs, 2);
   const auto start = std::chrono::steady_clock::now();
   ReadOptions read;
   read.threads = args.options.threads;

@@ -48,6 +48,8 @@ int RunVerify(VerifyArgs& args) {
     o.base_path = args.files[0];
     o.map_path = args.files[1];
   }
+  const Status outputs = CheckOutputs({{"--report", args.report_path}});
+  if (!outputs.ok()) return ReportFailure(outputs, 2);
   auto report = Verify(o);
   if (!report.ok()) return ReportFailure(report.status(), kVerifyFlags);
   if (!args.report_path.empty()) {

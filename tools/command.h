@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <initializer_list>
 #include <string>
 
 #include "dispex/status.h"
@@ -22,6 +23,16 @@ struct CommandRegistration {
 
 // Prints "dispex: <message>" on stderr and returns the exit code for a failed run.
 int ReportFailure(const Status& status, int exit_code = 1);
+
+// Checks, before any work, that each output of a command can be written (dispex/files.h:
+// CheckOutputFile, CheckOutputFolder; missing folders are made when it is written): the error
+// names its option. Empty paths (outputs not asked for) pass.
+struct OutputPath {
+  const char* flag;
+  std::string path;
+  bool folder = false;
+};
+Status CheckOutputs(std::initializer_list<OutputPath> outputs);
 
 // True when stderr is a terminal and CI is not set: only then is progress drawn.
 bool StderrIsInteractive();

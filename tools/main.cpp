@@ -10,7 +10,9 @@
 
 #include "command.h"
 #include "dispex/allocator.h"
+#include "dispex/files.h"
 #include "dispex/version.h"
+#include "parse_errors.h"
 
 namespace dispex::cli {
 namespace {
@@ -27,6 +29,16 @@ CommandRegistration::CommandRegistration(int order, CommandSetup setup) {
 int ReportFailure(const Status& status, int exit_code) {
   std::fprintf(stderr, "dispex: %s\n", status.message().c_str());
   return exit_code;
+}
+
+Status CheckOutputs(std::initializer_list<OutputPath> outputs) {
+  for (const OutputPath& output : outputs) {
+    if (output.path.empty()) continue;
+    const Status checked =
+        output.folder ? CheckOutputFolder(output.path) : CheckOutputFile(output.path);
+    if (!checked.ok()) return checked.WithPrefix(output.flag);
+  }
+  return Status::Ok();
 }
 
 bool StderrIsInteractive() {
@@ -77,14 +89,12 @@ int main(int argc, char** argv) {
   std::stable_sort(registry.begin(), registry.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   for (const auto& [order, setup] : registry) setup(app, exit_code);
-  std::string names;
   bool known = false;
   for (const CLI::App* sub : app.get_subcommands({})) {
-    names += (names.empty() ? "" : ", ") + sub->get_name();
     known |= argc > 1 && sub->get_name() == argv[1];
   }
   if (argc > 1 && argv[1][0] != '-' && !known) {
-    std::fprintf(stderr, "dispex: unknown command '%s' (commands: %s)\n", argv[1], names.c_str());
+    std::fprintf(stderr, "%s\n", UnknownCommandMessage(app, argv[1]).c_str());
     return 2;
   }
   try {
@@ -96,9 +106,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::string what = e.what();
-    std::replace(what.begin(), what.end(), '\n', ' ');
-    std::fprintf(stderr, "dispex: %s (see dispex --help)\n", what.c_str());
+    std::fprintf(stderr, "%s\n", ParseErrorMessage(app, e, argc, argv).c_str());
     return 2;
   }
   return exit_code;

@@ -191,8 +191,12 @@ struct ExtractOptions {
 // is split into, resolution 1x1 (each face's own is set when it is written).
 std::vector<PtexFaceInfo> PtexFaceTable(const LimitSurface& surface);
 
-// Checks ranges and combinations; the message names the option.
+// Checks ranges and combinations, and that the outputs can be written (CheckOutputFile,
+// CheckMapName), before any work; the message names the option.
 Status ValidateExtractOptions(const ExtractOptions& options);
+
+// A map's name whose extension says another format (map.exr, map.png, map.obj) is refused.
+Status CheckMapName(const std::string& path);
 
 // Sets one option by its ExtractOptions field name from a value as a manifest gives it
 // (ReadExtractManifest, docs/SHAPES.md) -- JSON text: "0.001", "\"auto\"", "\"64x64\"" --,

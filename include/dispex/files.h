@@ -19,4 +19,12 @@ Status WriteFileAtomically(const std::string& target, const void* data, std::siz
 // these is not the case.
 Status CheckReadableFile(const std::string& path);
 
+// Checks, before any work, that a file can be written at `path`: it is not a folder, and its
+// folder exists or can be made (the nearest folder above it that exists is a folder one can
+// write in). Missing folders are made when the file is written (WriteFileAtomically; the
+// library's maps and pictures alike) and removed again if the write fails.
+Status CheckOutputFile(const std::string& path);
+// The same for an output folder: `path` is a folder or can be made.
+Status CheckOutputFolder(const std::string& path);
+
 }  // namespace dispex

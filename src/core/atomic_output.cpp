@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <utility>
+#include <vector>
 
 namespace dispex {
 
@@ -57,26 +58,82 @@ void RemoveTemporaryOutputs() noexcept {
   }
 }
 
+namespace {
+
+// The folders above `path` that do not exist, the deepest first, and the nearest that does.
+std::vector<std::filesystem::path> MissingFolders(const std::filesystem::path& folder,
+                                                  std::filesystem::path& existing) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> missing;
+  std::error_code ec;
+  fs::path at = folder.empty() ? fs::path(".") : folder;
+  while (!fs::exists(at, ec) && at.has_relative_path()) {
+    missing.push_back(at);
+    const fs::path up = at.parent_path();
+    at = up.empty() ? fs::path(".") : up;
+  }
+  existing = at;
+  return missing;
+}
+
+// `folder` is one or can be made: the nearest that exists is a folder one can write in.
+Status CheckFolder(const std::string& what, const std::filesystem::path& folder) {
+  namespace fs = std::filesystem;
+  fs::path existing;
+  MissingFolders(folder, existing);
+  std::error_code ec;
+  if (!fs::is_directory(existing, ec)) {
+    return Status::Error(what + ": " + existing.string() + " is not a folder");
+  }
+  if (::access(existing.c_str(), W_OK | X_OK) != 0) {
+    return Status::Error(what + ": cannot write in " + existing.string() + ": " + ErrnoText(errno));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status CheckOutputFile(const std::string& path) {
+  namespace fs = std::filesystem;
+  if (path.empty()) return Status::Error("empty output file name");
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return Status::Error(path + ": is a folder");
+  return CheckFolder(path, fs::path(path).parent_path());
+}
+
+Status CheckOutputFolder(const std::string& path) {
+  namespace fs = std::filesystem;
+  if (path.empty()) return Status::Error("empty output folder name");
+  std::error_code ec;
+  if (fs::exists(path, ec) && !fs::is_directory(path, ec)) {
+    return Status::Error(path + ": is a file, not a folder");
+  }
+  return CheckFolder(path, fs::path(path));
+}
+
 StatusOr<AtomicOutput> AtomicOutput::Create(const std::string& target) {
   namespace fs = std::filesystem;
-  if (target.empty()) return Status::Error("empty output file name");
-  std::error_code ec;
-  fs::path path(target);
-  if (fs::is_directory(path, ec)) return Status::Error(target + ": is a directory");
-  fs::path dir = path.parent_path();
+  DISPEX_RETURN_IF_ERROR(CheckOutputFile(target));
+  fs::path dir = fs::path(target).parent_path();
+  fs::path existing;
+  std::vector<fs::path> made = MissingFolders(dir, existing);
+  for (auto it = made.rbegin(); it != made.rend(); ++it) {
+    std::error_code ec;
+    if (!fs::create_directory(*it, ec) && ec) {
+      for (auto undo = made.rbegin(); undo != it; ++undo) fs::remove(*undo, ec);
+      return Status::Error(target + ": cannot make folder " + it->string() + ": " + ec.message());
+    }
+  }
   if (dir.empty()) dir = ".";
-  if (!fs::exists(dir, ec)) {
-    return Status::Error(target + ": output directory " + dir.string() + " does not exist");
-  }
-  if (!fs::is_directory(dir, ec)) {
-    return Status::Error(target + ": " + dir.string() + " is not a directory");
-  }
   std::string pattern = target + ".tmp.XXXXXX";
   std::string buffer = pattern;
   int fd = ::mkstemp(buffer.data());
   if (fd < 0) {
+    const int err = errno;
+    std::error_code ec;
+    for (const fs::path& folder : made) fs::remove(folder, ec);
     return Status::Error(target + ": cannot create output in " + dir.string() + ": " +
-                         ErrnoText(errno));
+                         ErrnoText(err));
   }
   ::fchmod(
       fd, 0644 & ~[] {
@@ -89,6 +146,7 @@ StatusOr<AtomicOutput> AtomicOutput::Create(const std::string& target) {
   out.temp_ = buffer;
   out.fd_ = fd;
   out.slot_ = RegisterLive(buffer);
+  out.made_folders_ = std::move(made);
   return out;
 }
 
@@ -97,7 +155,8 @@ AtomicOutput::AtomicOutput(AtomicOutput&& other) noexcept
       temp_(std::move(other.temp_)),
       fd_(std::exchange(other.fd_, -1)),
       slot_(std::exchange(other.slot_, -1)),
-      written_(std::exchange(other.written_, 0)) {}
+      written_(std::exchange(other.written_, 0)),
+      made_folders_(std::move(other.made_folders_)) {}
 
 AtomicOutput& AtomicOutput::operator=(AtomicOutput&& other) noexcept {
   if (this != &other) {
@@ -107,6 +166,7 @@ AtomicOutput& AtomicOutput::operator=(AtomicOutput&& other) noexcept {
     fd_ = std::exchange(other.fd_, -1);
     slot_ = std::exchange(other.slot_, -1);
     written_ = std::exchange(other.written_, 0);
+    made_folders_ = std::move(other.made_folders_);
   }
   return *this;
 }
@@ -150,6 +210,7 @@ Status AtomicOutput::Commit() {
   }
   UnregisterLive(std::exchange(slot_, -1));
   temp_.clear();
+  made_folders_.clear();
   return Status::Ok();
 }
 
@@ -160,6 +221,9 @@ void AtomicOutput::Abandon() {
     temp_.clear();
   }
   UnregisterLive(std::exchange(slot_, -1));
+  std::error_code ec;
+  for (const std::filesystem::path& folder : made_folders_) std::filesystem::remove(folder, ec);
+  made_folders_.clear();
 }
 
 Status WriteFileAtomically(const std::string& target, const void* data, std::size_t size) {

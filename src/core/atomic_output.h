@@ -7,7 +7,9 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include "dispex/files.h"  // WriteFileAtomically
 #include "dispex/status.h"
@@ -16,8 +18,8 @@ namespace dispex {
 
 class AtomicOutput {
  public:
-  // Fails with a clear message if the directory is missing or not writable, or the target
-  // is a directory.
+  // Makes the target's missing folders (removed again by Abandon); fails with a clear message
+  // where they cannot be made or written in, or the target is a folder.
   static StatusOr<AtomicOutput> Create(const std::string& target);
 
   AtomicOutput() = default;
@@ -46,6 +48,8 @@ class AtomicOutput {
   int fd_ = -1;
   int slot_ = -1;
   std::size_t written_ = 0;
+  // Folders Create made for the target, the deepest first: removed (when empty) by Abandon.
+  std::vector<std::filesystem::path> made_folders_;
 };
 
 // Unlinks every temporary file of live AtomicOutputs. Async-signal-safe: a SIGINT/SIGTERM

@@ -1,11 +1,15 @@
 #include <fmt/format.h>
 
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
+#include <utility>
 
 #include "dispex/extract.h"
+#include "dispex/files.h"
 #include "dispex/vector_space.h"
 
 namespace dispex {
@@ -90,6 +94,32 @@ bool IsPowerOfTwoIn(int v, int lo, int hi) {
 }
 }  // namespace
 
+Status CheckMapName(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  static const std::pair<const char*, const char*> kOtherFormats[] = {
+      {".exr", "OpenEXR (UV-space tiles are written to uv_maps_dir)"},
+      {".png", "PNG"},
+      {".tif", "TIFF"},
+      {".tiff", "TIFF"},
+      {".jpg", "JPEG"},
+      {".jpeg", "JPEG"},
+      {".tx", "a mipmapped texture (maketx)"},
+      {".tex", "a RenderMan texture"},
+      {".obj", "a mesh (OBJ)"},
+      {".ply", "a mesh (PLY)"},
+      {".json", "JSON"},
+  };
+  for (const auto& [other, format] : kOtherFormats) {
+    if (extension == other) {
+      return Status::Error(fmt::format(
+          "output_path {}: the name says {}, and the map is written as Ptex: name it .ptx", path,
+          format));
+    }
+  }
+  return Status::Ok();
+}
+
 Status ValidateExtractOptions(const ExtractOptions& o) {
   if (o.base_path.empty() && !o.base_mesh) return Status::Error("no base mesh given");
   if (o.sculpt_path.empty() && !o.sculpt_mesh) return Status::Error("no sculpt mesh given");
@@ -170,6 +200,13 @@ Status ValidateExtractOptions(const ExtractOptions& o) {
     return Status::Error(
         "shard_sculpt part: needs method rays and a given search_distance (the correspondence "
         "and the automatic search distance read the whole sculpt)");
+  }
+  DISPEX_RETURN_IF_ERROR(CheckMapName(o.output_path));
+  const Status output = CheckOutputFile(o.output_path);
+  if (!output.ok()) return output.WithPrefix("output_path");
+  if (!o.uv_maps_dir.empty()) {
+    const Status folder = CheckOutputFolder(o.uv_maps_dir);
+    if (!folder.ok()) return folder.WithPrefix("uv_maps_dir");
   }
   SpectralOptions spectral;
   spectral.rule = o.resolution_rule;

@@ -197,11 +197,32 @@ TEST_F(BadInput, SculptCoveringHalfTheBaseIsRefused) {
 }
 
 TEST_F(BadInput, OutputPaths) {
-  ExpectFailure("extract " + cage_ + " " + sculpt_ + " -o " + (dir_ / "nodir") + "/out.ptx",
-                "does not exist");
-  ExpectFailure("extract " + cage_ + " " + sculpt_ + " -o " + sculpt_, "also an input", 2);
-  ExpectFailure("extract " + cage_ + " " + sculpt_ + " -o " + dir_.path().string(),
-                "is a directory");
+  Write("file.txt", "x");
+  const std::string under_file = dir_ / "file.txt/sub";
+  const std::string run = "extract " + cage_ + " " + sculpt_;
+  ExpectFailure(run + " -o " + under_file + "/out.ptx", "-o: " + under_file + "/out.ptx: ", 2);
+  ExpectFailure(run + " -o " + sculpt_, "also an input", 2);
+  ExpectFailure(run + " -o " + dir_.path().string(), "is a folder", 2);
+  ExpectFailure(run + " -o " + (dir_ / "map.exr"), "map.exr: the name says OpenEXR", 2);
+  // Every output is checked before any work: no map is written when the report cannot be.
+  ExpectFailure(run + " -o " + (dir_ / "m.ptx") + " --report " + under_file + "/r.json",
+                "--report: " + under_file + "/r.json", 2);
+  ExpectFailure(run + " -o " + (dir_ / "m.ptx") + " --preview " + (dir_ / "file.txt"),
+                "--preview: " + (dir_ / "file.txt") + ": is a file, not a folder", 2);
+  ExpectFailure("verify " + cage_ + " " + sculpt_ + " " + (dir_ / "no.ptx") + " --report " +
+                    under_file + "/v.json",
+                "--report: ", 2);
+  ExpectFailure("render " + cage_ + " -o " + under_file + "/r.png", "-o: ", 2);
+  // Missing folders are made for every output, and only by a run that writes it: a run that
+  // fails leaves none.
+  ExpectFailure(
+      "extract " + (dir_ / "missing.obj") + " " + sculpt_ + " -o " + (dir_ / "new/out.ptx"),
+      "missing.obj: no such file");
+  const auto made =
+      RunDispex(run + " -q -o " + (dir_ / "a/b/m.ptx") + " --report " + (dir_ / "c/r.json"), dir_);
+  EXPECT_EQ(made.exit_code, 0) << made.err;
+  EXPECT_TRUE(fs::exists(dir_ / "a/b/m.ptx"));
+  EXPECT_TRUE(fs::exists(dir_ / "c/r.json"));
   if (::geteuid() != 0) {
     fs::create_directories(dir_ / "ro");
     ::chmod((dir_ / "ro").c_str(), 0555);

@@ -69,13 +69,37 @@ TEST_F(AtomicOutputTest, SignalCleanupRemovesTemporaries) {
   EXPECT_FALSE(fs::exists(out->temp_path()));
 }
 
-TEST_F(AtomicOutputTest, MissingDirectoryIsAClearError) {
-  auto out = AtomicOutput::Create((dir_ / "nope" / "map.ptx").string());
-  ASSERT_FALSE(out.ok());
-  EXPECT_NE(out.status().message().find("does not exist"), std::string::npos);
+TEST_F(AtomicOutputTest, MissingFoldersAreMadeAndRemovedWhenAbandoned) {
+  const fs::path target = dir_ / "shot" / "maps" / "map.ptx";
+  ASSERT_TRUE(CheckOutputFile(target.string()).ok());
+  EXPECT_FALSE(fs::exists(dir_ / "shot"));  // the check makes nothing
+  {
+    auto out = AtomicOutput::Create(target.string());
+    ASSERT_TRUE(out.ok()) << out.status().message();
+    EXPECT_TRUE(fs::is_directory(dir_ / "shot" / "maps"));
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "shot")) << "an abandoned output leaves no folder";
+  auto out = AtomicOutput::Create(target.string());
+  ASSERT_TRUE(out.ok());
+  ASSERT_TRUE(out->Write("x", 1).ok());
+  ASSERT_TRUE(out->Commit().ok());
+  EXPECT_EQ(Slurp(target), "x");
+}
+
+TEST_F(AtomicOutputTest, OutputsThatCannotBeWrittenAreClearErrors) {
   auto dir = AtomicOutput::Create(dir_.string());
   ASSERT_FALSE(dir.ok());
-  EXPECT_NE(dir.status().message().find("is a directory"), std::string::npos);
+  EXPECT_NE(dir.status().message().find("is a folder"), std::string::npos);
+  std::ofstream(dir_ / "file.txt") << "x";
+  const Status under_file = CheckOutputFile((dir_ / "file.txt" / "sub" / "map.ptx").string());
+  ASSERT_FALSE(under_file.ok());
+  EXPECT_NE(under_file.message().find("file.txt is not a folder"), std::string::npos)
+      << under_file.message();
+  const Status folder = CheckOutputFolder((dir_ / "file.txt").string());
+  ASSERT_FALSE(folder.ok());
+  EXPECT_NE(folder.message().find("is a file, not a folder"), std::string::npos);
+  EXPECT_TRUE(CheckOutputFolder((dir_ / "new" / "tiles").string()).ok());
+  EXPECT_EQ(FileCount(), 1u);
 }
 
 TEST_F(AtomicOutputTest, WriteFileAtomically) {

@@ -245,6 +245,7 @@ TEST_F(ExtractTest, SculptFarAwayIsAClearErrorAndWritesNothing) {
 TEST_F(ExtractTest, BadInputsAreClearErrors) {
   std::string empty = dir_ / "empty.obj", no_faces = dir_ / "points.obj";
   std::ofstream(empty).close();
+  std::ofstream(dir_ / "file.txt") << "x";
   std::ofstream(no_faces) << "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
   struct Bad {
     std::string base, sculpt, out, expect;
@@ -254,8 +255,11 @@ TEST_F(ExtractTest, BadInputsAreClearErrors) {
       {cage_, no_faces, dir_ / "a.ptx", "points.obj"},
       {no_faces, sculpt_, dir_ / "a.ptx", "points.obj"},
       {cage_, dir_ / "missing.obj", dir_ / "a.ptx", "missing.obj: no such file"},
-      {cage_, sculpt_, (dir_.path() / "nodir" / "a.ptx").string(), "does not exist"},
+      {cage_, sculpt_, (dir_.path() / "file.txt" / "a.ptx").string(), "is not a folder"},
       {cage_, sculpt_, sculpt_, "also an input"},
+      {cage_, sculpt_, dir_ / "a.exr", "a.exr: the name says OpenEXR"},
+      // The outputs are checked before the meshes are read.
+      {dir_ / "missing.obj", sculpt_, dir_ / "a.png", "a.png: the name says PNG"},
   };
   for (const Bad& bad : cases) {
     ExtractOptions o;

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -521,7 +523,9 @@ TEST(PtexWriterErrors, InvalidInput) {
   o.compressor = PtexCompressor::kZlib;
   o.compression_level = 10;
   create_fails(o, 1, "zlib level");
-  EXPECT_FALSE(PtexWriter::Create((dir / "missing" / "x.ptx").string(), {}, 1).ok());
+  std::ofstream(dir / "file.txt") << "x";  // a file where a folder would be made
+  EXPECT_FALSE(PtexWriter::Create((dir / "file.txt" / "x.ptx").string(), {}, 1).ok());
+  std::filesystem::remove(dir / "file.txt");
 
   StatusOr<PtexWriter> w = PtexWriter::Create(path, {}, 3);
   ASSERT_TRUE(w.ok());

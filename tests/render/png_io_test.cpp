@@ -5,6 +5,7 @@
 
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 
 #include "dispex/render.h"
 #include "render_test_util.h"
@@ -134,10 +135,15 @@ TEST(Png, EveryTruncationIsAnErrorNotACrash) {
 
 TEST(Png, UnwritablePathIsAnErrorAndLeavesNothing) {
   TempDir dir;
-  Status st = WritePng(dir / "no/such/folder/a.png", Pattern(4, 4));
+  std::ofstream(dir / "file.txt") << "x";  // a file where a folder would be made
+  Status st = WritePng(dir / "file.txt/folder/a.png", Pattern(4, 4));
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.message().find("a.png"), std::string::npos) << st.message();
+  fs::remove(dir / "file.txt");
   EXPECT_TRUE(fs::is_empty(dir.path()));
+  // Missing folders are made.
+  ASSERT_TRUE(WritePng(dir / "new/folder/a.png", Pattern(4, 4)).ok());
+  EXPECT_TRUE(fs::exists(dir / "new/folder/a.png"));
 }
 
 TEST(Png, EmptyImageIsAnError) {
