@@ -17,6 +17,7 @@ namespace {
 
 constexpr FlagName kExtractFlags[] = {
     {"output_path", "-o"},
+    {"with check_inputs off", "with --no-input-checks"},
     {"oversample", "--oversample"},
     {"0 (automatic)", "'auto'"},
     {"max_oversample", "--max-oversample"},
@@ -359,6 +360,9 @@ void SetupExtract(CLI::App& app, int& exit_code) {
                   "texels of dilation outside the UV faces, so that filtering at seams never "
                   "reads empty texels")
       ->capture_default_str();
+  cmd->add_flag("!--no-input-checks", o.check_inputs,
+                "extract inputs that look like a mistake: a sculpt with fewer faces than its "
+                "base, or one moved, scaled or turned against it as a whole");
   cmd->add_flag("--incremental", o.incremental,
                 "re-use the map at the output path: left as it is when made from the same "
                 "inputs and options, else only the faces whose inputs changed are extracted "

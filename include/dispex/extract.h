@@ -136,6 +136,12 @@ struct ExtractOptions {
   // (bytes; 0: the memory the machine has available). See EstimateExtractMemory.
   std::uint64_t max_memory = 0;
 
+  // Refuse inputs that do not belong together (docs/ROBUSTNESS.md, "Inputs that do not belong
+  // together"): a sculpt with fewer faces than its base (the two swapped), and a sculpt moved,
+  // scaled or turned against its base as a whole (extract/input_checks.h). Off: extract them
+  // anyway, for a displacement that is meant.
+  bool check_inputs = true;
+
   // Re-use the map already at output_path (docs/INCREMENTAL.md): when the inputs and options
   // are those it was made from, it is left as it is (not rewritten); otherwise only the faces
   // whose key changed are extracted again and the others copied from it. The result is the

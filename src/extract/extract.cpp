@@ -22,6 +22,7 @@
 #include "extract/face_keys.h"
 #include "extract/face_records.h"
 #include "extract/face_totals.h"
+#include "extract/input_checks.h"
 #include "extract/missed_faces.h"
 #include "extract/parallel_errors.h"
 #include "extract/previous_map.h"
@@ -180,6 +181,9 @@ ExtractReport StartReport(const ExtractOptions& options, int threads) {
 StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInputs inputs,
                                      ExtractReport report, const Stopwatch& total_clock,
                                      std::vector<ShardPart>* parts) {
+  if (options.check_inputs) {
+    DISPEX_RETURN_IF_ERROR(CheckFaceCounts(inputs.base, inputs.sculpt));
+  }
   const bool shard = options.shard_count > 0;
   const bool merge = parts != nullptr;
   const std::string map_inputs_key = InputsKey(report).Hex();
@@ -227,6 +231,13 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
     DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
   }
   DISPEX_ASSIGN_OR_RETURN(ExtractSettings settings, ResolveSettings(options, inputs, report));
+  if (options.check_inputs && (mapping || inputs.tracer != nullptr)) {
+    std::optional<MappingGrids> grids;
+    if (mapping) grids.emplace(*inputs.mapping);
+    DISPEX_ASSIGN_OR_RETURN(PlacementFit fit,
+                            MeasurePlacement(inputs, mapping ? &*grids : nullptr, &settings));
+    DISPEX_RETURN_IF_ERROR(CheckPlacement(fit, report.base_diagonal, inputs.sculpt.source));
+  }
   Stopwatch keys_clock;
   const FaceKeys face_keys = ComputeFaceKeys(inputs, settings);
   const std::vector<Hash128>& keys = face_keys.keys;

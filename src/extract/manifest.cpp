@@ -92,6 +92,9 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
     return SetNamed(o.bvh_quality, v, ParseBuildQuality);
   } else if (name == "method") {
     return SetNamed(o.method, v, ParseExtractMethod);
+  } else if (name == "check_inputs") {
+    if (!v.is_boolean()) return Status::Error(fmt::format("{} is not true or false", v.dump()));
+    o.check_inputs = v.get<bool>();
   } else if (name == "vector") {
     if (v == "off") {
       o.vector.reset();
@@ -106,7 +109,7 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
         "ray_policy, tolerance, tolerance_fraction, resolution_rule, fixed_resolution, "
         "nonzero_threshold, "
         "data_type, compression_level, holes, watertight, max_miss_fraction, bvh_quality, "
-        "method, vector)");
+        "method, vector, check_inputs)");
   }
   return Status::Ok();
 }

@@ -24,6 +24,7 @@
 #include "extract/extract_settings.h"
 #include "extract/face_keys.h"
 #include "extract/face_records.h"
+#include "extract/input_checks.h"
 #include "extract/parallel_errors.h"
 #include "extract/process_faces.h"
 #include "extract/uv_maps.h"
@@ -441,6 +442,11 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
   }
   report.method = inputs.interpolate ? ExtractMethod::kInterpolate : ExtractMethod::kMapping;
   DISPEX_ASSIGN_OR_RETURN(ExtractSettings settings, ResolveSettings(options, inputs, report));
+  if (options.check_inputs) {
+    const CorrespondenceGrids grids(*correspondence, inputs.faces);
+    DISPEX_ASSIGN_OR_RETURN(PlacementFit fit, MeasurePlacement(inputs, &grids, &settings));
+    DISPEX_RETURN_IF_ERROR(CheckPlacement(fit, report.base_diagonal, inputs.sculpt.source));
+  }
   if (CancelRequested()) return Cancelled();
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateVectorMap(options, inputs));
 

@@ -108,10 +108,16 @@ TEST_F(BadInput, DegenerateAndNonManifoldBases) {
 }
 
 TEST_F(BadInput, SculptNotOverlappingTheBase) {
-  std::ofstream out(dir_ / "far.obj");
-  out << "v 100 100 100\nv 101 100 100\nv 101 101 100\nv 100 101 100\nf 1 2 3 4\n";
-  out.close();
+  auto far = ReadMesh(sculpt_);
+  ASSERT_TRUE(far.ok());
+  for (Float3& p : far->positions) p = {p.x + 100, p.y + 100, p.z + 100};
+  ASSERT_TRUE(WriteObj(dir_ / "far.obj", *far).ok());
   ExpectFailure(Extract(cage_, dir_ / "far.obj"), "do not overlap");
+}
+
+TEST_F(BadInput, BaseAndSculptSwapped) {
+  ExpectFailure(Extract(sculpt_, cage_), "base and sculpt swapped?");
+  ExpectFailure(Extract(sculpt_, cage_), "extract with --no-input-checks if this is meant");
 }
 
 TEST_F(BadInput, BadOptionValues) {
