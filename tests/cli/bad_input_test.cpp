@@ -186,7 +186,12 @@ TEST_F(BadInput, SculptCoveringHalfTheBaseIsRefused) {
     out << '\n';
   }
   out.close();
-  ExpectFailure(Extract(cage_, dir_ / "half.obj"), "more than the limit of 5%");
+  ExpectFailure(Extract(cage_, dir_ / "half.obj"), "more than --max-miss-fraction (5%)");
+  // The automatic settings are named by their options.
+  ExpectFailure(Extract(cage_, dir_ / "half.obj"),
+                "(automatic), more than --max-miss-fraction (5%): the sculpt covers only part of");
+  ExpectFailure(Extract(cage_, dir_ / "half.obj"),
+                "give a longer --search-distance, or raise --max-miss-fraction");
   // The limit is an option: raised, the same extraction succeeds and reports the fraction.
   auto r = RunDispex(
       Extract(cage_, dir_ / "half.obj", "--max-miss-fraction 1 -q --report " + (dir_ / "r.json")),
