@@ -21,6 +21,7 @@ constexpr FlagName kVerifyFlags[] = {
     {"max_error_rel", "--max-error-rel"},
     {"max_rms", "--max-rms"},
     {"max_p99", "--max-p99"},
+    {"max_mean_tolerances", "--max-mean-tolerances"},
 };
 
 struct VerifyArgs {
@@ -101,6 +102,11 @@ void SetupVerify(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-error-rel", o.max_error_rel,
                   "fail when a max error exceeds this fraction of the bounding-box diagonal")
       ->check(Positive());
+  cmd->add_option("--max-mean-tolerances", o.max_mean_tolerances,
+                  "fail (exit 3) when the mean distance from the sculpt's points to the displaced "
+                  "surface exceeds this many of the map's tolerances (0: off)")
+      ->check(NonNegative())
+      ->capture_default_str();
   cmd->add_option("--max-rms", o.max_rms,
                   "fail (exit 3) when an RMS error exceeds this, object units")
       ->check(Positive());

@@ -197,6 +197,11 @@ struct ExtractOptions {
 // is split into, resolution 1x1 (each face's own is set when it is written).
 std::vector<PtexFaceInfo> PtexFaceTable(const LimitSurface& surface);
 
+// What a map records of each mesh it was made from (dispex:base_fingerprint,
+// dispex:sculpt_fingerprint): "xxh3-128:" and the hash of everything the mesh as read holds that
+// can change a map (positions, faces, subdivision tags; not its groups, UVs or file name).
+std::string MeshFingerprint(const Mesh& mesh);
+
 // Checks ranges and combinations, and that the outputs can be written (CheckOutputFile,
 // CheckMapName), before any work; the message names the option.
 Status ValidateExtractOptions(const ExtractOptions& options);

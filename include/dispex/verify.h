@@ -209,6 +209,13 @@ struct VerifyOptions {
   double max_error_rel = 0;  // the same relative to the base bounding-box diagonal
   double max_rms = 0;        // fail when an RMS error exceeds this (object units; 0: off)
   double max_p99 = 0;        // fail when a 99th percentile exceeds this (object units; 0: off)
+  // Fail when the mean distance from the sculpt's points to the displaced surface exceeds this
+  // many of the map's tolerances (or `tolerance`) (0: off). Judged by default, so that a verify
+  // with no bound given still says whether map and sculpt belong together: good maps reach
+  // 0.5 (a cube refined twice; the bunny scan 0.25), a map against another asset's sculpt
+  // 150. The other way, from the displaced surface, also carries the sagging of the sculpt's
+  // facets between its vertices (9.4 tolerances on that cube) and is not judged by default.
+  double max_mean_tolerances = 2;
   // Bounds against the truth, scaled by the tolerance tau: this one, or 0 for the map's own
   // (its dispex:statistics meta data); with neither they are not checked.
   double tolerance = 0;
@@ -253,6 +260,7 @@ struct VerifyReport {
   VectorSpace map_space = VectorSpace::kTangent;  // of a vector map
   int samples_per_face_min = 0, samples_per_face_max = 0;
   bool measured_distances = false;
+  double distance_tolerance = 0;  // tau of the distances in tolerances (0: none known)
   ErrorStats map_to_sculpt;  // displaced limit surface -> nearest sculpt point
   ErrorStats sculpt_to_map;  // sculpt vertices -> nearest point of the displaced surface
   bool measured_truth = false;

@@ -96,7 +96,8 @@ def verify(base, sculpt, map, *, check=True, **options):
     """Measures `map` over `base` against `sculpt` (None: none) and/or a truth file (truth=PATH).
 
     options: samples_per_face, max_sculpt_points, max_error, max_error_rel, max_rms,
-    tolerance, truth_local_bound, truth_local_tolerance_factor, truth_rms_factor,
+    max_p99, max_mean_tolerances, tolerance, truth_local_bound, truth_local_tolerance_factor,
+    truth_rms_factor,
     truth_p99_factor, max_edge_step, max_edge_step_p99, threads. Returns the report (a dict);
     a map that fails a bound raises dispex.Error, unless check=False.
     """

@@ -64,6 +64,10 @@ void SetVerifyOption(VerifyOptions& o, const std::string& name, const py::handle
     o.max_error_rel = Number(v, name);
   } else if (name == "max_rms") {
     o.max_rms = Number(v, name);
+  } else if (name == "max_p99") {
+    o.max_p99 = Number(v, name);
+  } else if (name == "max_mean_tolerances") {
+    o.max_mean_tolerances = Number(v, name);
   } else if (name == "tolerance") {
     o.tolerance = Number(v, name);
   } else if (name == "truth_local_bound") {
@@ -84,7 +88,7 @@ void SetVerifyOption(VerifyOptions& o, const std::string& name, const py::handle
   } else {
     Unknown(name,
             "truth, samples_per_face, max_sculpt_points, max_error, max_error_rel, max_rms, "
-            "tolerance, truth_local_bound, truth_local_tolerance_factor, truth_rms_factor, "
+            "max_p99, max_mean_tolerances, tolerance, truth_local_bound, truth_local_tolerance_factor, truth_rms_factor, "
             "truth_p99_factor, max_edge_step, max_edge_step_p99, threads");
   }
 }

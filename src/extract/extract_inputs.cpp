@@ -16,13 +16,17 @@
 #include "extract/memory_check.h"
 #include "extract/parallel_errors.h"
 
+namespace dispex {
+
+std::string MeshFingerprint(const Mesh& mesh) {
+  return "xxh3-128:" + extract::MeshContentKey(mesh).Hex();
+}
+
+}  // namespace dispex
+
 namespace dispex::extract {
 
 namespace {
-
-std::string Fingerprint(const Mesh& mesh) {
-  return "xxh3-128:" + MeshContentKey(mesh).Hex();
-}
 
 struct MeshesRead {
   Mesh base;
@@ -55,7 +59,7 @@ StatusOr<MeshesRead> ReadMeshes(const ExtractOptions& options, ExtractReport& re
       Stopwatch clock;
       sculpt_read.emplace(ReadOrCopy(options.sculpt_path, options.sculpt_mesh, read_options));
       report.t_read_sculpt = clock.seconds();
-      if (sculpt_read->ok()) report.sculpt_fingerprint = Fingerprint(sculpt_read->value());
+      if (sculpt_read->ok()) report.sculpt_fingerprint = MeshFingerprint(sculpt_read->value());
     });
     Stopwatch clock;
     base_read.emplace(ReadOrCopy(options.base_path, options.base_mesh, read_options));
@@ -71,7 +75,7 @@ StatusOr<MeshesRead> ReadMeshes(const ExtractOptions& options, ExtractReport& re
   if (!surface_built->ok()) return surface_built->status();
   if (!sculpt_read->ok()) return sculpt_read->status();
   if (CancelRequested()) return Cancelled();
-  report.base_fingerprint = Fingerprint(base_read->value());
+  report.base_fingerprint = MeshFingerprint(base_read->value());
   return MeshesRead{std::move(*base_read).value(), std::move(*sculpt_read).value(),
                     std::move(*surface_built).value()};
 }
@@ -137,8 +141,8 @@ StatusOr<ExtractInputs> ReadInputs(const ExtractOptions& options, std::uint64_t 
 
 StatusOr<ExtractInputs> InputsFromMeshes(const ExtractOptions& options, Mesh base, Mesh sculpt,
                                          std::uint64_t memory_limit, ExtractReport& report) {
-  report.base_fingerprint = Fingerprint(base);
-  report.sculpt_fingerprint = Fingerprint(sculpt);
+  report.base_fingerprint = MeshFingerprint(base);
+  report.sculpt_fingerprint = MeshFingerprint(sculpt);
   Stopwatch clock;
   DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
   report.t_topology = clock.seconds();

@@ -627,6 +627,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   std::vector<PtexFaceInfo> map_faces;
   std::vector<std::vector<std::vector<float>>> map_fields;
   std::optional<PtexMapSampler> sampler;
+  std::string map_sculpt_fingerprint;
   if (IsUvMapPath(options.map_path)) {
     DISPEX_ASSIGN_OR_RETURN(uv, UvMap::Open(options.map_path));
     if (uv->channels() == 3) {
@@ -682,6 +683,9 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
             j.value("faces_filled_from_neighbours", std::int64_t{-1});
         r.map_tolerance = j.value("tolerance", 0.0);
       }
+    }
+    if (const PtexMetaItem* fingerprint = map.FindMetaData("dispex:sculpt_fingerprint")) {
+      map_sculpt_fingerprint = fingerprint->AsString();
     }
     reader.ptex = &map;
     reader.space = space;
@@ -758,6 +762,12 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
 
   if (!options.sculpt_path.empty()) {
     DISPEX_ASSIGN_OR_RETURN(Mesh sculpt, ReadMesh(options.sculpt_path));
+    if (!map_sculpt_fingerprint.empty() && MeshFingerprint(sculpt) != map_sculpt_fingerprint) {
+      r.warnings.push_back(fmt::format(
+          "{}: not the sculpt {} was made from (its fingerprint differs): an edited sculpt, or "
+          "another one",
+          options.sculpt_path, options.map_path));
+    }
     DISPEX_ASSIGN_OR_RETURN(DisplacedSurface displaced,
                             Displace(surface, reader, options.samples_per_face));
     r.samples_per_face_min = 1 << 30;
@@ -791,6 +801,20 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
 
   const double limit_abs = DistanceLimit(options, r.diagonal);
   const char* option = options.max_error_rel > 0 ? "max_error_rel" : "max_error";
+  r.distance_tolerance = options.tolerance > 0 ? options.tolerance : r.map_tolerance;
+  if (r.measured_distances && options.max_mean_tolerances > 0 && r.distance_tolerance > 0) {
+    // The sculpt's own points: the displaced surface's points also carry the sagging of the
+    // sculpt's facets between its vertices, many tolerances on a coarse sculpt.
+    const ErrorStats& s = r.sculpt_to_map;
+    if (r.passed && s.mean > options.max_mean_tolerances * r.distance_tolerance) {
+      r.passed = false;
+      r.failure = fmt::format(
+          "sculpt->map mean distance {:.4g} is {:.3g} tolerances, over max_mean_tolerances {} x "
+          "{:.4g}: is this the sculpt the map was made from?",
+          s.mean, s.mean / r.distance_tolerance, options.max_mean_tolerances,
+          r.distance_tolerance);
+    }
+  }
   if (r.measured_truth && r.truth_over_bound > 0) {
     const auto& w = r.truth_worst;
     r.passed = false;
@@ -845,11 +869,16 @@ nlohmann::json StatsJson(const ErrorStats& s, double diagonal) {
           {"p99_rel", s.p99 / diagonal},
           {"max_rel", s.max / diagonal}};
 }
-std::string StatsLine(const char* what, const ErrorStats& s, double diagonal) {
+// With `tau` > 0, the mean, p99 and max in tolerances too.
+std::string StatsLine(const char* what, const ErrorStats& s, double diagonal, double tau = 0) {
+  const std::string tolerances =
+      tau > 0 ? fmt::format("mean / p99 / max {:.3g} / {:.3g} / {:.3g} tolerances; ", s.mean / tau,
+                            s.p99 / tau, s.max / tau)
+              : "";
   return fmt::format(
-      "  {:<12} rms {:.4g}  p99 {:.4g}  max {:.4g}  (max {:.3g} of the diagonal; "
+      "  {:<12} rms {:.4g}  p99 {:.4g}  max {:.4g}  (max {:.3g} of the diagonal; {}"
       "{} points)\n",
-      what, s.rms, s.p99, s.max, s.max / diagonal, s.count);
+      what, s.rms, s.p99, s.max, s.max / diagonal, tolerances, s.count);
 }
 }  // namespace
 
@@ -950,8 +979,8 @@ std::string VerifyReportSummary(const VerifyReport& r) {
       r.map_vector ? fmt::format("vector map ({} space: P + D)", VectorSpaceName(r.map_space))
                    : std::string("scalar map (P + h N)"));
   if (r.measured_distances) {
-    out += StatsLine("map->sculpt", r.map_to_sculpt, r.diagonal);
-    out += StatsLine("sculpt->map", r.sculpt_to_map, r.diagonal);
+    out += StatsLine("map->sculpt", r.map_to_sculpt, r.diagonal, r.distance_tolerance);
+    out += StatsLine("sculpt->map", r.sculpt_to_map, r.diagonal, r.distance_tolerance);
     if (!r.worst_faces.empty()) {
       out += "  worst faces:";
       for (const auto& w : r.worst_faces) out += fmt::format(" {} ({:.3g})", w.face, w.max);

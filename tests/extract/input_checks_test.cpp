@@ -115,5 +115,38 @@ TEST(InputChecks, BaseAndSculptSwappedAreRefused) {
   EXPECT_FALSE(testing::fs::exists(dir / "map.ptx"));
 }
 
+// verify with no bound given judges the sculpt's points' distances by the map's own tolerance:
+// a map against another asset's sculpt fails (hundreds of tolerances), against its own passes
+// (0.14), and the report says when the sculpt is not the one the map was made from.
+TEST(InputChecks, VerifyJudgesByTheMapsToleranceAndNamesAnotherSculpt) {
+  TempDir dir;
+  const std::string cage = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
+  ASSERT_TRUE(
+      MakeSculpt(testing::SculptOptions(cage, dir / "s.obj", 3, Pattern::kDetail, 0)).ok());
+  ASSERT_TRUE(ExtractWith(cage, dir / "s.obj", dir).ok());
+  VerifyOptions v;
+  v.base_path = cage;
+  v.map_path = dir / "map.ptx";
+  v.sculpt_path = dir / "s.obj";
+  auto own = Verify(v);
+  ASSERT_TRUE(own.ok()) << own.status().message();
+  EXPECT_TRUE(own->passed) << own->failure;
+  EXPECT_GT(own->distance_tolerance, 0);
+  EXPECT_LT(own->sculpt_to_map.mean, 0.5 * own->distance_tolerance);
+  EXPECT_TRUE(own->warnings.empty());
+  v.sculpt_path = DataPath("meshes/stanford_bunny/bun_zipper.ply");
+  auto other = Verify(v);
+  ASSERT_TRUE(other.ok()) << other.status().message();
+  EXPECT_FALSE(other->passed);
+  EXPECT_NE(other->failure.find("is this the sculpt the map was made from?"), std::string::npos)
+      << other->failure;
+  ASSERT_EQ(other->warnings.size(), 1u);
+  EXPECT_NE(other->warnings[0].find("not the sculpt"), std::string::npos);
+  v.max_mean_tolerances = 0;  // off: no bound, passed
+  auto unbounded = Verify(v);
+  ASSERT_TRUE(unbounded.ok());
+  EXPECT_TRUE(unbounded->passed);
+}
+
 }  // namespace
 }  // namespace dispex
