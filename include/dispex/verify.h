@@ -261,8 +261,8 @@ struct VerifyReport {
   int samples_per_face_min = 0, samples_per_face_max = 0;
   bool measured_distances = false;
   double distance_tolerance = 0;  // tau of the distances in tolerances (0: none known)
-  ErrorStats map_to_sculpt;  // displaced limit surface -> nearest sculpt point
-  ErrorStats sculpt_to_map;  // sculpt vertices -> nearest point of the displaced surface
+  ErrorStats map_to_sculpt;       // displaced limit surface -> nearest sculpt point
+  ErrorStats sculpt_to_map;       // sculpt vertices -> nearest point of the displaced surface
   bool measured_truth = false;
   int truth_version = 0;  // of the truth file: 1, 2 or 3 (with D)
   // What `truth` measures at every record, in object units, by the kinds of map and truth:

@@ -88,7 +88,8 @@ void SetVerifyOption(VerifyOptions& o, const std::string& name, const py::handle
   } else {
     Unknown(name,
             "truth, samples_per_face, max_sculpt_points, max_error, max_error_rel, max_rms, "
-            "max_p99, max_mean_tolerances, tolerance, truth_local_bound, truth_local_tolerance_factor, truth_rms_factor, "
+            "max_p99, max_mean_tolerances, tolerance, truth_local_bound, "
+            "truth_local_tolerance_factor, truth_rms_factor, "
             "truth_p99_factor, max_edge_step, max_edge_step_p99, threads");
   }
 }

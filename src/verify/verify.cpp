@@ -811,8 +811,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
       r.failure = fmt::format(
           "sculpt->map mean distance {:.4g} is {:.3g} tolerances, over max_mean_tolerances {} x "
           "{:.4g}: is this the sculpt the map was made from?",
-          s.mean, s.mean / r.distance_tolerance, options.max_mean_tolerances,
-          r.distance_tolerance);
+          s.mean, s.mean / r.distance_tolerance, options.max_mean_tolerances, r.distance_tolerance);
     }
   }
   if (r.measured_truth && r.truth_over_bound > 0) {

@@ -121,8 +121,7 @@ TEST(InputChecks, BaseAndSculptSwappedAreRefused) {
 TEST(InputChecks, VerifyJudgesByTheMapsToleranceAndNamesAnotherSculpt) {
   TempDir dir;
   const std::string cage = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
-  ASSERT_TRUE(
-      MakeSculpt(testing::SculptOptions(cage, dir / "s.obj", 3, Pattern::kDetail, 0)).ok());
+  ASSERT_TRUE(MakeSculpt(testing::SculptOptions(cage, dir / "s.obj", 3, Pattern::kDetail, 0)).ok());
   ASSERT_TRUE(ExtractWith(cage, dir / "s.obj", dir).ok());
   VerifyOptions v;
   v.base_path = cage;
