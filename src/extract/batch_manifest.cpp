@@ -85,6 +85,10 @@ StatusOr<std::vector<BatchAsset>> ReadBatchManifest(const std::string& path,
     DISPEX_ASSIGN_OR_RETURN(const std::string output_dir,
                             extract::PathIn(entry, "output_dir", folder, where));
     asset.options.output_path = (fs::path(output_dir) / (asset.name + ".ptx")).string();
+    // A manifest's folders, like its files, are relative to the manifest.
+    if (!asset.options.uv_maps_dir.empty() && fs::path(asset.options.uv_maps_dir).is_relative()) {
+      asset.options.uv_maps_dir = (folder / asset.options.uv_maps_dir).lexically_normal().string();
+    }
     Status valid = ValidateExtractOptions(asset.options);
     if (!valid.ok()) return valid.WithPrefix(where);
     out.push_back(std::move(asset));

@@ -92,6 +92,12 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
     return SetNamed(o.bvh_quality, v, ParseBuildQuality);
   } else if (name == "method") {
     return SetNamed(o.method, v, ParseExtractMethod);
+  } else if (name == "uv_maps_dir") {
+    DISPEX_ASSIGN_OR_RETURN(o.uv_maps_dir, TextValue(v));
+  } else if (name == "uv_resolution") {
+    DISPEX_ASSIGN_OR_RETURN(o.uv_resolution, IntValue(v));
+  } else if (name == "uv_padding") {
+    DISPEX_ASSIGN_OR_RETURN(o.uv_padding, IntValue(v));
   } else if (name == "check_inputs") {
     if (!v.is_boolean()) return Status::Error(fmt::format("{} is not true or false", v.dump()));
     o.check_inputs = v.get<bool>();
@@ -109,7 +115,7 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
         "ray_policy, tolerance, tolerance_fraction, resolution_rule, fixed_resolution, "
         "nonzero_threshold, "
         "data_type, compression_level, holes, watertight, max_miss_fraction, bvh_quality, "
-        "method, vector, check_inputs)");
+        "method, vector, uv_maps_dir, uv_resolution, uv_padding, check_inputs)");
   }
   return Status::Ok();
 }

@@ -87,6 +87,29 @@ TEST_F(Farm, ABatchRunsEveryAssetAndAFailingOneDoesNotStopTheOthers) {
   EXPECT_TRUE(Slurp(dir_ / "maps/blub.ptx") == Expected("blub", "--data-type half"));
 }
 
+// The UV-space options too: a batch writes the UDIM tiles `extract --uv-maps` writes, into the
+// folder named relative to the manifest.
+TEST_F(Farm, ManifestsTakeTheUvOptions) {
+  Write("uv.json", R"({"assets": [
+      {"name": "spot", "base": "spot.obj", "sculpt": "spot_sculpt.obj", "output_dir": "maps",
+       "options": {"uv_maps_dir": "tiles", "uv_resolution": 64, "uv_padding": 2}}]})");
+  auto r = RunDispex("batch -q " + (dir_ / "uv.json"), dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto direct = RunDispex(fmt("spot") + " -o " + (dir_ / "direct.ptx") +
+                                    " -q --uv-maps " + (dir_ / "direct") +
+                                    " --uv-resolution 64 --uv-padding 2",
+                                dir_);
+  ASSERT_EQ(direct.exit_code, 0) << direct.err;
+  std::size_t tiles = 0;
+  for (const auto& entry : fs::directory_iterator(dir_ / "tiles")) {
+    const std::string name = entry.path().filename().string();
+    ASSERT_EQ(name.rfind("spot.", 0), 0u) << name;
+    EXPECT_TRUE(Slurp(entry.path()) == Slurp(dir_ / ("direct/direct." + name.substr(5)))) << name;
+    ++tiles;
+  }
+  EXPECT_GT(tiles, 0u);
+}
+
 TEST_F(Farm, BadManifestsFailInOneLineNamingTheEntry) {
   for (const auto& [text, needle] :
        {std::pair{R"({"assets": []})", "\"assets\" must be a non-empty list"},
