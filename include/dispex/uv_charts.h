@@ -64,6 +64,8 @@ struct UvTexelPlace {
 struct UvTile {
   int udim = 0;
   std::vector<UvTexelPlace> places;  // N x N, row-major, i fastest, row 0 at v = tile's 0
+  std::int64_t inside = 0;           // texel centres in some UV face
+  std::vector<std::int32_t> faces;   // the Ptex faces whose UVs reach the tile, ascending
 };
 
 struct UvRaster {

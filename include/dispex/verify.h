@@ -261,6 +261,8 @@ struct VerifyReport {
   int samples_per_face_min = 0, samples_per_face_max = 0;
   bool measured_distances = false;
   double distance_tolerance = 0;  // tau of the distances in tolerances (0: none known)
+  // A UV-space map: the Ptex faces with points whose UVs no tile holds (read as 0), ascending.
+  std::vector<int> uv_faces_without_tile;
   ErrorStats map_to_sculpt;       // displaced limit surface -> nearest sculpt point
   ErrorStats sculpt_to_map;       // sculpt vertices -> nearest point of the displaced surface
   bool measured_truth = false;

@@ -238,9 +238,16 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
   }
   if (!raster.faces_outside_udim.empty()) {
     report.warnings.push_back(fmt::format(
-        "{}: {} faces have UVs outside the UDIM tiles (u in [0, 10), v in [0, 99)) and are "
-        "not in the UV maps: {}",
+        "{}: {} faces have UVs reaching outside the UDIM tiles (u in [0, 10), v in [0, 99)); "
+        "only their part inside the tiles is in the UV maps: {}",
         options.base_path, raster.faces_outside_udim.size(), FaceList(raster.faces_outside_udim)));
+  }
+  for (const UvTile& tile : raster.tiles) {
+    if (tile.inside > 0) continue;
+    report.warnings.push_back(fmt::format(
+        "{}: UDIM tile {} is not written: the UVs of {} faces reach into it by less than a "
+        "texel, no texel centre inside ({})",
+        options.base_path, tile.udim, tile.faces.size(), FaceList(tile.faces)));
   }
   if (report.uv_texels_missed > 0) {
     report.warnings.push_back(
@@ -260,6 +267,7 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
   std::vector<std::string> paths;
   for (std::size_t t = 0; t < raster.tiles.size(); ++t) {
     if (CancelRequested()) return Cancelled();
+    if (raster.tiles[t].inside == 0) continue;  // nothing of the surface (warned above)
     UvMapTile& tile = tiles[t];
     tile.udim = raster.tiles[t].udim;
     tile.resolution = n;
@@ -270,6 +278,7 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
     tile.attributes.emplace_back("dispex:udim", fmt::format("{}", tile.udim));
     paths.push_back(UvMapTilePath(options.uv_maps_dir, shape, tile.udim));
   }
+  std::erase_if(tiles, [](const UvMapTile& tile) { return tile.resolution == 0; });
   // All the tiles or none: a failure leaves the previous run's set as it was.
   DISPEX_RETURN_IF_ERROR(WriteUvMapTiles(paths, tiles, options.data_type == PtexDataType::kHalf));
   report.uv_map_paths = paths;

@@ -120,7 +120,7 @@ StatusOr<UvRaster> RasterizeUvCharts(const PtexUvCharts& charts, const LimitSurf
   const auto texels = static_cast<std::size_t>(resolution) * static_cast<std::size_t>(resolution);
   std::vector<const std::vector<std::int32_t>*> lists;
   for (const auto& [udim, faces] : tile_faces) {
-    raster.tiles.push_back({udim, std::vector<UvTexelPlace>(texels)});
+    raster.tiles.push_back({udim, std::vector<UvTexelPlace>(texels), 0, faces});
     lists.push_back(&faces);
   }
   const int bands = (resolution + kBandRows - 1) / kBandRows;
@@ -171,6 +171,7 @@ StatusOr<UvRaster> RasterizeUvCharts(const PtexUvCharts& charts, const LimitSurf
   std::set<std::int32_t> overlap_faces;
   for (std::size_t t = 0; t < tasks; ++t) {
     raster.inside += band_inside[t];
+    raster.tiles[t / static_cast<std::size_t>(bands)].inside += band_inside[t];
     raster.overlap_texels += band_overlaps[t];
     overlap_faces.insert(band_overlap_faces[t].begin(), band_overlap_faces[t].end());
   }

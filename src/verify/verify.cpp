@@ -14,6 +14,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <mutex>
@@ -87,6 +88,8 @@ struct MapReader {
   // A scalar Ptex map read by the reference Ptex filter, which blends over face edges as a
   // renderer does (TruthScalar).
   const PtexMapSampler* across = nullptr;
+  // A UV-space map: per Ptex face, set where a point of it has no tile (read as 0).
+  std::vector<std::atomic<std::uint8_t>>* uv_missing = nullptr;
 
   float Scalar(PtexFaceId face, float u, float v) const {
     if (ptex != nullptr) return ptex->Sample(face, u, v);
@@ -114,7 +117,9 @@ struct MapReader {
   void ReadUv(PtexFaceId face, float u, float v, std::span<float> out) const {
     double at[2];
     charts->Evaluate(face, u, v, at);
-    uv->Sample(at[0], at[1], out);
+    if (!uv->Sample(at[0], at[1], out) && uv_missing != nullptr) {
+      (*uv_missing)[static_cast<std::size_t>(face.value)].store(1, std::memory_order_relaxed);
+    }
   }
   // Samples per side of a face's displaced grid: twice the Ptex face's resolution within
   // [8, 64]; for a UV map, twice the texels its UV footprint spans within [8, 64].
@@ -628,6 +633,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   std::vector<std::vector<std::vector<float>>> map_fields;
   std::optional<PtexMapSampler> sampler;
   std::string map_sculpt_fingerprint;
+  std::vector<std::atomic<std::uint8_t>> uv_missing;
   if (IsUvMapPath(options.map_path)) {
     DISPEX_ASSIGN_OR_RETURN(uv, UvMap::Open(options.map_path));
     if (uv->channels() == 3) {
@@ -647,6 +653,9 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     }
     DISPEX_ASSIGN_OR_RETURN(charts, PtexUvCharts::Build(base, surface));
     reader.uv = &*uv;
+    uv_missing = std::vector<std::atomic<std::uint8_t>>(
+        static_cast<std::size_t>(surface.num_ptex_faces()));
+    reader.uv_missing = &uv_missing;
     reader.charts = &*charts;
     const std::string tolerance = uv->Attribute("dispex:tolerance");
     if (!tolerance.empty()) r.map_tolerance = std::strtod(tolerance.c_str(), nullptr);
@@ -799,6 +808,19 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     r.measured_distances = true;
   }
 
+  for (std::size_t f = 0; f < uv_missing.size(); ++f) {
+    if (uv_missing[f].load()) r.uv_faces_without_tile.push_back(static_cast<int>(f));
+  }
+  if (!r.uv_faces_without_tile.empty()) {
+    std::string list;
+    for (std::size_t i = 0; i < r.uv_faces_without_tile.size() && i < 10; ++i) {
+      list += fmt::format("{}{}", i ? ", " : "", r.uv_faces_without_tile[i]);
+    }
+    if (r.uv_faces_without_tile.size() > 10) list += ", ...";
+    r.warnings.push_back(fmt::format(
+        "{}: {} Ptex faces have points whose UVs no tile holds (read as 0): {}", options.map_path,
+        r.uv_faces_without_tile.size(), list));
+  }
   const double limit_abs = DistanceLimit(options, r.diagonal);
   const char* option = options.max_error_rel > 0 ? "max_error_rel" : "max_error";
   r.distance_tolerance = options.tolerance > 0 ? options.tolerance : r.map_tolerance;
@@ -961,6 +983,7 @@ std::string VerifyReportJson(const VerifyReport& r) {
   j["passed"] = r.passed;
   if (!r.passed) j["failure"] = r.failure;
   j["warnings"] = r.warnings;
+  if (!r.uv_faces_without_tile.empty()) j["uv_faces_without_tile"] = r.uv_faces_without_tile;
   j["seconds"] = r.seconds;
   return j.dump(2) + "\n";
 }

@@ -203,8 +203,16 @@ TEST(UvExtract, SpotTexelsMatchTheExactDisplacement) {
   TempDir dir;
   const std::string cage = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
   Extracted e = ExtractUv(dir, cage, 3, 0.005, 256);
-  ASSERT_EQ(e.report.uv_map_paths.size(), 2u);  // 1001 and the sliver of 1011
+  // Two faces reach into 1011 by 0.00065 of a tile, short of its first texel centre at this
+  // resolution: no tile of nothing is written, and the report says so.
+  ASSERT_EQ(e.report.uv_map_paths.size(), 1u);
   EXPECT_EQ(e.report.uv_map_paths[0], dir / "uv/shape.1001.exr");
+  bool warned = false;
+  for (const std::string& w : e.report.warnings) {
+    warned |= w.find("UDIM tile 1011 is not written") != std::string::npos &&
+              w.find("(28, 31)") != std::string::npos;
+  }
+  EXPECT_TRUE(warned);
   EXPECT_EQ(e.report.uv_texels_missed, 0);
   EXPECT_GT(e.report.uv_overlap_texels, 0);  // spot's flipped UV faces, reported
   auto map = UvMap::Open(dir / "uv/shape.<UDIM>.exr");
@@ -212,6 +220,18 @@ TEST(UvExtract, SpotTexelsMatchTheExactDisplacement) {
   EXPECT_EQ(map->Attribute("dispex:space"), "normal");
   EXPECT_EQ(map->Attribute("dispex:midpoint"), "0");
   EXPECT_EQ(e.sculpt.folded_faces, 0u);
+  // verify names the faces whose UVs reach where no tile is (1011, and u < 0 for 71 and 74).
+  VerifyOptions v;
+  v.base_path = cage;
+  v.sculpt_path = dir / "sculpt.obj";
+  v.map_path = dir / "uv/shape.<UDIM>.exr";
+  auto verified = Verify(v);
+  ASSERT_TRUE(verified.ok()) << verified.status().message();
+  EXPECT_EQ(verified->uv_faces_without_tile, (std::vector<int>{28, 31, 71, 74}));
+  ASSERT_FALSE(verified->warnings.empty());
+  EXPECT_NE(verified->warnings.back().find("4 Ptex faces have points whose UVs no tile holds"),
+            std::string::npos)
+      << verified->warnings.back();
   auto truth = ReadGroundTruth(dir / "sculpt.obj.truth");
   ASSERT_TRUE(truth.ok()) << truth.status().message();
   const LocalLinearError local(*truth);
