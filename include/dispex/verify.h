@@ -263,8 +263,8 @@ struct VerifyReport {
   double distance_tolerance = 0;  // tau of the distances in tolerances (0: none known)
   // A UV-space map: the Ptex faces with points whose UVs no tile holds (read as 0), ascending.
   std::vector<int> uv_faces_without_tile;
-  ErrorStats map_to_sculpt;       // displaced limit surface -> nearest sculpt point
-  ErrorStats sculpt_to_map;       // sculpt vertices -> nearest point of the displaced surface
+  ErrorStats map_to_sculpt;  // displaced limit surface -> nearest sculpt point
+  ErrorStats sculpt_to_map;  // sculpt vertices -> nearest point of the displaced surface
   bool measured_truth = false;
   int truth_version = 0;  // of the truth file: 1, 2 or 3 (with D)
   // What `truth` measures at every record, in object units, by the kinds of map and truth:

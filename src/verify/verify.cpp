@@ -633,6 +633,7 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
   std::vector<std::vector<std::vector<float>>> map_fields;
   std::optional<PtexMapSampler> sampler;
   std::string map_sculpt_fingerprint;
+  std::int64_t map_sculpt_vertices = 0;  // as the map records it (0: not recorded)
   std::vector<std::atomic<std::uint8_t>> uv_missing;
   if (IsUvMapPath(options.map_path)) {
     DISPEX_ASSIGN_OR_RETURN(uv, UvMap::Open(options.map_path));
@@ -653,8 +654,8 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     }
     DISPEX_ASSIGN_OR_RETURN(charts, PtexUvCharts::Build(base, surface));
     reader.uv = &*uv;
-    uv_missing = std::vector<std::atomic<std::uint8_t>>(
-        static_cast<std::size_t>(surface.num_ptex_faces()));
+    uv_missing =
+        std::vector<std::atomic<std::uint8_t>>(static_cast<std::size_t>(surface.num_ptex_faces()));
     reader.uv_missing = &uv_missing;
     reader.charts = &*charts;
     const std::string tolerance = uv->Attribute("dispex:tolerance");
@@ -691,6 +692,9 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
         r.map_faces_filled_from_neighbours =
             j.value("faces_filled_from_neighbours", std::int64_t{-1});
         r.map_tolerance = j.value("tolerance", 0.0);
+        if (j.contains("sculpt") && j["sculpt"].is_object()) {
+          map_sculpt_vertices = j["sculpt"].value("vertices", std::int64_t{0});
+        }
       }
     }
     if (const PtexMetaItem* fingerprint = map.FindMetaData("dispex:sculpt_fingerprint")) {
@@ -710,6 +714,13 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
 
   if (!options.truth_path.empty()) {
     DISPEX_ASSIGN_OR_RETURN(GroundTruth truth, ReadGroundTruth(options.truth_path));
+    // One record per sculpt vertex: another count is another sculpt's truth.
+    if (map_sculpt_vertices > 0 && static_cast<std::int64_t>(truth.size()) != map_sculpt_vertices) {
+      return Status::Error(fmt::format(
+          "{}: {} records, but {} was made from a sculpt of {} vertices: the truth of another "
+          "sculpt",
+          options.truth_path, truth.size(), options.map_path, map_sculpt_vertices));
+    }
     for (std::size_t i = 0; i < truth.size(); ++i) {
       int f = truth.faces[i].value;
       float u = truth.uvs[2 * i], v = truth.uvs[2 * i + 1];
@@ -817,9 +828,9 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
       list += fmt::format("{}{}", i ? ", " : "", r.uv_faces_without_tile[i]);
     }
     if (r.uv_faces_without_tile.size() > 10) list += ", ...";
-    r.warnings.push_back(fmt::format(
-        "{}: {} Ptex faces have points whose UVs no tile holds (read as 0): {}", options.map_path,
-        r.uv_faces_without_tile.size(), list));
+    r.warnings.push_back(
+        fmt::format("{}: {} Ptex faces have points whose UVs no tile holds (read as 0): {}",
+                    options.map_path, r.uv_faces_without_tile.size(), list));
   }
   const double limit_abs = DistanceLimit(options, r.diagonal);
   const char* option = options.max_error_rel > 0 ? "max_error_rel" : "max_error";

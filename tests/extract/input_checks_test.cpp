@@ -145,6 +145,22 @@ TEST(InputChecks, VerifyJudgesByTheMapsToleranceAndNamesAnotherSculpt) {
   auto unbounded = Verify(v);
   ASSERT_TRUE(unbounded.ok());
   EXPECT_TRUE(unbounded->passed);
+  // A truth file of another sculpt of the same cage (another vertex count) is named as such.
+  ASSERT_TRUE(
+      MakeSculpt(testing::JitteredSculptOptions(cage, dir / "j.obj", 12, Pattern::kDetail, 0))
+          .ok());
+  VerifyOptions t;
+  t.base_path = cage;
+  t.map_path = dir / "map.ptx";
+  t.truth_path = dir / "j.obj.truth";
+  auto wrong_truth = Verify(t);
+  ASSERT_FALSE(wrong_truth.ok());
+  EXPECT_NE(wrong_truth.status().message().find("the truth of another sculpt"), std::string::npos)
+      << wrong_truth.status().message();
+  t.truth_path = dir / "s.obj.truth";
+  auto own_truth = Verify(t);
+  ASSERT_TRUE(own_truth.ok()) << own_truth.status().message();
+  EXPECT_TRUE(own_truth->passed) << own_truth->failure;
 }
 
 }  // namespace
