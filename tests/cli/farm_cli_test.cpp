@@ -95,9 +95,8 @@ TEST_F(Farm, ManifestsTakeTheUvOptions) {
        "options": {"uv_maps_dir": "tiles", "uv_resolution": 64, "uv_padding": 2}}]})");
   auto r = RunDispex("batch -q " + (dir_ / "uv.json"), dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto direct = RunDispex(fmt("spot") + " -o " + (dir_ / "direct.ptx") +
-                                    " -q --uv-maps " + (dir_ / "direct") +
-                                    " --uv-resolution 64 --uv-padding 2",
+  const auto direct = RunDispex(fmt("spot") + " -o " + (dir_ / "direct.ptx") + " -q --uv-maps " +
+                                    (dir_ / "direct") + " --uv-resolution 64 --uv-padding 2",
                                 dir_);
   ASSERT_EQ(direct.exit_code, 0) << direct.err;
   std::size_t tiles = 0;
