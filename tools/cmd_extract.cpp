@@ -69,42 +69,6 @@ struct ExtractArgs {
   bool asset() const { return !output_dir.empty() || !manifest_path.empty(); }
 };
 
-// "8G", "512M", "300K" or a number of bytes.
-StatusOr<std::uint64_t> ParseBytes(const std::string& text) {
-  double value = 0;
-  char unit = 0, extra = 0;
-  int n = std::sscanf(text.c_str(), "%lf%c%c", &value, &unit, &extra);
-  if (n < 1 || n > 2 || !(value > 0)) {
-    return Status::Error(fmt::format("--max-memory {}: expected a size such as 8G or 512M", text));
-  }
-  double scale = 1;
-  switch (n == 2 ? unit : 'B') {
-    case 'B':
-    case 'b':
-      break;
-    case 'K':
-    case 'k':
-      scale = 1024.0;
-      break;
-    case 'M':
-    case 'm':
-      scale = 1024.0 * 1024;
-      break;
-    case 'G':
-    case 'g':
-      scale = 1024.0 * 1024 * 1024;
-      break;
-    case 'T':
-    case 't':
-      scale = 1024.0 * 1024 * 1024 * 1024;
-      break;
-    default:
-      return Status::Error(
-          fmt::format("--max-memory {}: unknown unit '{}' (K, M, G, T)", text, unit));
-  }
-  return static_cast<std::uint64_t>(value * scale);
-}
-
 Status Resolve(ExtractArgs& a) {
   ExtractOptions& o = a.options;
   if (a.oversample != "auto") {
@@ -175,8 +139,8 @@ Status Resolve(ExtractArgs& a) {
   if (!shard_sculpt.ok()) return shard_sculpt.status().WithPrefix("--shard-sculpt");
   o.shard_sculpt = *shard_sculpt;
   if (!a.max_memory.empty()) {
-    auto bytes = ParseBytes(a.max_memory);
-    if (!bytes.ok()) return bytes.status();
+    auto bytes = ParseByteSize(a.max_memory);
+    if (!bytes.ok()) return bytes.status().WithPrefix("--max-memory");
     o.max_memory = *bytes;
   }
   if (!a.report_path.empty() && (a.report_path == o.base_path || a.report_path == o.sculpt_path ||

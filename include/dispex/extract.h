@@ -206,6 +206,9 @@ std::string MeshFingerprint(const Mesh& mesh);
 // CheckMapName), before any work; the message names the option.
 Status ValidateExtractOptions(const ExtractOptions& options);
 
+// A memory size: "8G", "512M", "300K" or a number of bytes (ExtractOptions::max_memory).
+StatusOr<std::uint64_t> ParseByteSize(const std::string& text);
+
 // A map's name whose extension says another format (map.exr, map.png, map.obj) is refused.
 Status CheckMapName(const std::string& path);
 

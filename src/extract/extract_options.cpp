@@ -217,6 +217,40 @@ Status ValidateExtractOptions(const ExtractOptions& o) {
   return ValidateSpectralOptions(spectral);
 }
 
+StatusOr<std::uint64_t> ParseByteSize(const std::string& text) {
+  double value = 0;
+  char unit = 0, extra = 0;
+  int n = std::sscanf(text.c_str(), "%lf%c%c", &value, &unit, &extra);
+  if (n < 1 || n > 2 || !(value > 0)) {
+    return Status::Error(fmt::format("'{}': expected a size such as 8G or 512M", text));
+  }
+  double scale = 1;
+  switch (n == 2 ? unit : 'B') {
+    case 'B':
+    case 'b':
+      break;
+    case 'K':
+    case 'k':
+      scale = 1024.0;
+      break;
+    case 'M':
+    case 'm':
+      scale = 1024.0 * 1024;
+      break;
+    case 'G':
+    case 'g':
+      scale = 1024.0 * 1024 * 1024;
+      break;
+    case 'T':
+    case 't':
+      scale = 1024.0 * 1024 * 1024 * 1024;
+      break;
+    default:
+      return Status::Error(fmt::format("'{}': unknown unit '{}' (K, M, G, T)", text, unit));
+  }
+  return static_cast<std::uint64_t>(value * scale);
+}
+
 Status ParseShard(std::string_view text, int& index, int& count) {
   const std::string s(text);
   int i = 0, n = 0;

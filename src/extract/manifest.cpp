@@ -98,6 +98,15 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
     DISPEX_ASSIGN_OR_RETURN(o.uv_resolution, IntValue(v));
   } else if (name == "uv_padding") {
     DISPEX_ASSIGN_OR_RETURN(o.uv_padding, IntValue(v));
+  } else if (name == "max_memory") {
+    if (v.is_number_unsigned()) {
+      o.max_memory = v.get<std::uint64_t>();
+    } else {
+      DISPEX_ASSIGN_OR_RETURN(std::string size, TextValue(v));
+      DISPEX_ASSIGN_OR_RETURN(o.max_memory, ParseByteSize(size));
+    }
+  } else if (name == "embree_isa") {
+    DISPEX_ASSIGN_OR_RETURN(o.embree_isa, TextValue(v));
   } else if (name == "check_inputs") {
     if (!v.is_boolean()) return Status::Error(fmt::format("{} is not true or false", v.dump()));
     o.check_inputs = v.get<bool>();
@@ -115,7 +124,8 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
         "ray_policy, tolerance, tolerance_fraction, resolution_rule, fixed_resolution, "
         "nonzero_threshold, "
         "data_type, compression_level, holes, watertight, max_miss_fraction, bvh_quality, "
-        "method, vector, uv_maps_dir, uv_resolution, uv_padding, check_inputs)");
+        "method, vector, uv_maps_dir, uv_resolution, uv_padding, max_memory, embree_isa, "
+        "check_inputs)");
   }
   return Status::Ok();
 }

@@ -92,7 +92,8 @@ TEST_F(Farm, ABatchRunsEveryAssetAndAFailingOneDoesNotStopTheOthers) {
 TEST_F(Farm, ManifestsTakeTheUvOptions) {
   Write("uv.json", R"({"assets": [
       {"name": "spot", "base": "spot.obj", "sculpt": "spot_sculpt.obj", "output_dir": "maps",
-       "options": {"uv_maps_dir": "tiles", "uv_resolution": 64, "uv_padding": 2}}]})");
+       "options": {"uv_maps_dir": "tiles", "uv_resolution": 64, "uv_padding": 2,
+                   "max_memory": "64G", "check_inputs": true}}]})");
   auto r = RunDispex("batch -q " + (dir_ / "uv.json"), dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto direct = RunDispex(fmt("spot") + " -o " + (dir_ / "direct.ptx") + " -q --uv-maps " +
@@ -119,6 +120,9 @@ TEST_F(Farm, BadManifestsFailInOneLineNamingTheEntry) {
         std::pair{R"({"assets": [{"name": "a", "base": "x", "sculpt": "y", "output_dir": "m",
                      "options": {"tolerance": "big"}}]})",
                   "assets[0].options.tolerance"},
+        std::pair{R"({"assets": [{"name": "a", "base": "x", "sculpt": "y", "output_dir": "m",
+                     "options": {"max_memory": "8X"}}]})",
+                  "assets[0].options.max_memory: '8X': unknown unit"},
         std::pair{R"({"asets": []})", "unknown key \"asets\""}}) {
     Write("m.json", text);
     for (const std::string command : {"batch ", "farm slurm --dry-run "}) {
