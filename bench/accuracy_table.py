@@ -11,6 +11,9 @@ import json
 import os
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scripts"))
+from write_between_markers import write_between_markers  # noqa: E402
+
 
 def load(path):
     with open(path) as f:
@@ -62,14 +65,7 @@ def main(argv):
     table = "\n".join(lines) + "\n"
     print(table, end="")
     if write:
-        text = open(write).read()
-        begin, end = "<!-- bench-accuracy-table:begin", "<!-- bench-accuracy-table:end -->"
-        i, j = text.find(begin), text.find(end)
-        if i < 0 or j < i:
-            sys.exit(f"accuracy_table.py: {write} has no bench-accuracy-table markers")
-        i = text.index("\n", i) + 1
-        with open(write, "w") as f:
-            f.write(text[:i] + "\n" + table + "\n" + text[j:])
+        write_between_markers(write, "bench-accuracy-table", table)
         print(f"accuracy_table.py: the table written into {write}", file=sys.stderr)
 
 

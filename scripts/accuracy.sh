@@ -172,16 +172,6 @@ if ((${#control_failures[@]})); then
 fi
 ((${#failures[@]} + ${#control_failures[@]} == 0)) || exit 1
 if ((write)); then
-  python3 - "$root/docs/ACCURACY.md" "$table" <<'PY'
-import sys
-doc, table = sys.argv[1], open(sys.argv[2]).read()
-text = open(doc).read()
-begin, end = "<!-- accuracy-table:begin", "<!-- accuracy-table:end -->"
-i, j = text.find(begin), text.find(end)
-if i < 0 or j < i:
-    sys.exit(f"accuracy.sh: {doc} has no accuracy-table markers")
-i = text.index("\n", i) + 1
-open(doc, "w").write(text[:i] + "\n" + table + "\n" + text[j:])
-PY
+  python3 "$root/scripts/write_between_markers.py" "$root/docs/ACCURACY.md" accuracy-table "$table"
   echo "accuracy.sh: the table written into docs/ACCURACY.md" >&2
 fi
