@@ -116,6 +116,7 @@ class SculptMapping {
     std::uint8_t kind = 0;  // 0: no neighbour with a surface, 1: `to`, 2: not laid out
     std::uint8_t q = 0;
     std::int32_t tx = 0, ty = 0;
+    bool leads() const { return kind == 1 && to >= 0; }  // into face `to`'s grid
   };
   const Crossing& crossing(int face, int edge) const {
     return crossings_[4 * static_cast<std::size_t>(face) + static_cast<std::size_t>(edge)];

@@ -17,7 +17,7 @@ namespace {
 bool Locate(const GridSource& source, int face, int edge, int x, int y, int& g, int& gx, int& gy) {
   const SculptMapping::Crossing* c = &source.crossing(face, edge);
   for (int hop = 0; hop < 2; ++hop) {
-    if (c->kind != 1 || c->to < 0) return false;
+    if (!c->leads()) return false;
     const std::array<int, 2> p = SculptMapping::CrossEdge(*c, x, y);
     gx = p[0], gy = p[1];
     g = c->to;
