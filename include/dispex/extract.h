@@ -216,6 +216,9 @@ Status CheckMapName(const std::string& path);
 // (ReadExtractManifest, docs/SHAPES.md) -- JSON text: "0.001", "\"auto\"", "\"64x64\"" --,
 // for a program that takes options by name (the Python module). Errors start with the name:
 // "tolerance: \"x\" is not a number", "colour: unknown option (known: ...)".
+// The names SetExtractOption takes, comma-separated (for messages).
+std::string ExtractOptionNames();
+
 Status SetExtractOption(ExtractOptions& options, const std::string& name,
                         const std::string& json_value);
 

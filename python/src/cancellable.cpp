@@ -24,10 +24,11 @@ struct Shown {
   std::uint64_t done = ~std::uint64_t{0}, total = 0;
 };
 
-// Calls the callback when the counter moved since it was last shown.
+// Calls the callback when the counter moved since it was last shown, once the total is known
+// (a callback's done / total never divides by 0).
 void Show(const py::object& callback, const ProgressCounter& counter, Shown& shown) {
   const std::uint64_t done = counter.done.load(), total = counter.total.load();
-  if (callback.is_none() || (done == shown.done && total == shown.total)) return;
+  if (callback.is_none() || total == 0 || (done == shown.done && total == shown.total)) return;
   shown = {done, total};
   callback(done, total);
 }

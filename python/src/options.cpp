@@ -64,7 +64,13 @@ void SetExtractOptions(ExtractOptions& options, const py::dict& kwargs) {
         throw py::value_error(fmt::format("{}: {} is not a number or a string", name,
                                           py::repr(value).cast<std::string>()));
       }
-      CheckArgument(SetExtractOption(options, name, json));
+      const Status set = SetExtractOption(options, name, json);
+      if (!set.ok() && set.message().rfind(name + ": unknown option", 0) == 0) {
+        throw py::value_error(
+            fmt::format("{}: unknown option (known: {}, threads, incremental, shard, shard_sculpt)",
+                        name, ExtractOptionNames()));
+      }
+      CheckArgument(set);
     }
   }
 }

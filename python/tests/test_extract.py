@@ -101,6 +101,7 @@ def test_incremental_run_of_an_unchanged_array_mesh_leaves_the_map(tmp_path, scu
     ({"oversample": 3}, "oversample = 3"),
     ({"holes": "maybe"}, "holes"),
     ({"colour": 1}, "colour: unknown option"),
+    ({"colour": 1}, "uv_maps_dir, .*threads, incremental, shard, shard_sculpt"),
     ({"threads": 1.5}, "threads: 1.5 is not an integer"),
     ({"progress": 3}, "progress: 3 is not callable"),
 ])

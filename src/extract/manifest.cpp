@@ -119,13 +119,7 @@ Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
     DISPEX_RETURN_IF_ERROR(SetNamed(space, v, ParseVectorSpace));
     o.vector = space;
   } else {
-    return Status::Error(
-        "unknown option (known: oversample, max_oversample, min_oversample, search_distance, "
-        "ray_policy, tolerance, tolerance_fraction, resolution_rule, fixed_resolution, "
-        "nonzero_threshold, "
-        "data_type, compression_level, holes, watertight, max_miss_fraction, bvh_quality, "
-        "method, vector, uv_maps_dir, uv_resolution, uv_padding, max_memory, embree_isa, "
-        "check_inputs)");
+    return Status::Error("unknown option (known: " + ExtractOptionNames() + ")");
   }
   return Status::Ok();
 }
@@ -167,6 +161,13 @@ StatusOr<json> ReadJsonObject(const std::string& path) {
 
 using extract::PathIn;
 using extract::SetOptions;
+
+std::string ExtractOptionNames() {
+  return "oversample, max_oversample, min_oversample, search_distance, ray_policy, tolerance, "
+         "tolerance_fraction, resolution_rule, fixed_resolution, nonzero_threshold, data_type, "
+         "compression_level, holes, watertight, max_miss_fraction, bvh_quality, method, vector, "
+         "uv_maps_dir, uv_resolution, uv_padding, max_memory, embree_isa, check_inputs";
+}
 
 Status SetExtractOption(ExtractOptions& options, const std::string& name,
                         const std::string& json_value) {
