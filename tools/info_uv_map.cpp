@@ -3,9 +3,7 @@
 // texels are not finite, and the dispex:* conventions of the header. --json: the same as JSON.
 #include <fmt/format.h>
 
-#include <cmath>
 #include <cstdio>
-#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -18,49 +16,27 @@ namespace dispex::cli {
 int UvMapInfo(const InfoOptions& options) {
   auto map = UvMap::Open(options.path);
   if (!map.ok()) return ReportFailure(map.status());
-  nlohmann::json j;
-  j["kind"] = map->channels() == 1 ? "scalar" : "vector";
-  j["resolution"] = map->resolution();
-  j["channels"] = map->channels();
-  nlohmann::json tiles = nlohmann::json::array();
-  std::string text = fmt::format("UV map      {} ({} tiles of {}x{}, {} channel{})\n", options.path,
-                                 map->tiles().size(), map->resolution(), map->resolution(),
-                                 map->channels(), map->channels() == 1 ? "" : "s");
-  for (std::size_t t = 0; t < map->tiles().size(); ++t) {
-    const UvMapTile& tile = map->tiles()[t];
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    std::size_t not_finite = 0;
-    for (float v : tile.values) {
-      if (!std::isfinite(v)) {
-        ++not_finite;
-        continue;
-      }
-      lo = std::min(lo, double(v));
-      hi = std::max(hi, double(v));
-    }
-    if (lo > hi) lo = hi = 0;
-    tiles.push_back({{"udim", tile.udim},
-                     {"path", map->paths()[t]},
-                     {"min", lo},
-                     {"max", hi},
-                     {"not_finite", not_finite}});
-    text +=
-        fmt::format("  tile {}  values [{:.6g}, {:.6g}]{}  {}\n", tile.udim, lo, hi,
-                    not_finite ? fmt::format(", {} not finite", not_finite) : "", map->paths()[t]);
-  }
-  j["tiles"] = tiles;
-  nlohmann::json attributes = nlohmann::json::object();
-  for (const auto& [key, value] : map->tiles().front().attributes) {
-    if (key.rfind("dispex:", 0) != 0) continue;
-    attributes[key] = value;
-    text += fmt::format("  {:<24} {}\n", key, value);
-  }
-  j["attributes"] = attributes;
+  const std::string json = UvMapSummaryJson(*map);
   if (options.json) {
-    std::puts(j.dump(2).c_str());
-  } else {
-    std::fputs(text.c_str(), stdout);
+    std::puts(json.c_str());
+    return 0;
   }
+  const nlohmann::json j = nlohmann::json::parse(json);
+  const int channels = j["channels"];
+  std::string text = fmt::format("UV map      {} ({} tiles of {}x{}, {} channel{})\n", options.path,
+                                 j["tiles"].size(), int(j["resolution"]), int(j["resolution"]),
+                                 channels, channels == 1 ? "" : "s");
+  for (const auto& tile : j["tiles"]) {
+    const std::size_t not_finite = tile["not_finite"];
+    text += fmt::format("  tile {}  values [{:.6g}, {:.6g}]{}  {}\n", int(tile["udim"]),
+                        double(tile["min"]), double(tile["max"]),
+                        not_finite ? fmt::format(", {} not finite", not_finite) : "",
+                        std::string(tile["path"]));
+  }
+  for (const auto& [key, value] : j["attributes"].items()) {
+    text += fmt::format("  {:<24} {}\n", key, std::string(value));
+  }
+  std::fputs(text.c_str(), stdout);
   return 0;
 }
 

@@ -73,6 +73,11 @@ class UvMap {
   int channels_ = 1, resolution_ = 0;
 };
 
+// What `dispex info --json` prints of a UV-space map, as JSON: kind ("scalar" or "vector"),
+// resolution, channels, each tile's udim, path, value range (min, max) and count of values that
+// are not finite, and the header's dispex:* attributes.
+std::string UvMapSummaryJson(const UvMap& map);
+
 // Whether `path` names an OpenEXR file (by its magic number, or by name when it does not
 // exist: "<UDIM>" or ".exr").
 bool IsUvMapPath(const std::string& path);

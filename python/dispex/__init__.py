@@ -121,7 +121,8 @@ def make_sculpt(cage, output, **options):
 
 
 def info(path, *, faces=False, strict=False):
-    """The summary `dispex info --json` prints of a mesh (OBJ, PLY) or a Ptex map, as a dict.
+    """The summary `dispex info --json` prints of a mesh (OBJ, PLY), a Ptex map or a UV-space
+    map tile (.exr), as a dict.
 
     faces: a map's face_list too; strict: a mesh's validation warnings raise dispex.Error.
     """

@@ -9,6 +9,7 @@
 #include "dispex/files.h"
 #include "dispex/mesh_summary.h"
 #include "dispex/ptex_describe.h"
+#include "dispex/uv_map.h"
 #include "dispex/verify.h"
 #include "errors.h"
 
@@ -166,12 +167,14 @@ py::dict RunMakeSculpt(const std::string& cage, const std::string& output, const
   return d;
 }
 
-// `dispex info --json [--faces] [--strict]`: the summary of a mesh or a Ptex map (chosen by its
-// first bytes, as the command chooses), as a dict.
+// `dispex info --json [--faces] [--strict]`: the summary of a mesh, a Ptex map or a UV-space map
+// (chosen by its first bytes, as the command chooses), as a dict.
 py::object Info(const std::string& path, bool faces, bool strict) {
   CheckOk(CheckReadableFile(path));
   std::string json;
-  if (HasPtexMagic(path)) {
+  if (IsUvMapPath(path)) {
+    json = UvMapSummaryJson(ValueOrRaise(UvMap::Open(path)));
+  } else if (HasPtexMagic(path)) {
     const PtexFile file = ValueOrRaise(PtexFile::Open(path));
     CheckOk(file.Validate());  // every block inflated and checked, as the command does
     json = PtexSummaryJson(file, faces);

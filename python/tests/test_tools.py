@@ -64,6 +64,16 @@ def test_info_is_the_command_lines_json(tmp_path, sculpts, faces):
     assert "face_list" in dispex.info(tmp_path / "m.ptx", faces=True)
 
 
+def test_info_of_a_uv_map_is_the_command_lines_json(tmp_path, sculpts):
+    dispex.extract(CUBE, sculpts(CUBE), tmp_path / "m.ptx", uv_maps_dir=str(tmp_path / "uv"),
+                   uv_resolution=32)
+    tiles = sorted((tmp_path / "uv").iterdir())
+    assert tiles
+    expected = json.loads(run_cli("info", tiles[0], "--json").stdout)
+    summary = dispex.info(tiles[0])
+    assert summary == expected and summary["kind"] == "scalar" and summary["resolution"] == 32
+
+
 def test_info_errors(tmp_path):
     with pytest.raises(dispex.Error, match="missing.obj"):
         dispex.info(tmp_path / "missing.obj")
