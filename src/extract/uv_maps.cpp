@@ -263,12 +263,12 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
   }
   const std::string shape = fs::path(options.output_path).stem().string();
   const auto attributes = TileAttributes(options, report);
-  std::vector<UvMapTile> tiles(raster.tiles.size());
+  std::vector<UvMapTile> tiles;
   std::vector<std::string> paths;
   for (std::size_t t = 0; t < raster.tiles.size(); ++t) {
     if (CancelRequested()) return Cancelled();
     if (raster.tiles[t].inside == 0) continue;  // nothing of the surface (warned above)
-    UvMapTile& tile = tiles[t];
+    UvMapTile& tile = tiles.emplace_back();
     tile.udim = raster.tiles[t].udim;
     tile.resolution = n;
     tile.channels = channels;
@@ -278,7 +278,6 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
     tile.attributes.emplace_back("dispex:udim", fmt::format("{}", tile.udim));
     paths.push_back(UvMapTilePath(options.uv_maps_dir, shape, tile.udim));
   }
-  std::erase_if(tiles, [](const UvMapTile& tile) { return tile.resolution == 0; });
   // All the tiles or none: a failure leaves the previous run's set as it was.
   DISPEX_RETURN_IF_ERROR(WriteUvMapTiles(paths, tiles, options.data_type == PtexDataType::kHalf));
   report.uv_map_paths = paths;

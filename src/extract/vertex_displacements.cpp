@@ -202,28 +202,28 @@ void GridDisplacements::Bend() {
 }
 
 void GridDisplacements::SetSampling(int n) {
-  sharpen_ = n > 0 && n >= m_ ? double(m_) / (4.0 * n) : 0.0;
+  const double sharpen = n > 0 && n >= m_ ? double(m_) / (4.0 * n) : 0.0;
+  read_d_.resize(d_.size());
+  for (std::size_t k = 0; k < d_.size(); ++k) read_d_[k] = d_[k] - sharpen * bend_d_[k];
+  read_h_.resize(h_.size());
+  for (std::size_t k = 0; k < h_.size(); ++k) read_h_[k] = h_[k] - sharpen * bend_h_[k];
 }
 
 GridDisplacements::Cell GridDisplacements::CellAt(double u, double v) const {
   const double x = std::clamp(u, 0.0, 1.0) * m_, y = std::clamp(v, 0.0, 1.0) * m_;
-  Cell c;
-  c.i = std::min(static_cast<int>(x), m_ - 1);
-  c.j = std::min(static_cast<int>(y), m_ - 1);
-  c.s = x - c.i;
-  c.t = y - c.j;
-  return c;
+  const int i = std::min(static_cast<int>(x), m_ - 1), j = std::min(static_cast<int>(y), m_ - 1);
+  const double s = x - i, t = y - j;
+  const std::size_t side = static_cast<std::size_t>(m_) + 1;
+  const std::size_t k00 = static_cast<std::size_t>(j) * side + static_cast<std::size_t>(i);
+  return {{k00, k00 + 1, k00 + side, k00 + side + 1},
+          {(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t}};
 }
 
 void GridDisplacements::DisplacementAt(double u, double v, double out[3]) const {
   const Cell c = CellAt(u, v);
-  const auto side = static_cast<std::size_t>(m_) + 1;
-  const std::size_t k00 = static_cast<std::size_t>(c.j) * side + static_cast<std::size_t>(c.i);
-  const std::size_t k[4] = {k00, k00 + 1, k00 + side, k00 + side + 1};
-  const double w[4] = {(1 - c.s) * (1 - c.t), c.s * (1 - c.t), (1 - c.s) * c.t, c.s * c.t};
   for (std::size_t a = 0; a < 3; ++a) {
     double sum = 0;
-    for (int q = 0; q < 4; ++q) sum += w[q] * (d_[3 * k[q] + a] - sharpen_ * bend_d_[3 * k[q] + a]);
+    for (int q = 0; q < 4; ++q) sum += c.w[q] * read_d_[3 * c.k[q] + a];
     out[a] = sum;
   }
 }
@@ -231,12 +231,8 @@ void GridDisplacements::DisplacementAt(double u, double v, double out[3]) const 
 double GridDisplacements::HeightAt(double u, double v) const {
   DISPEX_CHECK(normals_);
   const Cell c = CellAt(u, v);
-  const auto side = static_cast<std::size_t>(m_) + 1;
-  const std::size_t k00 = static_cast<std::size_t>(c.j) * side + static_cast<std::size_t>(c.i);
-  const std::size_t k[4] = {k00, k00 + 1, k00 + side, k00 + side + 1};
-  const double w[4] = {(1 - c.s) * (1 - c.t), c.s * (1 - c.t), (1 - c.s) * c.t, c.s * c.t};
   double sum = 0;
-  for (int q = 0; q < 4; ++q) sum += w[q] * (h_[k[q]] - sharpen_ * bend_h_[k[q]]);
+  for (int q = 0; q < 4; ++q) sum += c.w[q] * read_h_[c.k[q]];
   return sum;
 }
 

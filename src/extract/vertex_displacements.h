@@ -112,7 +112,7 @@ class GridDisplacements {
   int m() const { return m_; }
   // The field read by DisplacementAt and HeightAt: sampled on `n` x `n` texel centres (the
   // vertex values corrected for the blend), or 0: the plain bilinear field, for samples at
-  // no fixed place against the vertices (UV-space texels).
+  // no fixed place against the vertices (UV-space texels). Needed after each Evaluate.
   void SetSampling(int n);
   // At Ptex (u, v) in [0, 1] of the face evaluated: the cell i = min(floor(u m), m - 1),
   // s = u m - i (likewise j, t), and D or h bilinear over its corners, in double.
@@ -120,9 +120,10 @@ class GridDisplacements {
   double HeightAt(double u, double v) const;
 
  private:
+  // The four vertices of the cell holding (u, v) and their bilinear weights.
   struct Cell {
-    int i = 0, j = 0;
-    double s = 0, t = 0;
+    std::size_t k[4];
+    double w[4];
   };
   Cell CellAt(double u, double v) const;
   Status EvaluateApron(const GridSource& source, const Mesh& sculpt, LimitEvaluator& evaluator);
@@ -130,12 +131,12 @@ class GridDisplacements {
 
   int face_ = -1, m_ = 0;
   bool normals_ = false;
-  double sharpen_ = 0;  // m / 4n, or 0
   std::vector<VertexId> vertices_;
   std::vector<ApronVertex> apron_;
   std::vector<float> uv_, positions_, limit_normals_;
   std::vector<double> d_, h_;              // 3 and (with normals) 1 per vertex
   std::vector<double> bend_d_, bend_h_;    // L D and L h per vertex (0 where not defined)
+  std::vector<double> read_d_, read_h_;    // D - (m / 4n) L D, and h likewise: what is read
   std::vector<double> outer_d_, outer_h_;  // D and h of the apron vertex, by apron entry
   std::vector<int> outer_of_;              // per grid vertex: its apron entry, or -1
 };
