@@ -52,10 +52,11 @@ Status CheckFaceCounts(const Mesh& base, const Mesh& sculpt);
 // Fails, naming the sculpt and the transform, when the fit explains at least 90% of the
 // displacement and moves some point by 1.5% of `diagonal` or more, or 75% and 3%. A sculpt's own
 // low-frequency detail on a small cage is explained up to 88% (a cube refined twice, `detail`:
-// a move of 0.7% of the diagonal, a scale by 0.98 and a turn of 2.6 degrees). Measured on Spot (level 3, `detail`; through rays on the jittered layout):
-// the sculpt as made 27%, 0.4% (63%, 0.9%); moved by 2% of the diagonal 95%, 2.1% (89%, 2.4%),
-// by 3.6% 98% (83%, 4.2%); scaled by 1.05 90%, 2.1% (89%, 2.4%); turned by 5 degrees 93%,
-// 2.9% (79%, 2.8%); the bunny scan against its cage 16%, 0.3%.
+// a move of 0.7% of the diagonal, a scale by 0.98 and a turn of 2.6 degrees). Measured on Spot
+// (level 3, `detail`; through rays on the jittered layout): the sculpt as made 27%, 0.4% (63%,
+// 0.9%); moved by 2% of the diagonal 95%, 2.1% (89%, 2.4%), by 3.6% 98% (83%, 4.2%); scaled by 1.05
+// 90%, 2.1% (89%, 2.4%); turned by 5 degrees 93%, 2.9% (79%, 2.8%); the bunny scan against its cage
+// 16%, 0.3%.
 Status CheckPlacement(const PlacementFit& fit, double diagonal, const std::string& sculpt);
 
 }  // namespace dispex::extract
