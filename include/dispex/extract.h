@@ -12,7 +12,9 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "dispex/mesh.h"
@@ -203,7 +205,8 @@ std::vector<PtexFaceInfo> PtexFaceTable(const LimitSurface& surface);
 std::string MeshFingerprint(const Mesh& mesh);
 
 // Checks ranges and combinations, and that the outputs can be written (CheckOutputFile,
-// CheckMapName), before any work; the message names the option.
+// CheckMapName), before any work; the message names the option. Code kInvalidArgument, or
+// kOutput for an output that cannot be written.
 Status ValidateExtractOptions(const ExtractOptions& options);
 
 // A memory size: "8G", "512M", "300K" or a number of bytes (ExtractOptions::max_memory).
@@ -212,13 +215,40 @@ StatusOr<std::uint64_t> ParseByteSize(const std::string& text);
 // A map's name whose extension says another format (map.exr, map.png, map.obj) is refused.
 Status CheckMapName(const std::string& path);
 
-// Sets one option by its ExtractOptions field name from a value as a manifest gives it
-// (ReadExtractManifest, docs/SHAPES.md) -- JSON text: "0.001", "\"auto\"", "\"64x64\"" --,
-// for a program that takes options by name (the Python module). Errors start with the name:
-// "tolerance: \"x\" is not a number", "colour: unknown option (known: ...)".
+// ---- Options by name ---------------------------------------------------------------------------
+
+// The kind of value an option takes, as JSON (a manifest's value; a program's value turned
+// into JSON): what a program checks before it hands a value over.
+enum class OptionKind : std::uint8_t {
+  kInteger,        // 64
+  kNumber,         // 0.001 (an integer too)
+  kBool,           // true
+  kText,           // "64x64"
+  kPath,           // "maps/uv": a file or folder
+  kChoice,         // one of the names ExtractOptionSpec::values lists: "fill"
+  kIntegerOrAuto,  // 64 or "auto"
+  kSize,           // 8589934592 or "8G"
+  kDistance,       // 0.05, "auto" or "2%"
+};
+
+// One extract option set by name, declared once (src/extract/option_table.cpp).
+struct ExtractOptionSpec {
+  std::string_view name;  // the ExtractOptions field: manifests, Python keywords, messages
+  std::string_view flag;  // the command line's flag
+  OptionKind kind;
+  std::string_view values;  // what it takes, in words: "fill, fail or zero"
+  bool in_manifest;         // false: set for one run only (threads, incremental, shard)
+};
+std::span<const ExtractOptionSpec> ExtractOptionSpecs();
+
 // The names SetExtractOption takes, comma-separated (for messages).
 std::string ExtractOptionNames();
 
+// Sets one option by its ExtractOptions field name from a value as a manifest gives it
+// (ReadExtractManifest, docs/SHAPES.md) -- JSON text: "0.001", "\"auto\"", "\"64x64\"" --,
+// for a program that takes options by name (the Python module). Errors (code
+// kInvalidArgument) start with the name: "tolerance: \"x\" is not a number", "colour: unknown
+// option (known: ...)".
 Status SetExtractOption(ExtractOptions& options, const std::string& name,
                         const std::string& json_value);
 

@@ -119,6 +119,9 @@ struct PtexWriterOptions {
   int compression_level = -1;
 };
 
+// Empty when `level` (-1: the default) is a level `compressor` takes, else why not.
+std::string PtexCompressionLevelProblem(PtexCompressor compressor, int level);
+
 // Writes one Ptex file. Faces may be submitted in any order and from several threads at
 // once; each submission is converted, reduced and compressed immediately, so only
 // compressed blocks stay in memory. Finish() assembles the file in face-id / reduction

@@ -1,39 +1,88 @@
 // Status and StatusOr: the one error channel for bad input and bad options.
 //
 // A failed Status carries a one-line message that names the file, the line or element, and
-// what is wrong ("mesh.obj:12: face index 9 out of range (8 vertices)"). Broken internal
-// invariants are not Status errors: they are DISPEX_CHECK failures (src/core/check.h).
+// what is wrong ("mesh.obj:12: face index 9 out of range (8 vertices)"). Its code says what
+// kind of failure it is, so that a program branches on the code, never on the message text
+// (the command line's exit status, the Python module's exception classes); where known, the
+// file and the Ptex face it is about travel with it. Broken internal invariants are not
+// Status errors: they are DISPEX_CHECK failures (src/core/check.h).
 #pragma once
 
 #include <cassert>
+#include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 
 namespace dispex {
+
+enum class StatusCode : std::uint8_t {
+  kOk,
+  kFailed,           // any other failure
+  kInvalidArgument,  // an option or argument out of range, of the wrong kind, or unknown
+  kBadInput,         // a file or mesh that cannot be read or is malformed: path() names it
+  kMismatch,         // inputs that do not belong together (no overlap, another sculpt's parts)
+  kCheckFailed,      // a map that fails a check it was asked to pass (verify's bounds)
+  kCancelled,        // cancelled (dispex/cancel.h)
+  kOverBudget,       // estimated to need more memory than allowed (max_memory)
+  kOutput,           // an output that cannot be written: path() names it
+};
+// "ok", "failed", "invalid_argument", "bad_input", "mismatch", "check_failed", "cancelled",
+// "over_budget", "output".
+std::string_view StatusCodeName(StatusCode code);
 
 class [[nodiscard]] Status {
  public:
   Status() = default;
   static Status Ok() { return Status(); }
   static Status Error(std::string message) {
+    return Error(StatusCode::kFailed, std::move(message));
+  }
+  static Status Error(StatusCode code, std::string message) {
     Status s;
-    s.ok_ = false;
+    s.code_ = code == StatusCode::kOk ? StatusCode::kFailed : code;
     s.message_ = std::move(message);
     return s;
   }
 
-  bool ok() const { return ok_; }
+  bool ok() const { return code_ == StatusCode::kOk; }
+  StatusCode code() const { return code_; }
   const std::string& message() const { return message_; }
+  const std::string& path() const { return path_; }  // the file it is about, or empty
+  std::int64_t face() const { return face_; }        // the Ptex face it is about, or -1
 
   // Returns a copy whose message is "prefix: message" (for adding a file name or context).
   Status WithPrefix(const std::string& prefix) const {
-    return ok_ ? *this : Error(prefix + ": " + message_);
+    Status s = *this;
+    if (!ok()) s.message_ = prefix + ": " + message_;
+    return s;
+  }
+  // A copy with `code` where the failure's kind is not known yet (kFailed): the first, most
+  // specific code set on the way up stays.
+  Status WithCode(StatusCode code) const {
+    Status s = *this;
+    if (code_ == StatusCode::kFailed && code != StatusCode::kOk) s.code_ = code;
+    return s;
+  }
+  // A copy naming the file it is about, unless a deeper call already named one.
+  Status WithPath(const std::string& path) const {
+    Status s = *this;
+    if (!ok() && s.path_.empty()) s.path_ = path;
+    return s;
+  }
+  // A copy naming the Ptex face it is about, unless a deeper call already named one.
+  Status WithFace(std::int64_t face) const {
+    Status s = *this;
+    if (!ok() && s.face_ < 0) s.face_ = face;
+    return s;
   }
 
  private:
-  bool ok_ = true;
+  StatusCode code_ = StatusCode::kOk;
   std::string message_;
+  std::string path_;
+  std::int64_t face_ = -1;
 };
 
 // Either a value or a failed Status. Accessing the value of a failed StatusOr is a

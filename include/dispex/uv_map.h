@@ -67,6 +67,8 @@ class UvMap {
   std::string Attribute(const std::string& name) const;
 
  private:
+  static StatusOr<UvMap> OpenTiles(const std::string& pattern);
+
   std::vector<UvMapTile> tiles_;
   std::vector<std::string> paths_;
   std::vector<int> tile_index_;  // by UDIM - 1001: index into tiles_, -1 when absent

@@ -16,6 +16,11 @@ namespace dispex {
 
 namespace {
 
+// An output that cannot be written; path() names it.
+Status OutputError(const std::string& message) {
+  return Status::Error(StatusCode::kOutput, message);
+}
+
 // Temporary paths of live outputs, kept in fixed storage so a signal handler can read them
 // without locks or allocation.
 constexpr int kMaxLiveOutputs = 256;  // a UV map's tiles are committed together
@@ -83,10 +88,10 @@ Status CheckFolder(const std::string& what, const std::filesystem::path& folder)
   MissingFolders(folder, existing);
   std::error_code ec;
   if (!fs::is_directory(existing, ec)) {
-    return Status::Error(what + ": " + existing.string() + " is not a folder");
+    return OutputError(what + ": " + existing.string() + " is not a folder");
   }
   if (::access(existing.c_str(), W_OK | X_OK) != 0) {
-    return Status::Error(what + ": cannot write in " + existing.string() + ": " + ErrnoText(errno));
+    return OutputError(what + ": cannot write in " + existing.string() + ": " + ErrnoText(errno));
   }
   return Status::Ok();
 }
@@ -95,20 +100,20 @@ Status CheckFolder(const std::string& what, const std::filesystem::path& folder)
 
 Status CheckOutputFile(const std::string& path) {
   namespace fs = std::filesystem;
-  if (path.empty()) return Status::Error("empty output file name");
+  if (path.empty()) return OutputError("empty output file name");
   std::error_code ec;
-  if (fs::is_directory(path, ec)) return Status::Error(path + ": is a folder");
-  return CheckFolder(path, fs::path(path).parent_path());
+  if (fs::is_directory(path, ec)) return OutputError(path + ": is a folder").WithPath(path);
+  return CheckFolder(path, fs::path(path).parent_path()).WithPath(path);
 }
 
 Status CheckOutputFolder(const std::string& path) {
   namespace fs = std::filesystem;
-  if (path.empty()) return Status::Error("empty output folder name");
+  if (path.empty()) return OutputError("empty output folder name");
   std::error_code ec;
   if (fs::exists(path, ec) && !fs::is_directory(path, ec)) {
-    return Status::Error(path + ": is a file, not a folder");
+    return OutputError(path + ": is a file, not a folder").WithPath(path);
   }
-  return CheckFolder(path, fs::path(path));
+  return CheckFolder(path, fs::path(path)).WithPath(path);
 }
 
 StatusOr<AtomicOutput> AtomicOutput::Create(const std::string& target) {
@@ -121,7 +126,7 @@ StatusOr<AtomicOutput> AtomicOutput::Create(const std::string& target) {
     std::error_code ec;
     if (!fs::create_directory(*it, ec) && ec) {
       for (auto undo = made.rbegin(); undo != it; ++undo) fs::remove(*undo, ec);
-      return Status::Error(target + ": cannot make folder " + it->string() + ": " + ec.message());
+      return OutputError(target + ": cannot make folder " + it->string() + ": " + ec.message());
     }
   }
   if (dir.empty()) dir = ".";
@@ -132,8 +137,8 @@ StatusOr<AtomicOutput> AtomicOutput::Create(const std::string& target) {
     const int err = errno;
     std::error_code ec;
     for (const fs::path& folder : made) fs::remove(folder, ec);
-    return Status::Error(target + ": cannot create output in " + dir.string() + ": " +
-                         ErrnoText(err));
+    return OutputError(target + ": cannot create output in " + dir.string() + ": " +
+                       ErrnoText(err));
   }
   ::fchmod(
       fd, 0644 & ~[] {
@@ -176,13 +181,13 @@ AtomicOutput::~AtomicOutput() {
 }
 
 Status AtomicOutput::Write(const void* data, std::size_t size) {
-  if (fd_ < 0) return Status::Error(target_ + ": output is closed");
+  if (fd_ < 0) return OutputError(target_ + ": output is closed");
   const char* p = static_cast<const char*>(data);
   while (size > 0) {
     ssize_t n = ::write(fd_, p, size);
     if (n < 0) {
       if (errno == EINTR) continue;
-      return Status::Error(target_ + ": write failed: " + ErrnoText(errno));
+      return OutputError(target_ + ": write failed: " + ErrnoText(errno));
     }
     p += n;
     size -= static_cast<std::size_t>(n);
@@ -192,21 +197,21 @@ Status AtomicOutput::Write(const void* data, std::size_t size) {
 }
 
 Status AtomicOutput::Close() {
-  if (fd_ < 0) return Status::Error(target_ + ": output is closed");
+  if (fd_ < 0) return OutputError(target_ + ": output is closed");
   if (::fsync(fd_) != 0 && errno != EINVAL) {
-    return Status::Error(target_ + ": flush failed: " + ErrnoText(errno));
+    return OutputError(target_ + ": flush failed: " + ErrnoText(errno));
   }
   if (::close(std::exchange(fd_, -1)) != 0) {
-    return Status::Error(target_ + ": close failed: " + ErrnoText(errno));
+    return OutputError(target_ + ": close failed: " + ErrnoText(errno));
   }
   return Status::Ok();
 }
 
 Status AtomicOutput::Commit() {
-  if (temp_.empty()) return Status::Error(target_ + ": output is closed");
+  if (temp_.empty()) return OutputError(target_ + ": output is closed");
   if (fd_ >= 0) DISPEX_RETURN_IF_ERROR(Close());
   if (::rename(temp_.c_str(), target_.c_str()) != 0) {
-    return Status::Error(target_ + ": cannot rename temporary file: " + ErrnoText(errno));
+    return OutputError(target_ + ": cannot rename temporary file: " + ErrnoText(errno));
   }
   UnregisterLive(std::exchange(slot_, -1));
   temp_.clear();

@@ -18,15 +18,18 @@ std::string ErrnoText(int err) {
 }  // namespace
 
 Status CheckReadableFile(const std::string& path) {
+  auto error = [&](const std::string& message) {
+    return Status::Error(StatusCode::kBadInput, message).WithPath(path);
+  };
   struct stat st {};
-  if (path.empty()) return Status::Error("empty file name");
+  if (path.empty()) return error("empty file name");
   if (::stat(path.c_str(), &st) != 0) {
-    if (errno == ENOENT) return Status::Error(path + ": no such file");
-    return Status::Error(path + ": " + ErrnoText(errno));
+    if (errno == ENOENT) return error(path + ": no such file");
+    return error(path + ": " + ErrnoText(errno));
   }
-  if (S_ISDIR(st.st_mode)) return Status::Error(path + ": is a directory, not a file");
-  if (!S_ISREG(st.st_mode)) return Status::Error(path + ": not a regular file");
-  if (::access(path.c_str(), R_OK) != 0) return Status::Error(path + ": " + ErrnoText(errno));
+  if (S_ISDIR(st.st_mode)) return error(path + ": is a directory, not a file");
+  if (!S_ISREG(st.st_mode)) return error(path + ": not a regular file");
+  if (::access(path.c_str(), R_OK) != 0) return error(path + ": " + ErrnoText(errno));
   return Status::Ok();
 }
 

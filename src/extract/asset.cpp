@@ -172,12 +172,14 @@ StatusOr<AssetReport> ExtractAssetInArena(const ExtractAssetOptions& o, int thre
   }
 
   report.shapes.resize(jobs.size());
-  Progress bar("extract", jobs.size(), "shapes", o.options.progress);
+  // A program's counter (ExtractOptions::progress_counter) counts the shapes done.
+  Progress bar("extract", jobs.size(), "shapes", o.options.progress, o.options.progress_counter);
   FirstError error;
   tbb::parallel_for(std::size_t{0}, jobs.size(), [&](std::size_t i) {
     if (error.failed()) return;
     ShapeJob& job = jobs[i];
     job.options.progress = false;
+    job.options.progress_counter = nullptr;
     Stopwatch clock;
     ExtractReport shape_report = StartReport(job.options, threads);
     shape_report.shape = job.name;

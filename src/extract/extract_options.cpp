@@ -120,7 +120,9 @@ Status CheckMapName(const std::string& path) {
   return Status::Ok();
 }
 
-Status ValidateExtractOptions(const ExtractOptions& o) {
+namespace {
+
+Status CheckOptions(const ExtractOptions& o) {
   if (o.base_path.empty() && !o.base_mesh) return Status::Error("no base mesh given");
   if (o.sculpt_path.empty() && !o.sculpt_mesh) return Status::Error("no sculpt mesh given");
   if (o.output_path.empty()) return Status::Error("no output file given (output_path)");
@@ -155,6 +157,11 @@ Status ValidateExtractOptions(const ExtractOptions& o) {
   }
   if (o.data_type != PtexDataType::kFloat && o.data_type != PtexDataType::kHalf) {
     return Status::Error("data_type: must be float or half");
+  }
+  if (std::string why =
+          PtexCompressionLevelProblem(PtexWriterOptions{}.compressor, o.compression_level);
+      !why.empty()) {
+    return Status::Error(fmt::format("compression_level = {}: {}", o.compression_level, why));
   }
   if (!(o.max_miss_fraction >= 0 && o.max_miss_fraction <= 1)) {
     return Status::Error(
@@ -215,6 +222,12 @@ Status ValidateExtractOptions(const ExtractOptions& o) {
   spectral.fixed_ulog2 = o.fixed_ulog2;
   spectral.fixed_vlog2 = o.fixed_vlog2;
   return ValidateSpectralOptions(spectral);
+}
+
+}  // namespace
+
+Status ValidateExtractOptions(const ExtractOptions& options) {
+  return CheckOptions(options).WithCode(StatusCode::kInvalidArgument);
 }
 
 StatusOr<std::uint64_t> ParseByteSize(const std::string& text) {

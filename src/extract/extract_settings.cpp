@@ -62,7 +62,8 @@ Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs
                         : EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals,
                                                  report.base_diagonal);
     if (!estimate.ok()) {
-      return Status::Error(fmt::format("{} and {} do not overlap: {}", options.base_path,
+      return Status::Error(StatusCode::kMismatch,
+                           fmt::format("{} and {} do not overlap: {}", options.base_path,
                                        options.sculpt_path, estimate.status().message()));
     }
     report.search_estimate = *estimate;

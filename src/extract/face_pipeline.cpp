@@ -200,10 +200,11 @@ StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
 
   if (r.misses > 0) {
     if (settings.holes == HolePolicy::kFail) {
-      return Status::Error(fmt::format(
-          "Ptex face {}: {} of {} rays missed the sculpt within the search distance {:.6g} "
-          "(holes = fail)",
-          face.value, r.misses, count, settings.search_distance));
+      return Status::Error(StatusCode::kMismatch,
+                           fmt::format("Ptex face {}: {} of {} rays missed the sculpt within the "
+                                       "search distance {:.6g} (holes = fail)",
+                                       face.value, r.misses, count, settings.search_distance))
+          .WithFace(face.value);
     }
     if (r.misses == static_cast<std::int32_t>(count) && settings.holes == HolePolicy::kFill) {
       r.all_missed = true;

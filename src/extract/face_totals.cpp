@@ -45,18 +45,20 @@ void SumFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
 
 Status CheckMissFraction(const ExtractOptions& options, const ExtractReport& report) {
   if (!(report.miss_fraction > options.max_miss_fraction)) return Status::Ok();
-  return Status::Error(fmt::format(
-      "{:.1f}% of the samples ({} of {}) found no surface of {} within the search distance "
-      "{:.6g} ({}){}, more than max_miss_fraction ({:.4g}%): the sculpt covers only part of {} "
-      "or is not aligned with it; align the meshes, give a longer search_distance, or raise "
-      "max_miss_fraction",
-      100 * report.miss_fraction, report.misses, report.samples, options.sculpt_path,
-      report.search_distance,
-      options.search_distance.kind == SearchDistanceSpec::Kind::kAuto ? "automatic" : "given",
-      report.retry_search_distance > report.search_distance
-          ? fmt::format(" (and {:.6g} on the second search)", report.retry_search_distance)
-          : "",
-      100 * options.max_miss_fraction, options.base_path));
+  return Status::Error(
+      StatusCode::kMismatch,
+      fmt::format(
+          "{:.1f}% of the samples ({} of {}) found no surface of {} within the search distance "
+          "{:.6g} ({}){}, more than max_miss_fraction ({:.4g}%): the sculpt covers only part of {} "
+          "or is not aligned with it; align the meshes, give a longer search_distance, or raise "
+          "max_miss_fraction",
+          100 * report.miss_fraction, report.misses, report.samples, options.sculpt_path,
+          report.search_distance,
+          options.search_distance.kind == SearchDistanceSpec::Kind::kAuto ? "automatic" : "given",
+          report.retry_search_distance > report.search_distance
+              ? fmt::format(" (and {:.6g} on the second search)", report.retry_search_distance)
+              : "",
+          100 * options.max_miss_fraction, options.base_path));
 }
 
 }  // namespace

@@ -221,11 +221,13 @@ StatusOr<PlacementFit> MeasurePlacement(const ExtractInputs& inputs, const GridS
 
 Status CheckFaceCounts(const Mesh& base, const Mesh& sculpt) {
   if (sculpt.num_faces() >= base.num_faces()) return Status::Ok();
-  return Status::Error(fmt::format(
-      "{} has {} faces, fewer than the base {} ({}): base and sculpt swapped? The base is the "
-      "low-resolution cage, the sculpt the detailed mesh made from it; extract with "
-      "check_inputs off if this is meant",
-      sculpt.source, sculpt.num_faces(), base.source, base.num_faces()));
+  return Status::Error(
+      StatusCode::kMismatch,
+      fmt::format(
+          "{} has {} faces, fewer than the base {} ({}): base and sculpt swapped? The base is the "
+          "low-resolution cage, the sculpt the detailed mesh made from it; extract with "
+          "check_inputs off if this is meant",
+          sculpt.source, sculpt.num_faces(), base.source, base.num_faces()));
 }
 
 Status CheckPlacement(const PlacementFit& fit, double diagonal, const std::string& sculpt) {
@@ -234,13 +236,17 @@ Status CheckPlacement(const PlacementFit& fit, double diagonal, const std::strin
       (fit.explained >= 0.9 && move >= 0.015) || (fit.explained >= 0.75 && move >= 0.03);
   if (!moved) return Status::Ok();
   const double turn = Length(fit.rotation) * 180 / std::numbers::pi;
-  return Status::Error(fmt::format(
-      "{}: the sculpt looks moved against its base, not sculpted: a move by ({:.4g}, {:.4g}, "
-      "{:.4g}) ({:.2g}% of the base's diagonal), a scale by {:.4g} and a turn by {:.2g} degrees "
-      "explain {:.0f}% of its displacement (another unit, axis or pivot at export?); put it back "
-      "on its base, or extract with check_inputs off if the displacement is meant",
-      sculpt, fit.translation.x, fit.translation.y, fit.translation.z,
-      100 * Length(fit.translation) / diagonal, 1 + fit.scale, turn, 100 * fit.explained));
+  return Status::Error(
+      StatusCode::kMismatch,
+      fmt::format(
+          "{}: the sculpt looks moved against its base, not sculpted: a move by ({:.4g}, {:.4g}, "
+          "{:.4g}) ({:.2g}% of the base's diagonal), a scale by {:.4g} and a turn by {:.2g} "
+          "degrees "
+          "explain {:.0f}% of its displacement (another unit, axis or pivot at export?); put it "
+          "back "
+          "on its base, or extract with check_inputs off if the displacement is meant",
+          sculpt, fit.translation.x, fit.translation.y, fit.translation.z,
+          100 * Length(fit.translation) / diagonal, 1 + fit.scale, turn, 100 * fit.explained));
 }
 
 }  // namespace dispex::extract

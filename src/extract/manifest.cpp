@@ -16,126 +16,7 @@ namespace dispex {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-namespace {
-
-StatusOr<int> IntValue(const json& v) {
-  if (!v.is_number_integer()) return Status::Error(fmt::format("{} is not an integer", v.dump()));
-  return v.get<int>();
-}
-
-StatusOr<double> NumberValue(const json& v) {
-  if (!v.is_number()) return Status::Error(fmt::format("{} is not a number", v.dump()));
-  return v.get<double>();
-}
-
-StatusOr<std::string> TextValue(const json& v) {
-  if (!v.is_string()) return Status::Error(fmt::format("{} is not a string", v.dump()));
-  return v.get<std::string>();
-}
-
-// A field set from a name ("nearest", "fill"...) by its Parse function.
-template <class Field, class Parse>
-Status SetNamed(Field& field, const json& v, Parse parse) {
-  DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
-  DISPEX_ASSIGN_OR_RETURN(field, parse(s));
-  return Status::Ok();
-}
-
-// Sets one option by its ExtractOptions field name, from a value as the command line takes it.
-Status SetOption(ExtractOptions& o, const std::string& name, const json& v) {
-  auto text = [&]() { return v.is_string() ? v.get<std::string>() : v.dump(); };
-  if (name == "oversample") {
-    if (v == "auto") {
-      o.oversample = 0;
-      return Status::Ok();
-    }
-    DISPEX_ASSIGN_OR_RETURN(o.oversample, IntValue(v));
-  } else if (name == "max_oversample") {
-    DISPEX_ASSIGN_OR_RETURN(o.max_oversample, IntValue(v));
-  } else if (name == "min_oversample") {
-    DISPEX_ASSIGN_OR_RETURN(o.min_oversample, IntValue(v));
-  } else if (name == "search_distance") {
-    DISPEX_ASSIGN_OR_RETURN(o.search_distance, ParseSearchDistance(text()));
-  } else if (name == "ray_policy") {
-    return SetNamed(o.ray_policy, v, ParseHitPolicy);
-  } else if (name == "tolerance") {
-    DISPEX_ASSIGN_OR_RETURN(o.tolerance, NumberValue(v));
-  } else if (name == "tolerance_fraction") {
-    DISPEX_ASSIGN_OR_RETURN(o.tolerance_fraction, NumberValue(v));
-  } else if (name == "resolution_rule") {
-    return SetNamed(o.resolution_rule, v, ParseResolutionRule);
-  } else if (name == "fixed_resolution") {
-    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
-    unsigned w = 0, h = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(s.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || x != 'x' ||
-        !std::has_single_bit(w) || !std::has_single_bit(h)) {
-      return Status::Error(fmt::format("'{}': WxH with powers of two, e.g. 64x64", s));
-    }
-    o.fixed_ulog2 = std::countr_zero(w);
-    o.fixed_vlog2 = std::countr_zero(h);
-  } else if (name == "nonzero_threshold") {
-    DISPEX_ASSIGN_OR_RETURN(o.nonzero_threshold, NumberValue(v));
-  } else if (name == "data_type") {
-    DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
-    if (s != "float" && s != "half") return Status::Error(fmt::format("'{}': float or half", s));
-    o.data_type = s == "half" ? PtexDataType::kHalf : PtexDataType::kFloat;
-  } else if (name == "compression_level") {
-    DISPEX_ASSIGN_OR_RETURN(o.compression_level, IntValue(v));
-  } else if (name == "holes") {
-    return SetNamed(o.holes, v, ParseHolePolicy);
-  } else if (name == "watertight") {
-    return SetNamed(o.watertight, v, ParseWatertightEdges);
-  } else if (name == "max_miss_fraction") {
-    DISPEX_ASSIGN_OR_RETURN(o.max_miss_fraction, NumberValue(v));
-  } else if (name == "bvh_quality") {
-    return SetNamed(o.bvh_quality, v, ParseBuildQuality);
-  } else if (name == "method") {
-    return SetNamed(o.method, v, ParseExtractMethod);
-  } else if (name == "uv_maps_dir") {
-    DISPEX_ASSIGN_OR_RETURN(o.uv_maps_dir, TextValue(v));
-  } else if (name == "uv_resolution") {
-    DISPEX_ASSIGN_OR_RETURN(o.uv_resolution, IntValue(v));
-  } else if (name == "uv_padding") {
-    DISPEX_ASSIGN_OR_RETURN(o.uv_padding, IntValue(v));
-  } else if (name == "max_memory") {
-    if (v.is_number_unsigned()) {
-      o.max_memory = v.get<std::uint64_t>();
-    } else {
-      DISPEX_ASSIGN_OR_RETURN(std::string size, TextValue(v));
-      DISPEX_ASSIGN_OR_RETURN(o.max_memory, ParseByteSize(size));
-    }
-  } else if (name == "embree_isa") {
-    DISPEX_ASSIGN_OR_RETURN(o.embree_isa, TextValue(v));
-  } else if (name == "check_inputs") {
-    if (!v.is_boolean()) return Status::Error(fmt::format("{} is not true or false", v.dump()));
-    o.check_inputs = v.get<bool>();
-  } else if (name == "vector") {
-    if (v == "off") {
-      o.vector.reset();
-      return Status::Ok();
-    }
-    VectorSpace space{};
-    DISPEX_RETURN_IF_ERROR(SetNamed(space, v, ParseVectorSpace));
-    o.vector = space;
-  } else {
-    return Status::Error("unknown option (known: " + ExtractOptionNames() + ")");
-  }
-  return Status::Ok();
-}
-
-}  // namespace
-
 namespace extract {
-
-Status SetOptions(ExtractOptions& o, const json& options, const std::string& where) {
-  if (!options.is_object()) return Status::Error(where + ": not an object");
-  for (const auto& [name, value] : options.items()) {
-    Status s = SetOption(o, name, value);
-    if (!s.ok()) return s.WithPrefix(fmt::format("{}.{}", where, name));
-  }
-  return Status::Ok();
-}
 
 StatusOr<std::string> PathIn(const json& entry, const char* key, const fs::path& folder,
                              const std::string& where) {
@@ -161,20 +42,6 @@ StatusOr<json> ReadJsonObject(const std::string& path) {
 
 using extract::PathIn;
 using extract::SetOptions;
-
-std::string ExtractOptionNames() {
-  return "oversample, max_oversample, min_oversample, search_distance, ray_policy, tolerance, "
-         "tolerance_fraction, resolution_rule, fixed_resolution, nonzero_threshold, data_type, "
-         "compression_level, holes, watertight, max_miss_fraction, bvh_quality, method, vector, "
-         "uv_maps_dir, uv_resolution, uv_padding, max_memory, embree_isa, check_inputs";
-}
-
-Status SetExtractOption(ExtractOptions& options, const std::string& name,
-                        const std::string& json_value) {
-  const json value = json::parse(json_value, nullptr, /*allow_exceptions=*/false);
-  if (value.is_discarded()) return Status::Error(name + ": not a JSON value: " + json_value);
-  return SetOption(options, name, value).WithPrefix(name);
-}
 
 StatusOr<ExtractAssetOptions> ReadExtractManifest(const std::string& path,
                                                   const ExtractAssetOptions& defaults) {

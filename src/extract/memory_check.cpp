@@ -27,6 +27,7 @@ std::string Gib(std::uint64_t bytes) {
 
 Status TooBig(std::uint64_t need, std::uint64_t limit, const std::string& what) {
   return Status::Error(
+      StatusCode::kOverBudget,
       fmt::format("{} needs an estimated {} but the limit is {} (max_memory); free memory, use a "
                   "machine with more, or raise max_memory if the estimate is too high",
                   what, Gib(need), Gib(limit)));

@@ -17,9 +17,11 @@ Status FillMissedFaces(const ExtractOptions& options, const ExtractInputs& input
     any_hit |= r.samples > r.misses;
   }
   if (!any_hit) {
-    return Status::Error(fmt::format(
-        "no ray from {} hit {} within the search distance {:.6g}: the meshes do not overlap",
-        options.base_path, options.sculpt_path, report.search_distance));
+    return Status::Error(
+        StatusCode::kMismatch,
+        fmt::format(
+            "no ray from {} hit {} within the search distance {:.6g}: the meshes do not overlap",
+            options.base_path, options.sculpt_path, report.search_distance));
   }
   CrossFaceFill cross = FillEmptyFaces(has_values, faces.edge_means, inputs.faces);
   std::int64_t filled = 0;

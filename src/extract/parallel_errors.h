@@ -17,7 +17,8 @@ namespace dispex::extract {
 
 inline Status Cancelled() {
   int sig = CancelSignal();
-  return Status::Error(sig ? fmt::format("interrupted by signal {}", sig) : "interrupted");
+  return Status::Error(StatusCode::kCancelled,
+                       sig ? fmt::format("interrupted by signal {}", sig) : "interrupted");
 }
 
 // In parallel over `count` items, item k being face face_of(k), each thread with its own

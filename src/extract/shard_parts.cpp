@@ -75,7 +75,9 @@ std::string PartInputsKey(const std::string& map_inputs_key, int index, int coun
   return h.Digest().Hex();
 }
 
-StatusOr<ShardPart> OpenShardPart(const std::string& path) {
+namespace {
+
+StatusOr<ShardPart> ReadShardPart(const std::string& path) {
   StatusOr<PtexFile> file = PtexFile::Open(path);
   if (!file.ok()) return file.status().WithPrefix(path);
   const PtexMetaItem* item = file->FindMetaData(kShardMetaKey);
@@ -118,12 +120,20 @@ StatusOr<ShardPart> OpenShardPart(const std::string& path) {
   return part;
 }
 
+}  // namespace
+
+StatusOr<ShardPart> OpenShardPart(const std::string& path) {
+  StatusOr<ShardPart> part = ReadShardPart(path);
+  if (!part.ok()) return part.status().WithCode(StatusCode::kBadInput).WithPath(path);
+  return part;
+}
+
 StatusOr<std::vector<ShardPart>> CheckShardParts(std::vector<ShardPart> parts) {
-  if (parts.empty()) return Status::Error("no parts to merge");
+  if (parts.empty()) return Status::Error(StatusCode::kMismatch, "no parts to merge");
   for (std::size_t k = 1; k < parts.size(); ++k) {
     const std::string why = Difference(parts[k], parts[0]);
     if (!why.empty()) {
-      return Status::Error(fmt::format("{}: {}", parts[k].path, why));
+      return Status::Error(StatusCode::kMismatch, fmt::format("{}: {}", parts[k].path, why));
     }
   }
   std::stable_sort(parts.begin(), parts.end(), [](const ShardPart& a, const ShardPart& b) {
@@ -132,29 +142,34 @@ StatusOr<std::vector<ShardPart>> CheckShardParts(std::vector<ShardPart> parts) {
   const int count = parts[0].info.count;
   for (std::size_t k = 1; k < parts.size(); ++k) {
     if (parts[k].info.index == parts[k - 1].info.index) {
-      return Status::Error(fmt::format("{} and {} are both shard {}/{}", parts[k - 1].path,
+      return Status::Error(StatusCode::kMismatch,
+                           fmt::format("{} and {} are both shard {}/{}", parts[k - 1].path,
                                        parts[k].path, parts[k].info.index, count));
     }
   }
   for (int i = 1, k = 0; i <= count; ++i, ++k) {
     if (static_cast<std::size_t>(k) >= parts.size() ||
         parts[static_cast<std::size_t>(k)].info.index != i) {
-      return Status::Error(fmt::format("shard {}/{} is missing ({} of {} parts given)", i, count,
+      return Status::Error(StatusCode::kMismatch,
+                           fmt::format("shard {}/{} is missing ({} of {} parts given)", i, count,
                                        parts.size(), count));
     }
   }
   std::int64_t next = 0;
   for (const ShardPart& part : parts) {
     if (part.info.begin != next) {
-      return Status::Error(fmt::format(
-          "{}: shard {}/{} holds faces {}..{} of the shard order, but the shards before it end "
-          "at {}",
-          part.path, part.info.index, count, part.info.begin, part.info.end - 1, next - 1));
+      return Status::Error(
+          StatusCode::kMismatch,
+          fmt::format(
+              "{}: shard {}/{} holds faces {}..{} of the shard order, but the shards before it end "
+              "at {}",
+              part.path, part.info.index, count, part.info.begin, part.info.end - 1, next - 1));
     }
     next = part.info.end;
   }
   if (next != parts[0].file.num_faces()) {
-    return Status::Error(fmt::format("{}: the shards end at face {} of {} in shard order",
+    return Status::Error(StatusCode::kMismatch,
+                         fmt::format("{}: the shards end at face {} of {} in shard order",
                                      parts.back().path, next - 1, parts[0].file.num_faces()));
   }
   return parts;
@@ -163,23 +178,25 @@ StatusOr<std::vector<ShardPart>> CheckShardParts(std::vector<ShardPart> parts) {
 Status CheckPartsMatchInputs(const std::vector<ShardPart>& parts, const ExtractReport& report) {
   const ShardPart& part = parts.front();
   if (Meta(part.file, "dispex:base_fingerprint") != report.base_fingerprint) {
-    return Status::Error(
-        fmt::format("{}: made from another {} than the file there now (its "
-                    "fingerprint differs); run the shards again",
-                    part.path, report.base_path));
+    return Status::Error(StatusCode::kMismatch,
+                         fmt::format("{}: made from another {} than the file there now (its "
+                                     "fingerprint differs); run the shards again",
+                                     part.path, report.base_path));
   }
   if (Meta(part.file, "dispex:sculpt_fingerprint") != report.sculpt_fingerprint) {
-    return Status::Error(
-        fmt::format("{}: made from another {} than the file there now (its "
-                    "fingerprint differs); run the shards again",
-                    part.path, report.sculpt_path));
+    return Status::Error(StatusCode::kMismatch,
+                         fmt::format("{}: made from another {} than the file there now (its "
+                                     "fingerprint differs); run the shards again",
+                                     part.path, report.sculpt_path));
   }
   if (part.info.map_inputs_key != report.inputs_key) {
-    return Status::Error(fmt::format("{}: made from other inputs than {} and {} now", part.path,
+    return Status::Error(StatusCode::kMismatch,
+                         fmt::format("{}: made from other inputs than {} and {} now", part.path,
                                      report.base_path, report.sculpt_path));
   }
   if (static_cast<std::size_t>(part.file.num_faces()) != report.ptex_faces) {
-    return Status::Error(fmt::format("{}: has {} faces, {} now {}", part.path,
+    return Status::Error(StatusCode::kMismatch,
+                         fmt::format("{}: has {} faces, {} now {}", part.path,
                                      part.file.num_faces(), report.base_path, report.ptex_faces));
   }
   return Status::Ok();

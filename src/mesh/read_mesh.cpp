@@ -43,7 +43,9 @@ MeshFormat DetectMeshFormat(const std::string& path) {
   return HasPlyMagic(path) ? MeshFormat::kPly : MeshFormatOfName(path);
 }
 
-StatusOr<Mesh> ReadMesh(const std::string& path, const ReadOptions& options) {
+namespace {
+
+StatusOr<Mesh> ReadMeshFile(const std::string& path, const ReadOptions& options) {
   DISPEX_RETURN_IF_ERROR(CheckReadableFile(path));
   switch (DetectMeshFormat(path)) {
     case MeshFormat::kPly:
@@ -54,6 +56,14 @@ StatusOr<Mesh> ReadMesh(const std::string& path, const ReadOptions& options) {
       break;
   }
   return Status::Error(path + ": unknown mesh format (expected an .obj file or a PLY file)");
+}
+
+}  // namespace
+
+StatusOr<Mesh> ReadMesh(const std::string& path, const ReadOptions& options) {
+  StatusOr<Mesh> mesh = ReadMeshFile(path, options);
+  if (!mesh.ok()) return mesh.status().WithCode(StatusCode::kBadInput).WithPath(path);
+  return mesh;
 }
 
 }  // namespace dispex

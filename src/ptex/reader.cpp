@@ -567,16 +567,21 @@ PtexFile& PtexFile::operator=(PtexFile&&) noexcept = default;
 PtexFile::~PtexFile() = default;
 
 StatusOr<PtexFile> PtexFile::Open(const std::string& path, const PtexReadOptions& options) {
-  DISPEX_ASSIGN_OR_RETURN(MappedFile mapped, MappedFile::Open(path));
+  auto bad = [&](const Status& status) {
+    return status.WithCode(StatusCode::kBadInput).WithPath(path);
+  };
+  StatusOr<MappedFile> mapped = MappedFile::Open(path);
+  if (!mapped.ok()) return bad(mapped.status());
   PtexFile file;
   file.impl_ = std::make_unique<Impl>();
   Impl& impl = *file.impl_;
   impl.name = path;
   impl.options = options;
-  impl.mapped.emplace(std::move(mapped));
+  impl.mapped.emplace(std::move(mapped).value());
   impl.data = reinterpret_cast<const std::uint8_t*>(impl.mapped->data());
   impl.size = impl.mapped->size();
-  DISPEX_RETURN_IF_ERROR(impl.Parse());
+  const Status parsed = impl.Parse();
+  if (!parsed.ok()) return bad(parsed);
   return file;
 }
 

@@ -101,3 +101,11 @@ std::string Inflate(std::span<const std::uint8_t> in, std::span<std::uint8_t> ou
 }
 
 }  // namespace dispex::ptex
+
+namespace dispex {
+
+std::string PtexCompressionLevelProblem(PtexCompressor compressor, int level) {
+  return ptex::CheckCompressionLevel(compressor, level);
+}
+
+}  // namespace dispex

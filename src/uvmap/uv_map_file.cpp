@@ -150,7 +150,9 @@ Status WriteUvMapTiles(std::span<const std::string> paths, std::span<const UvMap
   return Status::Ok();
 }
 
-StatusOr<UvMapTile> ReadUvMapTile(const std::string& path) {
+namespace {
+
+StatusOr<UvMapTile> ReadTileFile(const std::string& path) {
   DISPEX_RETURN_IF_ERROR(CheckReadableFile(path));
   try {
     Imf::InputFile file(path.c_str(), /*numThreads=*/0);
@@ -206,6 +208,14 @@ StatusOr<UvMapTile> ReadUvMapTile(const std::string& path) {
   }
 }
 
+}  // namespace
+
+StatusOr<UvMapTile> ReadUvMapTile(const std::string& path) {
+  StatusOr<UvMapTile> tile = ReadTileFile(path);
+  if (!tile.ok()) return tile.status().WithCode(StatusCode::kBadInput).WithPath(path);
+  return tile;
+}
+
 bool IsUvMapPath(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (in) {
@@ -221,6 +231,12 @@ bool IsUvMapPath(const std::string& path) {
 }
 
 StatusOr<UvMap> UvMap::Open(const std::string& pattern) {
+  StatusOr<UvMap> map = OpenTiles(pattern);
+  if (!map.ok()) return map.status().WithCode(StatusCode::kBadInput).WithPath(pattern);
+  return map;
+}
+
+StatusOr<UvMap> UvMap::OpenTiles(const std::string& pattern) {
   std::string prefix;
   const std::size_t marker = pattern.find("<UDIM>");
   if (marker != std::string::npos) {

@@ -411,8 +411,10 @@ StatusOr<SculptLayout> ParseSculptLayout(std::string_view name) {
   return Status::Error(fmt::format("unknown layout '{}' (refined, jittered)", name));
 }
 
-StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
-  Stopwatch clock;
+namespace {
+
+// The options' ranges and combinations, before any work.
+Status CheckMakeSculptOptions(const MakeSculptOptions& options) {
   const bool jittered = options.layout == SculptLayout::kJittered;
   if (!jittered && (options.levels < 1 || options.levels > 8)) {
     return Status::Error(fmt::format("levels = {}: must be 1..8", options.levels));
@@ -441,6 +443,15 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   if (options.pattern == Pattern::kImage && options.image_path.empty()) {
     return Status::Error("the image pattern needs a height image (image:FILE.png)");
   }
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
+  Stopwatch clock;
+  DISPEX_RETURN_IF_ERROR(CheckMakeSculptOptions(options).WithCode(StatusCode::kInvalidArgument));
+  const bool jittered = options.layout == SculptLayout::kJittered;
   std::optional<tbb::global_control> limit;
   if (options.threads > 0) {
     limit.emplace(tbb::global_control::max_allowed_parallelism,
