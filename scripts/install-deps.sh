@@ -9,7 +9,7 @@ packages=(
   libdeflate-dev zlib1g-dev libfftw3-dev libxxhash-dev
   libfast-float-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libpng-dev libopenexr-dev libgtest-dev libgmock-dev libbenchmark-dev
-  python3-dev pybind11-dev python3-numpy python3-pytest
+  python3-dev pybind11-dev python3-numpy python3-pytest mypy
 )
 if [[ "${DISPEX_WITH_FORMAT:-0}" == 1 ]]; then
   packages+=(clang-format-14)

@@ -1,10 +1,12 @@
-// Library errors in Python terms: a Status about the arguments is a ValueError, any other
-// failure a dispex.Error (a RuntimeError); both carry the library's one-line message.
+// Library errors in Python terms, chosen by the Status's code (dispex/status.h), never by its
+// message: kInvalidArgument is a ValueError, every other failure an instance of a subclass of
+// dispex.Error (python/dispex/_errors.py) with the library's one-line message and the fields
+// code, path and face.
 #pragma once
 
 #include <pybind11/pybind11.h>
 
-#include <stdexcept>
+#include <exception>
 #include <utility>
 
 #include "dispex/status.h"
@@ -13,16 +15,22 @@ namespace dispex::python {
 
 namespace py = pybind11;
 
-// Raised as dispex.Error.
-class Error : public std::runtime_error {
+// A failed Status on its way to Python.
+class StatusError : public std::exception {
  public:
-  using std::runtime_error::runtime_error;
+  explicit StatusError(Status status) : status_(std::move(status)) {}
+  const Status& status() const { return status_; }
+  const char* what() const noexcept override { return status_.message().c_str(); }
+
+ private:
+  Status status_;
 };
 
-// Defines dispex.Error in `module` and translates Error into it.
+// Translates StatusError into its Python exception.
 void AddErrors(py::module_& module);
 
-// Throws Error (dispex.Error) / py::value_error (ValueError) when `status` failed.
+// Throws StatusError when `status` failed; CheckArgument as kInvalidArgument (ValueError)
+// unless the status says otherwise.
 void CheckOk(const Status& status);
 void CheckArgument(const Status& status);
 

@@ -26,10 +26,10 @@ namespace {
 py::array Checked(const py::handle& value, const std::string& what, const char* kinds, int ndim,
                   py::ssize_t columns) {
   py::array a = py::array::ensure(value);
-  if (!a) throw py::value_error(fmt::format("{}: not an array", what));
+  if (!a) throw py::type_error(fmt::format("{}: not an array", what));
   const char kind = a.dtype().kind();
   if (std::string(kinds).find(kind) == std::string::npos) {
-    throw py::value_error(
+    throw py::type_error(
         fmt::format("{}: dtype {} is not {}", what, py::str(a.dtype()).cast<std::string>(),
                     std::string(kinds) == "f" ? "a float type" : "an integer type"));
   }
@@ -133,7 +133,8 @@ PyMesh MakeMesh(const py::handle& points, const py::handle& counts, const py::ha
                 const py::handle& corner_vertices, const py::handle& corner_sharpness,
                 const py::handle& holes, const py::handle& face_groups,
                 const std::optional<std::vector<std::string>>& group_names, const Rules& rules,
-                const std::string& name, const std::string& argument) {
+                const py::handle& uvs, const py::handle& face_uv_indices, const std::string& name,
+                const std::string& argument) {
   const std::string at = argument.empty() ? "" : argument + ".";
   Mesh mesh;
   mesh.source = argument.empty() ? (name.empty() ? "mesh" : name) : argument;
@@ -217,6 +218,26 @@ PyMesh MakeMesh(const py::handle& points, const py::handle& counts, const py::ha
   } else if (group_names) {
     throw py::value_error(fmt::format("{}group_names: given without face_groups", at));
   }
+  if (!uvs.is_none() && !face_uv_indices.is_none()) {
+    const std::vector<double> uv = Floats(uvs, at + "uvs", 2, 2);
+    for (std::size_t k = 0; k < uv.size(); ++k) {
+      if (!std::isfinite(static_cast<float>(uv[k]))) {
+        throw py::value_error(fmt::format("{}uvs[{}]: not finite (as float32)", at, k / 2));
+      }
+    }
+    const std::vector<std::int64_t> corners = Integers(face_uv_indices, at + "face_uv_indices");
+    if (corners.size() != ids.size()) {
+      throw py::value_error(fmt::format(
+          "{}face_uv_indices: {} entries, but the faces have {} corners (one UV index each)", at,
+          corners.size(), ids.size()));
+    }
+    CheckIndices(corners, static_cast<std::int64_t>(uv.size() / 2), at + "face_uv_indices", "UVs");
+    mesh.uvs.assign(uv.begin(), uv.end());
+    mesh.face_uv_indices.assign(corners.begin(), corners.end());
+  } else if (!uvs.is_none() || !face_uv_indices.is_none()) {
+    throw py::value_error(uvs.is_none() ? fmt::format("{}face_uv_indices: given without uvs", at)
+                                        : fmt::format("{}uvs: given without face_uv_indices", at));
+  }
   SetRules(mesh, rules, at);
   CheckArgument(CheckMeshArrays(mesh));
   return PyMesh{std::make_shared<const Mesh>(std::move(mesh)), name};
@@ -230,18 +251,22 @@ py::array_t<T> ToArray(const std::vector<T>& values) {
 }  // namespace
 
 void AddMesh(py::module_& module) {
-  py::class_<PyMesh>(module, "Mesh",
-                     "A polygon mesh (a base cage or a sculpt) from NumPy arrays: points (N, 3) "
-                     "floats, face_vertex_counts (F,) and face_vertex_indices (sum of counts,) "
-                     "integers; optional subdivision tags (crease_edges (K, 2) with "
-                     "crease_sharpness (K,), corner_vertices with corner_sharpness, holes: face "
-                     "ids; sharpness defaults to 10, infinitely sharp) and groups (face_groups "
-                     "(F,) indices into group_names); the subdivision rules OBJ `t` tags set "
-                     "(boundary_interpolation: none, edge_only, edge_and_corner; "
-                     "crease_method: uniform, chaikin; triangle_subdivision: catmark, smooth; "
-                     "None: a file's default). `name`: the file name the mesh stands for "
-                     "in reports and maps. Wrong dtypes, shapes, non-finite points and indices "
-                     "out of range raise ValueError naming the array.")
+  py::class_<PyMesh>(
+      module, "Mesh",
+      "A polygon mesh (a base cage or a sculpt) from NumPy arrays: points (N, 3) "
+      "floats, face_vertex_counts (F,) and face_vertex_indices (sum of counts,) "
+      "integers; optional subdivision tags (crease_edges (K, 2) with "
+      "crease_sharpness (K,), corner_vertices with corner_sharpness, holes: face "
+      "ids; sharpness defaults to 10, infinitely sharp) and groups (face_groups "
+      "(F,) indices into group_names); texture coordinates (uvs (M, 2) floats with "
+      "face_uv_indices, one index into uvs per face corner, laid out as "
+      "face_vertex_indices: what UV-space maps need); the subdivision rules OBJ `t` tags set "
+      "(boundary_interpolation: none, edge_only, edge_and_corner; "
+      "crease_method: uniform, chaikin; triangle_subdivision: catmark, smooth; "
+      "None: a file's default). `name`: the file name the mesh stands for "
+      "in reports and maps. Wrong dtypes, shapes, non-finite points and indices "
+      "out of range raise ValueError naming the array, a value that is not an array "
+      "TypeError.")
       .def(
           py::init([](const py::handle& points, const py::handle& counts, const py::handle& indices,
                       const py::handle& crease_edges, const py::handle& crease_sharpness,
@@ -250,12 +275,13 @@ void AddMesh(py::module_& module) {
                       const std::optional<std::vector<std::string>>& group_names,
                       const std::optional<std::string>& boundary_interpolation,
                       const std::optional<std::string>& crease_method,
-                      const std::optional<std::string>& triangle_subdivision,
-                      const std::string& name, const std::string& argument) {
+                      const std::optional<std::string>& triangle_subdivision, const py::handle& uvs,
+                      const py::handle& face_uv_indices, const std::string& name,
+                      const std::string& argument) {
             return MakeMesh(points, counts, indices, crease_edges, crease_sharpness,
                             corner_vertices, corner_sharpness, holes, face_groups, group_names,
-                            Rules{boundary_interpolation, crease_method, triangle_subdivision},
-                            name, argument);
+                            Rules{boundary_interpolation, crease_method, triangle_subdivision}, uvs,
+                            face_uv_indices, name, argument);
           }),
           py::arg("points"), py::arg("face_vertex_counts"), py::arg("face_vertex_indices"),
           py::kw_only(), py::arg("crease_edges") = py::none(),
@@ -263,11 +289,13 @@ void AddMesh(py::module_& module) {
           py::arg("corner_sharpness") = py::none(), py::arg("holes") = py::none(),
           py::arg("face_groups") = py::none(), py::arg("group_names") = py::none(),
           py::arg("boundary_interpolation") = py::none(), py::arg("crease_method") = py::none(),
-          py::arg("triangle_subdivision") = py::none(), py::arg("name") = "",
-          py::arg("_argument") = "")
-      .def_readonly("name", &PyMesh::name)
-      .def_property_readonly("num_vertices", [](const PyMesh& m) { return m.mesh->num_vertices(); })
-      .def_property_readonly("num_faces", [](const PyMesh& m) { return m.mesh->num_faces(); })
+          py::arg("triangle_subdivision") = py::none(), py::arg("uvs") = py::none(),
+          py::arg("face_uv_indices") = py::none(), py::arg("name") = "", py::arg("_argument") = "")
+      .def_readonly("name", &PyMesh::name, "The file name the mesh stands for in reports and maps")
+      .def_property_readonly(
+          "num_vertices", [](const PyMesh& m) { return m.mesh->num_vertices(); }, "Vertices")
+      .def_property_readonly(
+          "num_faces", [](const PyMesh& m) { return m.mesh->num_faces(); }, "Faces")
       .def_property_readonly(
           "points",
           [](const PyMesh& m) {
@@ -276,17 +304,21 @@ void AddMesh(py::module_& module) {
             std::memcpy(a.mutable_data(), m.mesh->positions.data(),
                         m.mesh->num_vertices() * sizeof(Float3));
             return a;
-          })
-      .def_property_readonly("face_vertex_counts",
-                             [](const PyMesh& m) {
-                               std::vector<std::int32_t> counts(m.mesh->num_faces());
-                               for (std::size_t f = 0; f < counts.size(); ++f) {
-                                 counts[f] = m.mesh->face_size(f);
-                               }
-                               return ToArray(counts);
-                             })
-      .def_property_readonly("face_vertex_indices",
-                             [](const PyMesh& m) { return ToArray(m.mesh->face_indices); })
+          },
+          "(N, 3) float32: the vertex positions")
+      .def_property_readonly(
+          "face_vertex_counts",
+          [](const PyMesh& m) {
+            std::vector<std::int32_t> counts(m.mesh->num_faces());
+            for (std::size_t f = 0; f < counts.size(); ++f) {
+              counts[f] = m.mesh->face_size(f);
+            }
+            return ToArray(counts);
+          },
+          "(F,) int32: each face's number of vertices")
+      .def_property_readonly(
+          "face_vertex_indices", [](const PyMesh& m) { return ToArray(m.mesh->face_indices); },
+          "The faces' vertex indices, face after face")
       .def_property_readonly(
           "crease_edges",
           [](const PyMesh& m) {
@@ -297,35 +329,57 @@ void AddMesh(py::module_& module) {
               a.mutable_at(k, 1) = c[k].v1.value;
             }
             return a;
-          })
-      .def_property_readonly("crease_sharpness",
-                             [](const PyMesh& m) {
-                               std::vector<float> s;
-                               for (const auto& c : m.mesh->tags.creases) s.push_back(c.sharpness);
-                               return ToArray(s);
-                             })
-      .def_property_readonly("holes",
-                             [](const PyMesh& m) {
-                               std::vector<std::int32_t> h;
-                               for (BaseFaceId f : m.mesh->tags.holes) h.push_back(f.value);
-                               return ToArray(h);
-                             })
-      .def_property_readonly("face_groups",
-                             [](const PyMesh& m) { return ToArray(m.mesh->face_groups); })
-      .def_property_readonly("group_names", [](const PyMesh& m) { return m.mesh->group_names; })
-      .def_property_readonly("corner_vertices",
-                             [](const PyMesh& m) {
-                               std::vector<std::int32_t> v;
-                               for (const auto& c : m.mesh->tags.corners)
-                                 v.push_back(c.vertex.value);
-                               return ToArray(v);
-                             })
-      .def_property_readonly("corner_sharpness",
-                             [](const PyMesh& m) {
-                               std::vector<float> s;
-                               for (const auto& c : m.mesh->tags.corners) s.push_back(c.sharpness);
-                               return ToArray(s);
-                             })
+          },
+          "(K, 2) int32: the vertex pairs of creased edges")
+      .def_property_readonly(
+          "crease_sharpness",
+          [](const PyMesh& m) {
+            std::vector<float> s;
+            for (const auto& c : m.mesh->tags.creases) s.push_back(c.sharpness);
+            return ToArray(s);
+          },
+          "(K,) float32: each creased edge's sharpness (10: infinitely sharp)")
+      .def_property_readonly(
+          "holes",
+          [](const PyMesh& m) {
+            std::vector<std::int32_t> h;
+            for (BaseFaceId f : m.mesh->tags.holes) h.push_back(f.value);
+            return ToArray(h);
+          },
+          "The face ids tagged as holes")
+      .def_property_readonly(
+          "face_groups", [](const PyMesh& m) { return ToArray(m.mesh->face_groups); },
+          "(F,) int32: each face's index into group_names (empty: no groups)")
+      .def_property_readonly(
+          "group_names", [](const PyMesh& m) { return m.mesh->group_names; },
+          "The o/g group names face_groups indexes")
+      .def_property_readonly(
+          "uvs",
+          [](const PyMesh& m) {
+            py::array_t<float> a({static_cast<py::ssize_t>(m.mesh->num_uvs()), py::ssize_t{2}});
+            std::copy(m.mesh->uvs.begin(), m.mesh->uvs.end(), a.mutable_data());
+            return a;
+          },
+          "(M, 2) float32: the texture coordinates (u, v); empty when the mesh has none")
+      .def_property_readonly(
+          "face_uv_indices", [](const PyMesh& m) { return ToArray(m.mesh->face_uv_indices); },
+          "One index into uvs per face corner, laid out as face_vertex_indices")
+      .def_property_readonly(
+          "corner_vertices",
+          [](const PyMesh& m) {
+            std::vector<std::int32_t> v;
+            for (const auto& c : m.mesh->tags.corners) v.push_back(c.vertex.value);
+            return ToArray(v);
+          },
+          "The vertex ids tagged as corners")
+      .def_property_readonly(
+          "corner_sharpness",
+          [](const PyMesh& m) {
+            std::vector<float> s;
+            for (const auto& c : m.mesh->tags.corners) s.push_back(c.sharpness);
+            return ToArray(s);
+          },
+          "Each corner's sharpness")
       .def_property_readonly(
           "subdivision_rules",
           [](const PyMesh& m) {
@@ -339,7 +393,8 @@ void AddMesh(py::module_& module) {
             if (t.triangles_from_file)
               d["triangle_subdivision"] = std::string(TriangleSubdivisionName(t.triangles));
             return d;
-          })
+          },
+          "The subdivision rules tags set, by name, as the constructor takes them")
       .def("__repr__", [](const PyMesh& m) {
         return fmt::format("<dispex.Mesh {}: {} vertices, {} faces>",
                            m.name.empty() ? "(unnamed)" : m.name, m.mesh->num_vertices(),

@@ -12,5 +12,6 @@ PYBIND11_MODULE(_dispex, module) {
   AddMesh(module);
   AddExtract(module);
   AddMaps(module);
+  AddUvMaps(module);
   AddTools(module);
 }

@@ -1,5 +1,6 @@
-// Extraction options from Python keyword arguments: ExtractOptions' field names, values as a
-// manifest takes them (SetExtractOption), plus threads, max_memory and incremental.
+// Extraction options from Python: the library's option table (ExtractOptionSpecs) handed to the
+// package, which turns each keyword argument into the JSON value the library takes
+// (python/dispex/_options.py), and those values set on ExtractOptions.
 #pragma once
 
 #include <pybind11/pybind11.h>
@@ -10,7 +11,11 @@ namespace dispex::python {
 
 namespace py = pybind11;
 
-// Sets `options` from `kwargs`; ValueError with the library's message (naming the option).
-void SetExtractOptions(ExtractOptions& options, const py::dict& kwargs);
+// Sets `options` from `values` (option name -> JSON text); ValueError with the library's
+// message (naming the option).
+void SetExtractOptions(ExtractOptions& options, const py::dict& values);
+
+// dispex._dispex._extract_option_specs(): the table as a list of dicts.
+void AddOptionSpecs(py::module_& module);
 
 }  // namespace dispex::python

@@ -17,21 +17,25 @@ namespace dispex::python {
 
 namespace {
 
+// A real number: a Python int or float or a NumPy scalar (anything with __float__ but a bool or
+// a string); TypeError otherwise.
 double Number(const py::handle& value, const std::string& name) {
-  if (py::isinstance<py::bool_>(value) ||
-      !(py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value))) {
-    throw py::value_error(
+  if (py::isinstance<py::bool_>(value) || py::isinstance<py::str>(value) ||
+      py::isinstance<py::bytes>(value) || !PyNumber_Check(value.ptr()) ||
+      py::hasattr(value, "__complex__")) {
+    throw py::type_error(
         fmt::format("{}: {} is not a number", name, py::repr(value).cast<std::string>()));
   }
-  return value.cast<double>();
+  return py::float_(py::reinterpret_borrow<py::object>(value)).cast<double>();
 }
 
+// An integer: a Python int or a NumPy integer (anything with __index__ but a bool).
 long long Integer(const py::handle& value, const std::string& name) {
-  if (py::isinstance<py::bool_>(value) || !py::isinstance<py::int_>(value)) {
-    throw py::value_error(
+  if (py::isinstance<py::bool_>(value) || !PyIndex_Check(value.ptr())) {
+    throw py::type_error(
         fmt::format("{}: {} is not an integer", name, py::repr(value).cast<std::string>()));
   }
-  return value.cast<long long>();
+  return py::int_(py::reinterpret_borrow<py::object>(value)).cast<long long>();
 }
 
 long long NonNegative(const py::handle& value, const std::string& name) {
@@ -42,7 +46,7 @@ long long NonNegative(const py::handle& value, const std::string& name) {
 
 std::string Text(const py::handle& value, const std::string& name) {
   if (!py::isinstance<py::str>(value)) {
-    throw py::value_error(
+    throw py::type_error(
         fmt::format("{}: {} is not a string", name, py::repr(value).cast<std::string>()));
   }
   return value.cast<std::string>();
@@ -72,7 +76,10 @@ void SetVerifyOption(VerifyOptions& o, const std::string& name, const py::handle
   } else if (name == "tolerance") {
     o.tolerance = Number(v, name);
   } else if (name == "truth_local_bound") {
-    if (!py::isinstance<py::bool_>(v)) throw py::value_error(name + ": not True or False");
+    if (!py::isinstance<py::bool_>(v)) {
+      throw py::type_error(
+          fmt::format("{}: {} is not True or False", name, py::repr(v).cast<std::string>()));
+    }
     o.truth_local_bound = v.cast<bool>();
   } else if (name == "truth_local_tolerance_factor") {
     o.truth_local_tolerance_factor = Number(v, name);
@@ -95,8 +102,8 @@ void SetVerifyOption(VerifyOptions& o, const std::string& name, const py::handle
   }
 }
 
-// Verify; a map that does not pass raises dispex.Error "<map>: <why>" (the command's exit 3)
-// unless check=False, which returns the report with "passed": false.
+// Verify's report as a dict; a map that does not pass (the command's exit 3) raises
+// dispex.VerifyError "<map>: <why>" carrying the report, unless check=False.
 py::object RunVerify(const std::string& base, const std::optional<std::string>& sculpt,
                      const std::string& map, bool check, const py::dict& kwargs) {
   VerifyOptions o;
@@ -107,8 +114,15 @@ py::object RunVerify(const std::string& base, const std::optional<std::string>& 
   std::optional<StatusOr<VerifyReport>> report;
   RunCancellable([&] { report.emplace(Verify(o)); }, ProgressCounter{}, py::none());
   const VerifyReport done = ValueOrRaise(std::move(*report));
-  if (check && !done.passed) throw Error(map + ": " + done.failure);
-  return py::module_::import("json").attr("loads")(VerifyReportJson(done));
+  py::object json = py::module_::import("json").attr("loads")(VerifyReportJson(done));
+  if (check && !done.passed) {
+    py::object cls = py::module_::import("dispex._errors").attr("VerifyError");
+    py::object error =
+        cls(map + ": " + done.failure, py::arg("report") = json, py::arg("path") = map);
+    PyErr_SetObject(cls.ptr(), error.ptr());
+    throw py::error_already_set();
+  }
+  return json;
 }
 
 void SetMakeSculptOption(MakeSculptOptions& o, const std::string& name, const py::handle& v) {
@@ -181,7 +195,9 @@ py::object Info(const std::string& path, bool faces, bool strict) {
   } else {
     const Mesh mesh = ValueOrRaise(ReadMesh(path));
     const MeshSummary summary = SummarizeMesh(mesh, DetectMeshFormat(path));
-    if (strict) CheckOk(RequireClean(mesh, summary.validation));
+    if (strict)
+      CheckOk(
+          RequireClean(mesh, summary.validation).WithCode(StatusCode::kBadInput).WithPath(path));
     json = MeshSummaryJson(path, mesh, summary);
   }
   return py::module_::import("json").attr("loads")(json);

@@ -97,25 +97,41 @@ def test_incremental_run_of_an_unchanged_array_mesh_leaves_the_map(tmp_path, scu
 
 
 @pytest.mark.parametrize("options, message", [
-    ({"tolerance": "x"}, "tolerance: \"x\" is not a number"),
+    ({"tolerance": "x"}, "tolerance: 'x' is not a number"),
+    ({"tolerance": float("nan")}, "tolerance: nan is not a finite number"),
     ({"oversample": 3}, "oversample = 3"),
     ({"holes": "maybe"}, "holes"),
+    ({"compression_level": 99}, "compression_level = 99"),
     ({"colour": 1}, "colour: unknown option"),
     ({"colour": 1}, "uv_maps_dir, .*threads, incremental, shard, shard_sculpt"),
+    ({"uv_maps": "uv", "uv_maps_dir": "uv"}, "given twice"),
+])
+def test_bad_values_raise_value_error_naming_them(tmp_path, sculpts, options, message):
+    with pytest.raises(ValueError, match=message.replace("(", r"\(")):
+        dispex.extract(CUBE, sculpts(CUBE), tmp_path / "m.ptx", **options)
+    assert not (tmp_path / "m.ptx").exists()
+
+
+@pytest.mark.parametrize("options, message", [
     ({"threads": 1.5}, "threads: 1.5 is not an integer"),
+    ({"threads": True}, "threads: True is not an integer"),
+    ({"check_inputs": None}, "check_inputs: None is not True or False"),
+    ({"holes": 1}, "holes: 1 is not a string \\(fill, fail or zero\\)"),
+    ({"uv_maps": 3}, "uv_maps: 3 is not a path"),
     ({"progress": 3}, "progress: 3 is not callable"),
 ])
-def test_bad_options_raise_value_error_naming_them(tmp_path, sculpts, options, message):
-    with pytest.raises(ValueError, match=message.replace("(", r"\(")):
+def test_values_of_the_wrong_type_raise_type_error(tmp_path, sculpts, options, message):
+    with pytest.raises(TypeError, match=message):
         dispex.extract(CUBE, sculpts(CUBE), tmp_path / "m.ptx", **options)
     assert not (tmp_path / "m.ptx").exists()
 
 
 def test_failures_raise_dispex_error_with_the_librarys_message(tmp_path, sculpts):
     missing = tmp_path / "missing.obj"
-    with pytest.raises(dispex.Error, match=str(missing)) as raised:
+    with pytest.raises(dispex.InputError, match=str(missing)) as raised:
         dispex.extract(missing, sculpts(CUBE), tmp_path / "m.ptx")
-    assert isinstance(raised.value, RuntimeError)
+    assert isinstance(raised.value, dispex.Error) and isinstance(raised.value, RuntimeError)
+    assert raised.value.path == str(missing) and raised.value.code == "bad_input"
     assert "\n" not in str(raised.value)
     assert not (tmp_path / "m.ptx").exists()
 

@@ -65,11 +65,15 @@ def test_sampling_at_texel_centres_gives_the_texels(fixed_map):
     ([0], [1.5], [0.5], r"u\[0\] = 1.5: not in \[0, 1\]"),
     ([0], [0.5], [np.nan], r"v\[0\] = nan: not in \[0, 1\]"),
     ([0, 1], [0.5], [0.5], "faces, u and v: 2, 1 and 1 values"),
-    ([0.5], [0.5], [0.5], "faces: expected a 1-D array of integers"),
 ])
 def test_bad_sample_arguments(fixed_map, faces, u, v, message):
     with pytest.raises(ValueError, match=message):
         fixed_map.sample(np.array(faces), np.array(u), np.array(v))
+
+
+def test_sample_arguments_of_the_wrong_type(fixed_map):
+    with pytest.raises(TypeError, match="faces: expected a 1-D array of integers"):
+        fixed_map.sample(np.array([0.5]), np.array([0.5]), np.array([0.5]))
 
 
 def test_a_file_that_is_not_a_map_raises_dispex_error(tmp_path):

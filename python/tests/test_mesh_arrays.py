@@ -31,13 +31,10 @@ def test_read_mesh_gives_the_files_arrays():
 
 
 @pytest.mark.parametrize("changes, message", [
-    ({"points": QUAD_POINTS.astype(np.int32)}, r"base\.points: dtype int32 is not a float type"),
     ({"points": QUAD_POINTS[:, :2]}, r"base\.points: shape \(4, 2\), expected \(N, 3\)"),
     ({"points": np.where(QUAD_POINTS == 1, np.nan, QUAD_POINTS)},
      r"base\.points\[1\]: not finite"),
     ({"points": QUAD_POINTS * 1e39}, r"base\.points\[1\]: not finite \(as float32\)"),
-    ({"face_vertex_counts": np.array([4.0])},
-     r"base\.face_vertex_counts: dtype float64 is not an integer type"),
     ({"face_vertex_counts": np.array([2, 2])},
      r"base\.face_vertex_counts\[0\]: 2 vertices, fewer than 3"),
     ({"face_vertex_counts": np.array([5])},
@@ -58,6 +55,21 @@ def test_bad_arrays_raise_value_error_naming_them(tmp_path, changes, message):
     assert not (tmp_path / "m.ptx").exists()
 
 
+@pytest.mark.parametrize("changes, message", [
+    ({"points": QUAD_POINTS.astype(np.int32)}, r"base\.points: dtype int32 is not a float type"),
+    ({"face_vertex_counts": np.array([4.0])},
+     r"base\.face_vertex_counts: dtype float64 is not an integer type"),
+    ({"uvs": np.array([["a", "b"]])}, r"base\.uvs: dtype <U1 is not a float type"),
+])
+def test_arrays_of_the_wrong_type_raise_type_error(tmp_path, changes, message):
+    arrays = quad(**changes)
+    if "uvs" in changes:
+        arrays["face_uv_indices"] = np.zeros(4, dtype=np.int32)
+    with pytest.raises(TypeError, match=message):
+        dispex.extract(arrays, CUBE, tmp_path / "m.ptx")
+    assert not (tmp_path / "m.ptx").exists()
+
+
 def test_a_missing_array_is_named():
     with pytest.raises(ValueError, match="sculpt: no face_vertex_indices array"):
         arrays = quad()
@@ -66,7 +78,7 @@ def test_a_missing_array_is_named():
 
 
 def test_neither_path_nor_mesh():
-    with pytest.raises(ValueError, match="base: 3 is not a path"):
+    with pytest.raises(TypeError, match="base: 3 is neither a path, a dispex.Mesh nor a dict"):
         dispex.extract(3, CUBE, "m.ptx")
 
 

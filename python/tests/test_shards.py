@@ -44,7 +44,6 @@ def test_a_missing_part_names_itself_and_writes_nothing(tmp_path, sculpts):
 
 @pytest.mark.parametrize("options, message", [
     ({"shard": "4/3"}, "shard: '4/3': expected I/N"),
-    ({"shard": 2}, "shard: 2 is not a string"),
     ({"shard": "1/2", "shard_sculpt": "half"}, "shard_sculpt: unknown shard sculpt 'half'"),
     ({"shard": "1/2", "shard_sculpt": "part"}, "needs method rays and a given search_distance"),
 ])
@@ -54,17 +53,22 @@ def test_bad_shard_options_raise_value_error(tmp_path, sculpts, options, message
     assert not (tmp_path / "part.ptx").exists()
 
 
+def test_a_shard_of_the_wrong_type_raises_type_error(tmp_path, sculpts):
+    with pytest.raises(TypeError, match="shard: 2 is not a string"):
+        dispex.extract(CUBE, sculpts(CUBE), tmp_path / "part.ptx", shard=2)
+
+
 def test_shards_of_meshes_in_memory_are_refused(tmp_path, sculpts):
     with pytest.raises(ValueError, match="base and sculpt must be paths"):
         dispex.extract(dispex.read_mesh(CUBE), sculpts(CUBE), tmp_path / "part.ptx", shard="1/2")
 
 
-@pytest.mark.parametrize("parts, options, message", [
-    ("part.ptx", {}, "is one path, not a list"),
-    ([3], {}, r"parts\[0\]: 3 is not a path"),
-    (["part.ptx"], {"threads": 1.5}, "threads: 1.5 is not an integer"),
-    (["part.ptx"], {"max_memory": -1}, r"max_memory = -1: must be >= 0"),
+@pytest.mark.parametrize("parts, options, error, message", [
+    ("part.ptx", {}, TypeError, "is one path, not a list"),
+    ([3], {}, TypeError, r"parts\[0\]: 3 is not a path"),
+    (["part.ptx"], {"threads": 1.5}, TypeError, "threads: 1.5 is not an integer"),
+    (["part.ptx"], {"max_memory": -1}, ValueError, r"max_memory = -1: must be >= 0"),
 ])
-def test_bad_merge_arguments_raise_value_error(tmp_path, parts, options, message):
-    with pytest.raises(ValueError, match=message):
+def test_bad_merge_arguments_raise_value_or_type_error(tmp_path, parts, options, error, message):
+    with pytest.raises(error, match=message):
         dispex.merge(parts, tmp_path / "merged.ptx", **options)

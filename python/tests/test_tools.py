@@ -18,9 +18,11 @@ def test_make_sculpt_writes_the_command_lines_files(tmp_path):
 
 
 @pytest.mark.parametrize("options, error, message", [
-    ({"levels": 9}, dispex.Error, "levels = 9: must be 1..8"),
+    ({"levels": 9}, ValueError, "levels = 9: must be 1..8"),
+    ({"amplitude": -1}, ValueError, "amplitude = -1: must be >= 0"),
     ({"pattern": "stripes"}, ValueError, "pattern: unknown pattern"),
-    ({"levels": "2"}, ValueError, "levels: '2' is not an integer"),
+    ({"levels": "2"}, TypeError, "levels: '2' is not an integer"),
+    ({"amplitude": None}, TypeError, "amplitude: None is not a number"),
     ({"colour": 1}, ValueError, "colour: unknown option"),
 ])
 def test_make_sculpt_errors(tmp_path, options, error, message):
