@@ -11,36 +11,33 @@
 #include "dispex/files.h"
 #include "dispex/render.h"
 #include "flag_names.h"
+#include "progress_lines.h"
 
 namespace dispex::cli {
 namespace {
 
-constexpr FlagName kExtractFlags[] = {
-    {"output_path", "-o"},
-    {"with check_inputs off", "with --no-input-checks"},
-    {"oversample", "--oversample"},
-    {"0 (automatic)", "'auto'"},
-    {"max_oversample", "--max-oversample"},
-    {"min_oversample", "--min-oversample"},
-    {"search_distance", "--search-distance"},
-    {"tolerance", "--tolerance"},
-    {"tolerance_fraction", "--tolerance-fraction"},
-    {"nonzero_threshold", "--nonzero-threshold"},
-    {"fixed_ulog2 x fixed_vlog2", "--fixed-resolution (log2)"},
-    {"data_type", "--data-type"},
-    {"compression_level", "--compression-level"},
-    {"holes", "--holes"},
-    {"max_miss_fraction", "--max-miss-fraction"},
-    {"threads", "--threads"},
-    {"max_memory", "--max-memory"},
-    {"output_dir", "--out-dir"},
-    {"method", "--method"},
-    {"shard_count", "--shard"},
-    {"shard_sculpt", "--shard-sculpt"},
-    {"uv_maps_dir", "--uv-maps"},
-    {"uv_resolution", "--uv-resolution"},
-    {"uv_padding", "--uv-padding"},
-};
+// The library's field names in messages, spelled as flags: phrases, fields that are not extract
+// options, and the one-word options where messages use them as fields, then the flag of every
+// option with a snake_case name (one word such as "vector" or "shard" is also plain English).
+const std::vector<FlagName>& ExtractFlagNames() {
+  static const std::vector<FlagName> flags = [] {
+    std::vector<FlagName> out = {
+        {"output_path", "-o"},          {"with check_inputs off", "with --no-input-checks"},
+        {"0 (automatic)", "'auto'"},    {"fixed_ulog2 x fixed_vlog2", "--fixed-resolution (log2)"},
+        {"output_dir", "--out-dir"},    {"shard_count", "--shard"},
+        {"oversample", "--oversample"}, {"tolerance", "--tolerance"},
+        {"holes", "--holes"},           {"method", "--method"},
+        {"threads", "--threads"},
+    };
+    for (const ExtractOptionSpec& option : ExtractOptionSpecs()) {
+      if (option.name.find('_') != std::string_view::npos) {
+        out.push_back({option.name, option.flag});
+      }
+    }
+    return out;
+  }();
+  return flags;
+}
 
 struct ExtractArgs {
   ExtractOptions options;
@@ -65,6 +62,8 @@ struct ExtractArgs {
   std::string shard;
   std::string shard_sculpt = "whole";
   bool quiet = false;
+  bool progress_lines = false;
+  ProgressLines* lines = nullptr;  // with --progress-lines, while the work runs
 
   bool asset() const { return !output_dir.empty() || !manifest_path.empty(); }
 };
@@ -130,7 +129,7 @@ Status Resolve(ExtractArgs& a) {
   auto method = ParseExtractMethod(a.method);
   if (!method.ok()) return method.status().WithPrefix("--method");
   o.method = *method;
-  o.progress = !a.quiet && StderrIsInteractive();
+  o.progress = !a.quiet && !a.progress_lines && StderrIsInteractive();
   if (!a.shard.empty()) {
     Status shard = ParseShard(a.shard, o.shard_index, o.shard_count);
     if (!shard.ok()) return shard.WithPrefix("--shard");
@@ -175,9 +174,10 @@ Status Resolve(ExtractArgs& a) {
 template <class Report>
 int Conclude(const ExtractArgs& args, const StatusOr<Report>& report,
              std::string (*json)(const Report&), std::string (*summary)(const Report&)) {
+  if (args.lines != nullptr) args.lines->Finish();  // the last progress line before the rest
   if (!report.ok()) {
     int sig = CancelSignal();
-    return ReportFailure(report.status(), kExtractFlags, sig ? 128 + sig : 1);
+    return ReportFailure(report.status(), ExtractFlagNames(), sig ? 128 + sig : 1);
   }
   if (!args.report_path.empty()) {
     const std::string text = json(*report);
@@ -197,21 +197,25 @@ int RunAsset(ExtractArgs& args) {
   if (!args.manifest_path.empty()) {
     if (!args.options.base_path.empty() || !args.options.sculpt_path.empty()) {
       return ReportFailure(Status::Error("--manifest names the files: give no BASE or SCULPT"),
-                           kExtractFlags, 2);
+                           ExtractFlagNames(), 2);
     }
     auto read = ReadExtractManifest(args.manifest_path, asset);
-    if (!read.ok()) return ReportFailure(read.status(), kExtractFlags, 2);
+    if (!read.ok()) return ReportFailure(read.status(), ExtractFlagNames(), 2);
     asset = std::move(*read);
   } else if (args.options.base_path.empty() || args.options.sculpt_path.empty()) {
-    return ReportFailure(Status::Error("give BASE and SCULPT (or --manifest)"), kExtractFlags, 2);
+    return ReportFailure(Status::Error("give BASE and SCULPT (or --manifest)"), ExtractFlagNames(),
+                         2);
   }
   return Conclude(args, ExtractAsset(asset), AssetReportJson, AssetReportSummary);
 }
 
 int RunExtract(ExtractArgs& args) {
   Status resolved = Resolve(args);
-  if (!resolved.ok()) return ReportFailure(resolved, kExtractFlags, 2);
+  if (!resolved.ok()) return ReportFailure(resolved, ExtractFlagNames(), 2);
   InstallCancelSignalHandlers();
+  ProgressLines lines(args.asset() ? "shapes" : "extract", args.progress_lines);
+  args.options.progress_counter = lines.counter();
+  args.lines = &lines;
   if (args.asset()) return RunAsset(args);
   const int status = Conclude(args, Extract(args.options), ExtractReportJson, ExtractReportSummary);
   if (status != 0) return status;
@@ -343,6 +347,11 @@ void SetupExtract(CLI::App& app, int& exit_code) {
                   "also write DIR/<map>_atlas.png and DIR/<map>_compare.png (base and base + "
                   "map side by side)");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress bar and no summary");
+  cmd->add_flag("--progress-lines", args->progress_lines,
+                "progress for a program that drives the command: a line 'progress extract "
+                "DONE/TOTAL' (Ptex faces; 'progress shapes' with --out-dir) on stderr up to 10 "
+                "times a second and once at the end, also when stderr is not a terminal (instead "
+                "of the bar; -q leaves them on)");
   cmd->callback([args, &exit_code] { exit_code = RunExtract(*args); });
 }
 
