@@ -19,7 +19,7 @@ import os
 from . import _dispex
 from ._dispex import Map, Mesh, UvMap, __version__
 from ._errors import (CancelledError, Error, InputError, MemoryBudgetError, MismatchError,
-                      OutputError, VerifyError)
+                      OutputError, VerifyError, shown as _shown)
 from . import _options
 
 __all__ = ["CancelledError", "Error", "InputError", "Map", "MemoryBudgetError", "Mesh",
@@ -34,7 +34,7 @@ def _path(value, argument):
         if not path:
             raise ValueError(f"{argument}: empty path")
         return path
-    raise TypeError(f"{argument}: {value!r} is not a path (str or os.PathLike)")
+    raise TypeError(f"{argument}: {_shown(value)} is not a path (str or os.PathLike)")
 
 
 def _mesh_or_path(value, argument):
@@ -57,7 +57,7 @@ def _mesh_or_path(value, argument):
         return Mesh(points, counts, indices, _argument=argument, **arrays)
     if isinstance(value, (str, bytes, os.PathLike)):
         return _path(value, argument)
-    raise TypeError(f"{argument}: {value!r} is neither a path, a dispex.Mesh nor a dict of "
+    raise TypeError(f"{argument}: {_shown(value)} is neither a path, a dispex.Mesh nor a dict of "
                     f"mesh arrays")
 
 
@@ -68,7 +68,7 @@ _MESH_KEYWORDS = {"crease_edges", "crease_sharpness", "corner_vertices", "corner
 
 def _check_progress(progress):
     if progress is not None and not callable(progress):
-        raise TypeError(f"progress: {progress!r} is not callable")
+        raise TypeError(f"progress: {_shown(progress)} is not callable")
 
 
 def option_names():
@@ -125,7 +125,7 @@ def _shape_list(shapes):
     if shapes is None:
         return []
     if isinstance(shapes, str) or not all(isinstance(s, str) for s in shapes):
-        raise TypeError(f"shapes: {shapes!r} is not a list of shape names")
+        raise TypeError(f"shapes: {_shown(shapes)} is not a list of shape names")
     return list(shapes)
 
 
@@ -152,7 +152,7 @@ def merge(parts, output, *, progress=None, threads=0, max_memory=0):
     """
     _check_progress(progress)
     if isinstance(parts, (str, bytes, os.PathLike)):
-        raise TypeError(f"parts: {parts!r} is one path, not a list of parts")
+        raise TypeError(f"parts: {_shown(parts)} is one path, not a list of parts")
     paths = [_path(part, f"parts[{i}]") for i, part in enumerate(parts)]
     limits = _options.to_json({"threads": threads, "max_memory": max_memory})
     return _dispex._merge(paths, _path(output, "output"), progress, limits)

@@ -8,6 +8,18 @@ the library's one-line message and what it is about.
 from typing import Any, Dict, Optional
 
 
+def shown(value: Any) -> str:
+    """`value` as messages show it: its repr, or for a long one (a whole array) its type and,
+    for an array, its shape."""
+    text = repr(value)
+    if len(text) <= 60:
+        return text
+    shape = getattr(value, "shape", None)
+    kind = type(value).__module__ + "." + type(value).__qualname__
+    kind = kind.replace("builtins.", "")
+    return f"<{kind} of shape {tuple(shape)}>" if shape is not None else f"<{kind}>"
+
+
 class Error(RuntimeError):
     """A dispex failure.
 

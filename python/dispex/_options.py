@@ -15,6 +15,7 @@ import os
 from typing import Any, Dict
 
 from . import _dispex
+from ._errors import shown
 
 SPECS: Dict[str, Dict[str, Any]] = {s["name"]: s for s in _dispex._extract_option_specs()}
 
@@ -32,7 +33,7 @@ ALIASES: Dict[str, str] = {
 
 
 def _type_error(name, value, what):
-    return TypeError(f"{name}: {value!r} is not {what}")
+    return TypeError(f"{name}: {shown(value)} is not {what}")
 
 
 def _integer(name, value):
@@ -42,7 +43,7 @@ def _integer(name, value):
         try:
             return int(value)
         except ValueError:
-            raise ValueError(f"{name}: {value!r} is not an integer") from None
+            raise ValueError(f"{name}: {shown(value)} is not an integer") from None
     try:
         return operator.index(value)
     except TypeError:
@@ -56,13 +57,13 @@ def _number(name, value):
         try:
             number = float(value)
         except ValueError:
-            raise ValueError(f"{name}: {value!r} is not a number") from None
+            raise ValueError(f"{name}: {shown(value)} is not a number") from None
     elif isinstance(value, numbers.Real):
         number = float(value)
     else:
         raise _type_error(name, value, "a number")
     if not math.isfinite(number):
-        raise ValueError(f"{name}: {value!r} is not a finite number")
+        raise ValueError(f"{name}: {shown(value)} is not a finite number")
     return int(number) if isinstance(value, numbers.Integral) else number
 
 

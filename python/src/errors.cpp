@@ -41,6 +41,10 @@ void Raise(const Status& status) {
 
 }  // namespace
 
+std::string Shown(const py::handle& value) {
+  return py::module_::import("dispex._errors").attr("shown")(value).cast<std::string>();
+}
+
 void AddErrors(py::module_&) {
   py::register_exception_translator([](std::exception_ptr p) {
     try {

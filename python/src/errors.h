@@ -7,6 +7,7 @@
 #include <pybind11/pybind11.h>
 
 #include <exception>
+#include <string>
 #include <utility>
 
 #include "dispex/status.h"
@@ -33,6 +34,10 @@ void AddErrors(py::module_& module);
 // unless the status says otherwise.
 void CheckOk(const Status& status);
 void CheckArgument(const Status& status);
+
+// `value` as a message shows it: its repr, or for a long one (a whole array) its type and,
+// for an array, its shape.
+std::string Shown(const py::handle& value);
 
 template <class T>
 T ValueOrRaise(StatusOr<T> result) {

@@ -29,8 +29,8 @@ void SetInput(const py::handle& value, const char* argument, std::string& path,
   } else if (py::isinstance<py::str>(value)) {
     path = value.cast<std::string>();
   } else {
-    throw py::type_error(fmt::format("{}: {} is neither a path nor a dispex.Mesh", argument,
-                                     py::repr(value).cast<std::string>()));
+    throw py::type_error(
+        fmt::format("{}: {} is neither a path nor a dispex.Mesh", argument, Shown(value)));
   }
 }
 

@@ -4,6 +4,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -243,6 +244,84 @@ PyMesh MakeMesh(const py::handle& points, const py::handle& counts, const py::ha
   return PyMesh{std::make_shared<const Mesh>(std::move(mesh)), name};
 }
 
+// The arguments of dispex.Mesh(...), checked as the signature in its docstring says
+// (TypeError naming what is wrong), without pybind11's own argument types in the messages.
+// `_argument` (the name dispex.extract gives a dict of arrays in errors) is not documented.
+PyMesh MeshFromArguments(const py::args& args, const py::kwargs& kwargs) {
+  static const std::array<const char*, 3> kPositional = {"points", "face_vertex_counts",
+                                                         "face_vertex_indices"};
+  static const std::array<const char*, 13> kKeywords = {"crease_edges",
+                                                        "crease_sharpness",
+                                                        "corner_vertices",
+                                                        "corner_sharpness",
+                                                        "holes",
+                                                        "face_groups",
+                                                        "group_names",
+                                                        "boundary_interpolation",
+                                                        "crease_method",
+                                                        "uvs",
+                                                        "face_uv_indices",
+                                                        "triangle_subdivision",
+                                                        "name"};
+  if (args.size() > kPositional.size()) {
+    throw py::type_error(fmt::format(
+        "Mesh: takes 3 positional arguments (points, face_vertex_counts, face_vertex_indices), "
+        "{} given",
+        args.size()));
+  }
+  py::dict given;
+  for (std::size_t k = 0; k < args.size(); ++k) given[kPositional[k]] = args[k];
+  for (const auto& [key, value] : kwargs) {
+    const std::string name = py::str(key);
+    const bool known = name == "_argument" ||
+                       std::find_if(kKeywords.begin(), kKeywords.end(),
+                                    [&](const char* k) { return name == k; }) != kKeywords.end() ||
+                       std::find_if(kPositional.begin(), kPositional.end(),
+                                    [&](const char* k) { return name == k; }) != kPositional.end();
+    if (!known) {
+      std::string names;
+      for (const char* k : kKeywords) names += fmt::format("{}{}", names.empty() ? "" : ", ", k);
+      throw py::type_error(fmt::format("Mesh: unknown keyword '{}' (known: {})", name, names));
+    }
+    if (given.contains(key)) throw py::type_error(fmt::format("Mesh: {} given twice", name));
+    given[key] = value;
+  }
+  for (const char* name : kPositional) {
+    if (!given.contains(name)) throw py::type_error(fmt::format("Mesh: no {} given", name));
+  }
+  auto get = [&](const char* name) -> py::object {
+    return given.contains(name) ? py::object(given[name]) : py::object(py::none());
+  };
+  auto text = [&](const char* name) -> std::optional<std::string> {
+    py::object value = get(name);
+    if (value.is_none()) return std::nullopt;
+    if (!py::isinstance<py::str>(value)) {
+      throw py::type_error(fmt::format("{}: {} is not a string", name, Shown(value)));
+    }
+    return value.cast<std::string>();
+  };
+  std::optional<std::vector<std::string>> group_names;
+  if (py::object names = get("group_names"); !names.is_none()) {
+    if (py::isinstance<py::str>(names)) {
+      throw py::type_error("group_names: a string, not a list of names");
+    }
+    group_names.emplace();
+    for (py::handle n : names) {
+      if (!py::isinstance<py::str>(n)) {
+        throw py::type_error(fmt::format("group_names: {} is not a string", Shown(n)));
+      }
+      group_names->push_back(n.cast<std::string>());
+    }
+  }
+  return MakeMesh(
+      get("points"), get("face_vertex_counts"), get("face_vertex_indices"), get("crease_edges"),
+      get("crease_sharpness"), get("corner_vertices"), get("corner_sharpness"), get("holes"),
+      get("face_groups"), group_names,
+      Rules{text("boundary_interpolation"), text("crease_method"), text("triangle_subdivision")},
+      get("uvs"), get("face_uv_indices"), text("name").value_or(""),
+      text("_argument").value_or(""));
+}
+
 template <class T>
 py::array_t<T> ToArray(const std::vector<T>& values) {
   return py::array_t<T>(static_cast<py::ssize_t>(values.size()), values.data());
@@ -267,30 +346,13 @@ void AddMesh(py::module_& module) {
       "in reports and maps. Wrong dtypes, shapes, non-finite points and indices "
       "out of range raise ValueError naming the array, a value that is not an array "
       "TypeError.")
-      .def(
-          py::init([](const py::handle& points, const py::handle& counts, const py::handle& indices,
-                      const py::handle& crease_edges, const py::handle& crease_sharpness,
-                      const py::handle& corner_vertices, const py::handle& corner_sharpness,
-                      const py::handle& holes, const py::handle& face_groups,
-                      const std::optional<std::vector<std::string>>& group_names,
-                      const std::optional<std::string>& boundary_interpolation,
-                      const std::optional<std::string>& crease_method,
-                      const std::optional<std::string>& triangle_subdivision, const py::handle& uvs,
-                      const py::handle& face_uv_indices, const std::string& name,
-                      const std::string& argument) {
-            return MakeMesh(points, counts, indices, crease_edges, crease_sharpness,
-                            corner_vertices, corner_sharpness, holes, face_groups, group_names,
-                            Rules{boundary_interpolation, crease_method, triangle_subdivision}, uvs,
-                            face_uv_indices, name, argument);
-          }),
-          py::arg("points"), py::arg("face_vertex_counts"), py::arg("face_vertex_indices"),
-          py::kw_only(), py::arg("crease_edges") = py::none(),
-          py::arg("crease_sharpness") = py::none(), py::arg("corner_vertices") = py::none(),
-          py::arg("corner_sharpness") = py::none(), py::arg("holes") = py::none(),
-          py::arg("face_groups") = py::none(), py::arg("group_names") = py::none(),
-          py::arg("boundary_interpolation") = py::none(), py::arg("crease_method") = py::none(),
-          py::arg("triangle_subdivision") = py::none(), py::arg("uvs") = py::none(),
-          py::arg("face_uv_indices") = py::none(), py::arg("name") = "", py::arg("_argument") = "")
+      .def(py::init([](const py::args& args, const py::kwargs& kwargs) {
+             return MeshFromArguments(args, kwargs);
+           }),
+           "Mesh(points, face_vertex_counts, face_vertex_indices, *, crease_edges=None, "
+           "crease_sharpness=None, corner_vertices=None, corner_sharpness=None, holes=None, "
+           "face_groups=None, group_names=None, boundary_interpolation=None, crease_method=None, "
+           "triangle_subdivision=None, uvs=None, face_uv_indices=None, name='')")
       .def_readonly("name", &PyMesh::name, "The file name the mesh stands for in reports and maps")
       .def_property_readonly(
           "num_vertices", [](const PyMesh& m) { return m.mesh->num_vertices(); }, "Vertices")

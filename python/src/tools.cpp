@@ -23,8 +23,7 @@ double Number(const py::handle& value, const std::string& name) {
   if (py::isinstance<py::bool_>(value) || py::isinstance<py::str>(value) ||
       py::isinstance<py::bytes>(value) || !PyNumber_Check(value.ptr()) ||
       py::hasattr(value, "__complex__")) {
-    throw py::type_error(
-        fmt::format("{}: {} is not a number", name, py::repr(value).cast<std::string>()));
+    throw py::type_error(fmt::format("{}: {} is not a number", name, Shown(value)));
   }
   return py::float_(py::reinterpret_borrow<py::object>(value)).cast<double>();
 }
@@ -32,8 +31,7 @@ double Number(const py::handle& value, const std::string& name) {
 // An integer: a Python int or a NumPy integer (anything with __index__ but a bool).
 long long Integer(const py::handle& value, const std::string& name) {
   if (py::isinstance<py::bool_>(value) || !PyIndex_Check(value.ptr())) {
-    throw py::type_error(
-        fmt::format("{}: {} is not an integer", name, py::repr(value).cast<std::string>()));
+    throw py::type_error(fmt::format("{}: {} is not an integer", name, Shown(value)));
   }
   return py::int_(py::reinterpret_borrow<py::object>(value)).cast<long long>();
 }
@@ -46,8 +44,7 @@ long long NonNegative(const py::handle& value, const std::string& name) {
 
 std::string Text(const py::handle& value, const std::string& name) {
   if (!py::isinstance<py::str>(value)) {
-    throw py::type_error(
-        fmt::format("{}: {} is not a string", name, py::repr(value).cast<std::string>()));
+    throw py::type_error(fmt::format("{}: {} is not a string", name, Shown(value)));
   }
   return value.cast<std::string>();
 }
@@ -77,8 +74,7 @@ void SetVerifyOption(VerifyOptions& o, const std::string& name, const py::handle
     o.tolerance = Number(v, name);
   } else if (name == "truth_local_bound") {
     if (!py::isinstance<py::bool_>(v)) {
-      throw py::type_error(
-          fmt::format("{}: {} is not True or False", name, py::repr(v).cast<std::string>()));
+      throw py::type_error(fmt::format("{}: {} is not True or False", name, Shown(v)));
     }
     o.truth_local_bound = v.cast<bool>();
   } else if (name == "truth_local_tolerance_factor") {

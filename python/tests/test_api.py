@@ -334,3 +334,20 @@ def test_a_script_using_the_module_type_checks(tmp_path):
                             str(tmp_path / "cache"), str(bad)], capture_output=True, text=True,
                            env=env)
     assert wrong.returncode == 1 and "Incompatible types in assignment" in wrong.stdout
+
+
+def test_messages_show_no_whole_arrays_and_no_binding_internals(tmp_path, sculpts):
+    big = np.zeros(1000)
+    with pytest.raises(TypeError, match=r"tolerance: <numpy.ndarray of shape \(1000,\)> is not"):
+        dispex.extract(CUBE, sculpts(CUBE), tmp_path / "m.ptx", tolerance=big)
+    mesh = dispex.read_mesh(CUBE)
+    with pytest.raises(TypeError) as raised:
+        dispex.Mesh(mesh.points, mesh.face_vertex_counts, mesh.face_vertex_indices, creases=big)
+    message = str(raised.value)
+    assert message.startswith("Mesh: unknown keyword 'creases' (known: crease_edges, ")
+    assert "handle" not in message and "_argument" not in message and "0., 0." not in message
+    with pytest.raises(TypeError, match="Mesh: no face_vertex_indices given"):
+        dispex.Mesh(mesh.points, mesh.face_vertex_counts)
+    with pytest.raises(TypeError, match="Mesh: takes 3 positional arguments"):
+        dispex.Mesh(mesh.points, mesh.face_vertex_counts, mesh.face_vertex_indices, None)
+    assert "handle" not in dispex.Mesh.__init__.__doc__
