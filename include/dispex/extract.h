@@ -238,6 +238,10 @@ struct ExtractOptionSpec {
   OptionKind kind;
   std::string_view values;  // what it takes, in words: "fill, fail or zero"
   bool in_manifest;         // false: set for one run only (threads, incremental, shard)
+  // Recorded in the map (dispex:options) and so in its inputs key: a change re-extracts an
+  // incremental run's faces. false: how the run goes, not what the map holds (threads,
+  // memory, checks, where other outputs go).
+  bool in_map = false;
 };
 std::span<const ExtractOptionSpec> ExtractOptionSpecs();
 

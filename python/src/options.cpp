@@ -53,6 +53,7 @@ void AddOptionSpecs(py::module_& module) {
       d["kind"] = std::string(KindName(s.kind));
       d["values"] = std::string(s.values);
       d["in_manifest"] = s.in_manifest;
+      d["in_map"] = s.in_map;
       specs.append(d);
     }
     return specs;

@@ -27,6 +27,9 @@ def test_every_option_of_the_table_is_a_flag_of_the_command_line():
         assert re.search(re.escape(spec["flag"]) + r"\b", help_text), (name, spec["flag"])
         assert spec["kind"] in {"integer", "number", "bool", "text", "path", "choice",
                                 "integer_or_auto", "size", "distance"}
+    recorded = {name for name, spec in names.items() if spec["in_map"]}
+    assert {"tolerance", "oversample", "search_distance", "vector", "method"} <= recorded
+    assert not {"threads", "max_memory", "incremental", "uv_maps_dir", "check_inputs"} & recorded
 
 
 # A value for each option other than its default, and the command line's arguments for it.

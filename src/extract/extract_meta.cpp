@@ -2,9 +2,7 @@
 
 #include <fmt/format.h>
 
-#include <bit>
 #include <filesystem>
-#include <type_traits>
 
 #include "extract/face_records.h"
 
@@ -15,125 +13,7 @@ std::string FileName(const std::string& path) {
   return std::filesystem::path(path).filename().string();
 }
 
-std::string_view SearchKindName(SearchDistanceSpec::Kind kind) {
-  switch (kind) {
-    case SearchDistanceSpec::Kind::kAuto:
-      return "auto";
-    case SearchDistanceSpec::Kind::kAbsolute:
-      return "absolute";
-    case SearchDistanceSpec::Kind::kRelative:
-      return "relative";
-  }
-  return "auto";
-}
 }  // namespace
-
-nlohmann::json ExtractOptionsJson(const ExtractOptions& o) {
-  nlohmann::json j;
-  j["oversample"] = o.oversample == 0 ? nlohmann::json("auto") : nlohmann::json(o.oversample);
-  j["max_oversample"] = o.max_oversample;
-  j["min_oversample"] = o.min_oversample;
-  j["search_distance"] = {{"kind", std::string(SearchKindName(o.search_distance.kind))},
-                          {"value", o.search_distance.value}};
-  j["ray_policy"] = std::string(HitPolicyName(o.ray_policy));
-  j["tolerance"] = o.tolerance == 0 ? nlohmann::json("auto") : nlohmann::json(o.tolerance);
-  j["tolerance_fraction"] = o.tolerance_fraction;
-  j["resolution_rule"] = std::string(ResolutionRuleName(o.resolution_rule));
-  j["nonzero_threshold"] = o.nonzero_threshold;
-  j["fixed_resolution"] = {1 << o.fixed_ulog2, 1 << o.fixed_vlog2};
-  j["data_type"] = std::string(PtexDataTypeName(o.data_type));
-  j["compression_level"] = o.compression_level;
-  j["holes"] = std::string(HolePolicyName(o.holes));
-  j["max_miss_fraction"] = o.max_miss_fraction;
-  j["bvh_quality"] = std::string(BuildQualityName(o.bvh_quality));
-  j["watertight"] = std::string(WatertightEdgesName(o.watertight));
-  // Only on vector maps, so that scalar maps keep their keys (incremental re-use).
-  if (o.vector) j["vector"] = std::string(VectorSpaceName(*o.vector));
-  // Only when given: maps made before the option existed keep their keys.
-  if (o.method != ExtractMethod::kAuto) j["method"] = std::string(ExtractMethodName(o.method));
-  return j;
-}
-
-StatusOr<ExtractOptions> ExtractOptionsFromJson(const nlohmann::json& j) {
-  if (!j.is_object()) return Status::Error("options: not a JSON object");
-  ExtractOptions o;
-  for (const auto& [key, value] : j.items()) {
-    auto named = [&](auto parse, auto& field) -> Status {
-      if (!value.is_string()) return Status::Error("not a name");
-      DISPEX_ASSIGN_OR_RETURN(field, parse(value.template get<std::string>()));
-      return Status::Ok();
-    };
-    auto number = [&](auto& field) -> Status {
-      if (!value.is_number()) return Status::Error("not a number");
-      field = value.template get<std::remove_reference_t<decltype(field)>>();
-      return Status::Ok();
-    };
-    Status s = Status::Ok();
-    if (key == "oversample") {
-      s = value == "auto" ? (o.oversample = 0, Status::Ok()) : number(o.oversample);
-    } else if (key == "max_oversample") {
-      s = number(o.max_oversample);
-    } else if (key == "min_oversample") {
-      s = number(o.min_oversample);
-    } else if (key == "search_distance") {
-      const std::string kind = value.value("kind", "");
-      o.search_distance.kind = kind == "absolute"   ? SearchDistanceSpec::Kind::kAbsolute
-                               : kind == "relative" ? SearchDistanceSpec::Kind::kRelative
-                                                    : SearchDistanceSpec::Kind::kAuto;
-      if (kind != "auto" && kind != "absolute" && kind != "relative") {
-        s = Status::Error("kind must be auto, absolute or relative");
-      } else if (!value.contains("value") || !value["value"].is_number()) {
-        s = Status::Error("no numeric value");
-      } else {
-        o.search_distance.value = value["value"].get<double>();
-      }
-    } else if (key == "ray_policy") {
-      s = named(ParseHitPolicy, o.ray_policy);
-    } else if (key == "tolerance") {
-      s = value == "auto" ? (o.tolerance = 0, Status::Ok()) : number(o.tolerance);
-    } else if (key == "tolerance_fraction") {
-      s = number(o.tolerance_fraction);
-    } else if (key == "resolution_rule") {
-      s = named(ParseResolutionRule, o.resolution_rule);
-    } else if (key == "nonzero_threshold") {
-      s = number(o.nonzero_threshold);
-    } else if (key == "fixed_resolution") {
-      if (!value.is_array() || value.size() != 2 || !value[0].is_number_integer() ||
-          !value[1].is_number_integer() || value[0].get<int>() < 1 || value[1].get<int>() < 1) {
-        s = Status::Error("not [width, height]");
-      } else {
-        o.fixed_ulog2 = std::bit_width(value[0].get<unsigned>()) - 1;
-        o.fixed_vlog2 = std::bit_width(value[1].get<unsigned>()) - 1;
-      }
-    } else if (key == "data_type") {
-      s = value == PtexDataTypeName(PtexDataType::kHalf)
-              ? (o.data_type = PtexDataType::kHalf, Status::Ok())
-          : value == PtexDataTypeName(PtexDataType::kFloat)
-              ? (o.data_type = PtexDataType::kFloat, Status::Ok())
-              : Status::Error("float32 or half");
-    } else if (key == "compression_level") {
-      s = number(o.compression_level);
-    } else if (key == "holes") {
-      s = named(ParseHolePolicy, o.holes);
-    } else if (key == "max_miss_fraction") {
-      s = number(o.max_miss_fraction);
-    } else if (key == "bvh_quality") {
-      s = named(ParseBuildQuality, o.bvh_quality);
-    } else if (key == "watertight") {
-      s = named(ParseWatertightEdges, o.watertight);
-    } else if (key == "method") {
-      s = named(ParseExtractMethod, o.method);
-    } else if (key == "vector") {
-      VectorSpace space{};
-      s = named(ParseVectorSpace, space);
-      o.vector = space;
-    } else {
-      s = Status::Error("unknown option");
-    }
-    if (!s.ok()) return s.WithPrefix("options." + key);
-  }
-  return o;
-}
 
 nlohmann::json ExtractStatisticsJson(const ExtractReport& r) {
   nlohmann::json j;
