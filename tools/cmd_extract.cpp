@@ -12,6 +12,7 @@
 #include "dispex/render.h"
 #include "flag_names.h"
 #include "progress_lines.h"
+#include "watch.h"
 
 namespace dispex::cli {
 namespace {
@@ -64,6 +65,8 @@ struct ExtractArgs {
   bool quiet = false;
   bool progress_lines = false;
   ProgressLines* lines = nullptr;  // with --progress-lines, while the work runs
+  bool watch = false;
+  int watch_settle_ms = WatchSettings{}.settle_ms;
 
   bool asset() const { return !output_dir.empty() || !manifest_path.empty(); }
 };
@@ -150,6 +153,14 @@ Status Resolve(ExtractArgs& a) {
   DISPEX_RETURN_IF_ERROR(CheckOutputs({{"--report", a.report_path},
                                        {"--preview", a.preview_dir, /*folder=*/true},
                                        {"--out-dir", a.output_dir, /*folder=*/true}}));
+  if (a.watch) {
+    if (a.asset()) {
+      return Status::Error("--watch re-extracts one map (-o), not --out-dir/--manifest");
+    }
+    if (o.shard_count > 0) return Status::Error("--watch re-extracts a whole map, not a --shard");
+    // Each round re-uses the map; UV-space maps are not re-used: a full extraction each round.
+    if (o.uv_maps_dir.empty()) o.incremental = true;
+  }
   if (a.asset()) {
     if (!o.output_path.empty()) return Status::Error("give -o or --out-dir/--manifest, not both");
     if (!a.manifest_path.empty() && !a.shapes.empty()) {
@@ -161,6 +172,9 @@ Status Resolve(ExtractArgs& a) {
   if (!a.shapes.empty()) return Status::Error("--shapes needs --out-dir (one map per shape)");
   if (o.shard_count > 0 && !a.preview_dir.empty()) {
     return Status::Error("--preview needs a whole map, not a shard's part: preview the merged map");
+  }
+  if (o.plan_only && (!a.preview_dir.empty() || a.watch)) {
+    return Status::Error("--plan writes nothing: not with --preview or --watch");
   }
   if (o.base_path.empty() || o.sculpt_path.empty()) {
     return Status::Error("give BASE and SCULPT (or --manifest)");
@@ -209,10 +223,47 @@ int RunAsset(ExtractArgs& args) {
   return Conclude(args, ExtractAsset(asset), AssetReportJson, AssetReportSummary);
 }
 
+// --watch (tools/watch.h): a round at start and one per save of BASE or SCULPT, each printing a
+// line; one that fails leaves the map as it was. Ends on Ctrl-C: 128 + the signal.
+int RunWatchRounds(const ExtractArgs& args) {
+  WatchSettings settings;
+  settings.settle_ms = args.watch_settle_ms;
+  std::vector<std::string> warned;
+  const ExtractOptions& o = args.options;
+  return RunWatch(
+      {o.base_path, o.sculpt_path}, settings, args.quiet,
+      [&](const std::vector<std::string>& changed) {
+        ProgressLines lines("extract", args.progress_lines);
+        ExtractOptions options = o;
+        options.progress_counter = lines.counter();
+        const StatusOr<ExtractReport> report = Extract(options);
+        lines.Finish();
+        if (CancelRequested()) return;
+        if (!report.ok()) {
+          const std::string why = WithFlagNames(report.status().message(), ExtractFlagNames());
+          std::fputs(WatchFailureLine(changed, o.output_path, why).c_str(), stderr);
+          return;
+        }
+        if (!args.report_path.empty()) {
+          const std::string text = ExtractReportJson(*report);
+          Status written = WriteFileAtomically(args.report_path, text.data(), text.size());
+          if (!written.ok()) ReportFailure(written.WithPrefix("--report"));
+        }
+        if (!args.preview_dir.empty() && (!report->unchanged || changed.empty())) {
+          Status previews = WritePreviews(o.base_path, o.output_path, args.preview_dir);
+          if (!previews.ok()) ReportFailure(previews.WithPrefix("--preview"));
+        }
+        if (!args.quiet) {
+          std::fputs(WatchRoundLines(changed, *report, warned).c_str(), stderr);
+        }
+      });
+}
+
 int RunExtract(ExtractArgs& args) {
   Status resolved = Resolve(args);
   if (!resolved.ok()) return ReportFailure(resolved, ExtractFlagNames(), 2);
   InstallCancelSignalHandlers();
+  if (args.watch) return RunWatchRounds(args);
   ProgressLines lines(args.asset() ? "shapes" : "extract", args.progress_lines);
   args.options.progress_counter = lines.counter();
   args.lines = &lines;
@@ -331,6 +382,10 @@ void SetupExtract(CLI::App& app, int& exit_code) {
   cmd->add_flag("!--no-input-checks", o.check_inputs,
                 "extract inputs that look like a mistake: a sculpt with fewer faces than its "
                 "base, or one moved, scaled or turned against it as a whole");
+  cmd->add_flag("--plan", o.plan_only,
+                "print the plan -- which faces would be traced and which copied, the method and "
+                "what the BVH holds -- and stop: the inputs are read and matched, nothing is "
+                "written (with --report, the report's \"plan\")");
   cmd->add_flag("--incremental", o.incremental,
                 "re-use the map at the output path: left as it is when made from the same "
                 "inputs and options, else only the faces whose inputs changed are extracted "
@@ -341,6 +396,17 @@ void SetupExtract(CLI::App& app, int& exit_code) {
   cmd->add_option("--shard-sculpt", args->shard_sculpt,
                   "what a shard keeps of the sculpt: whole, or part (only what its faces' rays "
                   "reach: memory falls with N; needs --method rays and --search-distance)")
+      ->capture_default_str();
+  CLI::Option* watch =
+      cmd->add_flag("--watch", args->watch,
+                    "keep running: extract again each time BASE or SCULPT is saved, re-using the "
+                    "map (--incremental; UV-space maps: a full extraction), one line per round; "
+                    "a broken save leaves the map as it was; Ctrl-C ends it (exit 130)");
+  cmd->add_option("--watch-settle", args->watch_settle_ms,
+                  "with --watch: milliseconds a file written in place must stay unchanged (size, "
+                  "time) before it is read")
+      ->check(NonNegative())
+      ->needs(watch)
       ->capture_default_str();
   cmd->add_option("--report", args->report_path, "write a JSON report to this file");
   cmd->add_option("--preview", args->preview_dir,

@@ -151,6 +151,11 @@ struct ExtractOptions {
   // another version is not re-used (a warning says why).
   bool incremental = false;
 
+  // Stop once the plan is made (ExtractReport::plan: which faces would run, from where the
+  // others come, the method and tracer): the inputs are read, matched and keyed, no face is
+  // traced and nothing is written.
+  bool plan_only = false;
+
   // Vector displacement (docs/VECTOR.md): a 3-channel map of D = sculpt - limit surface in this
   // space (include/dispex/vector_space.h), the sculpt read exactly at each sample through its
   // correspondence with the base -- it must be the base refined (MatchRefinedSculpt) -- with
@@ -256,8 +261,41 @@ std::string ExtractOptionNames();
 Status SetExtractOption(ExtractOptions& options, const std::string& name,
                         const std::string& json_value);
 
+// What one map's extraction does, decided before its faces are traced, each part by the stage
+// that can decide it (the method once the sculpt is matched, the faces once their keys are
+// known); in the report ("plan") and, with ExtractOptions::plan_only, all a run does.
+struct ExtractPlan {
+  enum class Output : std::uint8_t {
+    kMap,        // the map at output_path (and its UV-space tiles)
+    kShardPart,  // a farm shard's part (ExtractOptions::shard_count)
+    kUpToDate,   // nothing: the map at output_path was made from these inputs (incremental)
+  };
+  enum class Tracer : std::uint8_t {
+    kNone,         // no BVH: the sculpt read through its correspondence (mapping, interpolate)
+    kWholeSculpt,  // a BVH of the whole sculpt
+    kWithinReach,  // a BVH of the sculpt within reach of the faces that run (and their rings)
+  };
+  Output output = Output::kMap;
+  int channels = 1;                               // 3: a vector map
+  ExtractMethod method = ExtractMethod::kAuto;    // the method that runs (kAuto: not chosen yet)
+  Tracer tracer = Tracer::kWholeSculpt;
+  // Where the faces that do not run get their texels: "" (all run), the previous map's path
+  // (incremental), or "N shard parts" (a merge).
+  std::string faces_from;
+  std::string redo_reason;  // why faces run again (incremental): ExtractReport::redo_reason
+  // Ptex faces: all of them; those extracted in this run; copied from faces_from; another
+  // shard's (a shard part); holes of the base (no surface, written as 0). -1: not planned yet.
+  std::int64_t faces = 0, faces_run = -1, faces_copied = -1, faces_elsewhere = 0, hole_faces = 0;
+  bool uv_maps = false;  // UV-space tiles written after the map
+};
+std::string_view ExtractPlanOutputName(ExtractPlan::Output output);  // "map", "shard part", "up to date"
+std::string_view ExtractPlanTracerName(ExtractPlan::Tracer tracer);  // "none", "whole sculpt", "within reach"
+// The plan in a few lines for people ("plan: a map (scalar), method mapping, BVH: none ...").
+std::string ExtractPlanSummary(const ExtractPlan& plan);
+
 struct ExtractReport {
   std::string version;
+  ExtractPlan plan;
   std::string shape;  // the shape's name when extracted as part of an asset (ExtractAsset)
   std::string base_path, sculpt_path, output_path;
   std::string base_fingerprint, sculpt_fingerprint;

@@ -62,6 +62,7 @@ OPTION_VALUES = {
     "incremental": (None, None),  # test_extract.py: incremental runs of array meshes
     "shard": (None, None),  # test_shards.py
     "shard_sculpt": (None, None),
+    "plan_only": (None, None),  # test_the_plan_says_what_a_run_will_do_and_writes_nothing
 }
 
 
@@ -354,3 +355,26 @@ def test_messages_show_no_whole_arrays_and_no_binding_internals(tmp_path, sculpt
     with pytest.raises(TypeError, match="Mesh: takes 3 positional arguments"):
         dispex.Mesh(mesh.points, mesh.face_vertex_counts, mesh.face_vertex_indices, None)
     assert "handle" not in dispex.Mesh.__init__.__doc__
+
+
+def test_the_plan_says_what_a_run_will_do_and_writes_nothing(tmp_path, sculpts):
+    sculpt = sculpts(CUBE)
+    out = tmp_path / "m.ptx"
+    plan = dispex.extract(CUBE, sculpt, out, plan_only=True)["plan"]
+    assert not out.exists()
+    assert plan["output"] == "map" and plan["faces"]["all"] == 6
+    assert plan["faces"]["extracted"] == 6 and plan["faces"]["copied"] == 0
+    dispex.extract(CUBE, sculpt, out)
+    assert dispex.extract(CUBE, sculpt, out, plan_only=True, incremental=True)["plan"][
+        "output"] == "up to date"
+    # A changed option: the plan's counts are those the run then has.
+    planned = dispex.extract(CUBE, sculpt, out, plan_only=True, incremental=True,
+                             tolerance=0.0005)["plan"]
+    done = dispex.extract(CUBE, sculpt, out, incremental=True, tolerance=0.0005)
+    assert planned["redo_reason"] == "options: tolerance"
+    assert planned["faces"]["extracted"] == done["incremental"]["faces_extracted"]
+    assert planned["faces"]["copied"] == done["incremental"]["faces_copied"]
+    assert done["plan"] == planned
+    part = dispex.extract(CUBE, sculpt, tmp_path / "p.ptx", plan_only=True, shard="1/2")["plan"]
+    assert part["output"] == "shard part"
+    assert part["faces"]["extracted"] + part["faces"]["another_shards"] == 6

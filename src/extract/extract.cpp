@@ -17,6 +17,7 @@
 #include "extract/extract_inputs.h"
 #include "extract/extract_mapping.h"
 #include "extract/extract_meta.h"
+#include "extract/extract_plan.h"
 #include "extract/extract_settings.h"
 #include "extract/extract_shape.h"
 #include "extract/face_keys.h"
@@ -105,36 +106,145 @@ std::string RedoReason(const PreviousMap& previous, const ExtractReport& report)
 }
 
 // The tracer of an incremental run, a merge or a shard of part of the sculpt, with a given
-// search distance: the sculpt within reach of the faces whose first pass runs (not copied; a
-// shard's own) and of the faces `rings` around them; for a run not a shard, the whole sculpt
-// when that is most of it. The tie rule (dispex/trace.h) keeps hits at shared edges, vertices
-// and folds those of the whole sculpt's BVH.
-Status BuildLocalTracer(const ExtractOptions& options, const PreviousMap& previous,
-                        std::span<const std::uint8_t> in_shard, int rings, const FaceKeys& keys,
+// search distance: the sculpt within reach (`traced`: FacesWithinReach). The tie rule
+// (dispex/trace.h) keeps hits at shared edges, vertices and folds those of the whole sculpt's
+// BVH.
+Status BuildLocalTracer(const ExtractOptions& options, std::vector<std::uint8_t> traced, bool shard,
                         ExtractInputs& inputs, ExtractReport& report) {
-  const auto n = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
-  std::vector<std::uint8_t> traced(n, 0);
-  std::vector<int> ring;
-  for (std::size_t f = 0; f < n; ++f) {
-    if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
-    if (!in_shard.empty() && !in_shard[f]) continue;
-    if (!previous.usable() || !previous.Reusable(f, keys.keys[f])) {
-      traced[f] = 1;
-      ring.push_back(static_cast<int>(f));
-    }
-  }
-  AddRings(inputs.faces, rings, std::move(ring), traced);
-  const auto count = static_cast<std::size_t>(std::count(traced.begin(), traced.end(), 1));
-  if (in_shard.empty() && 2 * count > n) return BuildTracer(options, inputs, report);
   SetTracerOptions(options, inputs);
   Stopwatch clock;
-  Mesh part = SculptWithinReach(inputs, keys, traced);
+  Mesh part = SculptWithinReach(inputs, *inputs.face_keys, traced);
   report.t_bvh = clock.seconds();
-  report.tracer_faces = static_cast<std::int64_t>(count);
+  report.tracer_faces = std::count(traced.begin(), traced.end(), 1);
   // A shard needs no more of the sculpt than its part (no stage crosses faces): released
   // before the BVH is built, its memory falls with the shard count.
-  if (!in_shard.empty() && part.num_faces() > 0) ReleaseSculpt(inputs);
+  if (shard && part.num_faces() > 0) ReleaseSculpt(inputs);
   return BuildPartTracer(std::move(part), std::move(traced), inputs, report);
+}
+
+// The output, the inputs key and, for an incremental run or a merge, the previous map or the
+// parts the faces that do not run are copied from.
+StatusOr<PreviousMap> PlanOutput(const ExtractOptions& options, const ExtractInputs& inputs,
+                                 std::vector<ShardPart>* parts, ExtractReport& report) {
+  ExtractPlan& plan = report.plan;
+  const bool shard = options.shard_count > 0;
+  plan.output = shard ? ExtractPlan::Output::kShardPart : ExtractPlan::Output::kMap;
+  plan.channels = options.vector ? 3 : 1;
+  plan.faces = inputs.surface.num_ptex_faces();
+  plan.uv_maps = !options.uv_maps_dir.empty();
+  const std::string map_inputs_key = InputsKey(report).Hex();
+  report.inputs_key = shard
+                          ? PartInputsKey(map_inputs_key, options.shard_index, options.shard_count)
+                          : map_inputs_key;
+  const auto num_faces = static_cast<std::size_t>(plan.faces);
+  PreviousMap previous;
+  if (parts != nullptr) {
+    DISPEX_RETURN_IF_ERROR(CheckPartsMatchInputs(*parts, report));
+    report.parts_merged = static_cast<std::int64_t>(parts->size());
+    plan.faces_from = fmt::format("{} shard parts", parts->size());
+    previous = PreviousMap::FromParts(std::move(*parts), ShardOrder(inputs.base, inputs.surface));
+    return previous;
+  }
+  if (!options.incremental) return previous;
+  previous = PreviousMap::Open(options.output_path, num_faces, options.vector.has_value());
+  const std::string stored = previous.usable() ? previous.MetaString(kInputsKeyMetaKey) : "";
+  if (stored == report.inputs_key) {
+    report.unchanged = true;
+    plan.output = ExtractPlan::Output::kUpToDate;
+    return previous;
+  }
+  previous.CheckFaceData();
+  if (!previous.notice().empty()) report.warnings.push_back(previous.notice());
+  report.redo_reason = plan.redo_reason = RedoReason(previous, report);
+  if (previous.usable()) plan.faces_from = options.output_path;
+  return previous;
+}
+
+// A shard's faces: a run of the shard order balanced by cost (PlanShard); empty for a run that
+// is not a shard.
+std::vector<std::uint8_t> ShardFaces(const ExtractOptions& options, const ExtractInputs& inputs,
+                                     const ExtractSettings& settings, const FaceKeys& keys,
+                                     ExtractReport& report) {
+  if (options.shard_count == 0) return {};
+  const std::vector<std::int32_t> order = ShardOrder(inputs.base, inputs.surface);
+  const ShardRange range = PlanShard(inputs.surface, settings.plan, keys, order,
+                                     options.shard_index, options.shard_count);
+  report.shard_begin = range.begin;
+  report.shard_end = range.end;
+  report.shard_cost_fraction = range.cost_fraction;
+  std::vector<std::uint8_t> in_shard(static_cast<std::size_t>(inputs.surface.num_ptex_faces()), 0);
+  for (auto i = range.begin; i < range.end; ++i) {
+    in_shard[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])] = 1;
+  }
+  return in_shard;
+}
+
+// A sculpt moved, scaled or turned against its base as a whole is refused (input_checks.h).
+Status CheckPlacementIfAsked(const ExtractOptions& options, const ExtractInputs& inputs,
+                             const ExtractSettings& settings, const ExtractReport& report) {
+  const bool mapping = inputs.mapping != nullptr;
+  if (!options.check_inputs || (!mapping && inputs.tracer == nullptr)) return Status::Ok();
+  std::optional<MappingGrids> grids;
+  if (mapping) grids.emplace(*inputs.mapping);
+  DISPEX_ASSIGN_OR_RETURN(PlacementFit fit,
+                          MeasurePlacement(inputs, mapping ? &*grids : nullptr, &settings));
+  return CheckPlacement(fit, report.base_diagonal, inputs.sculpt.source);
+}
+
+// A shard's part: its faces' first pass and its record.
+Status WritePart(const ExtractOptions& options, const ExtractInputs& inputs,
+                 std::span<const std::uint8_t> in_shard, const ProcessedFaces& faces,
+                 PtexWriter& writer, ExtractReport& report) {
+  report.faces_extracted = -faces.faces_copied;
+  for (std::size_t f = 0; f < in_shard.size(); ++f) {
+    report.faces_extracted +=
+        in_shard[f] && !inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
+  }
+  ShardInfo info;
+  info.index = options.shard_index;
+  info.count = options.shard_count;
+  info.begin = report.shard_begin;
+  info.end = report.shard_end;
+  info.map_inputs_key = InputsKey(report).Hex();
+  info.base_path = std::filesystem::absolute(options.base_path).lexically_normal().string();
+  info.sculpt_path = std::filesystem::absolute(options.sculpt_path).lexically_normal().string();
+  info.options = ExtractOptionsJson(options).dump();
+  return CommitPart(writer, inputs, in_shard, info, faces, report);
+}
+
+// The stages that cross faces -- faces that missed filled from their neighbours, shared edges
+// made to meet, the totals -- then the map and its UV-space tiles.
+Status WriteMap(const ExtractOptions& options, ExtractInputs& inputs,
+                const ExtractSettings& settings, ProcessedFaces& faces, PtexWriter& writer,
+                const Stopwatch& faces_clock, ExtractReport& report) {
+  report.faces_extracted = static_cast<std::int64_t>(inputs.surface.num_ptex_faces()) -
+                           faces.faces_copied - inputs.surface.stats().hole_ptex_faces;
+  DISPEX_RETURN_IF_ERROR(FillMissedFaces(options, inputs, faces, writer, report));
+  if (settings.watertight != WatertightEdges::kOff) {
+    DISPEX_RETURN_IF_ERROR(MatchEdges(inputs, settings, faces, report));
+    if (inputs.widened) {
+      report.tracer += inputs.traced.empty()
+                           ? std::string("; then the whole sculpt, for faces the edges raised")
+                           : fmt::format("; then {} of {} sculpt faces, for faces the edges raised",
+                                         inputs.traced_part.num_faces(), report.sculpt_faces);
+    }
+    DISPEX_RETURN_IF_ERROR(WriteKeptFaces(writer, inputs, faces));
+  }
+  ListDiscontinuousFaces(inputs, faces, report);
+  report.t_sample_trace = faces_clock.seconds();
+  if (inputs.mapping != nullptr) ReportMapping(inputs, faces, report);
+  DISPEX_RETURN_IF_ERROR(AddFaceTotals(options, inputs, settings, faces, report));
+  DISPEX_RETURN_IF_ERROR(CommitMap(writer, inputs, inputs.face_keys->keys, faces, report));
+  if (!options.uv_maps_dir.empty()) {
+    DISPEX_RETURN_IF_ERROR(WriteUvMaps(options, inputs, settings, report));
+  }
+  return Status::Ok();
+}
+
+ExtractReport Finished(ExtractReport report, const Stopwatch& total_clock) {
+  report.peak_rss_bytes = PeakResidentBytes();
+  report.t_total = total_clock.seconds();
+  return report;
 }
 
 // Several disjoint shapes are ExtractAsset's: one map per shape.
@@ -184,137 +294,71 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   if (options.check_inputs) {
     DISPEX_RETURN_IF_ERROR(CheckFaceCounts(inputs.base, inputs.sculpt));
   }
-  const bool shard = options.shard_count > 0;
-  const bool merge = parts != nullptr;
-  const std::string map_inputs_key = InputsKey(report).Hex();
-  report.inputs_key = shard
-                          ? PartInputsKey(map_inputs_key, options.shard_index, options.shard_count)
-                          : map_inputs_key;
-  const auto num_faces = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
-  PreviousMap previous;
-  if (merge) {
-    DISPEX_RETURN_IF_ERROR(CheckPartsMatchInputs(*parts, report));
-    report.parts_merged = static_cast<std::int64_t>(parts->size());
-    previous = PreviousMap::FromParts(std::move(*parts), ShardOrder(inputs.base, inputs.surface));
-  } else if (options.incremental) {
-    // An up-to-date map is left as it is.
-    previous = PreviousMap::Open(options.output_path, num_faces, options.vector.has_value());
-    const std::string stored = previous.usable() ? previous.MetaString(kInputsKeyMetaKey) : "";
-    if (stored == report.inputs_key) {
-      report.unchanged = true;
-      report.t_total = total_clock.seconds();
-      report.peak_rss_bytes = PeakResidentBytes();
-      return report;
-    }
-  }
-  if (options.incremental && !merge) {
-    previous.CheckFaceData();
-    if (!previous.notice().empty()) report.warnings.push_back(previous.notice());
-    report.redo_reason = RedoReason(previous, report);
-  }
+  ExtractPlan& plan = report.plan;
+  DISPEX_ASSIGN_OR_RETURN(PreviousMap previous, PlanOutput(options, inputs, parts, report));
+  if (plan.output == ExtractPlan::Output::kUpToDate)
+    return Finished(std::move(report), total_clock);
   if (options.vector) {
     return ExtractVectorShape(options, std::move(inputs), std::move(report), total_clock,
                               previous.usable() ? &previous : nullptr);
   }
-  // Through the subdivision correspondence no BVH is built up front (extract_mapping.h).
+  // Through the subdivision correspondence no BVH is built (extract_mapping.h). The automatic
+  // search distance is estimated with rays over the whole surface; a given one lets an
+  // incremental run, a merge or a shard of ShardSculpt::kPart trace only the sculpt within
+  // reach of the faces it extracts.
   DISPEX_RETURN_IF_ERROR(ChooseMethod(options, inputs, report));
-  const bool mapping = inputs.mapping != nullptr;
-  // The automatic search distance is estimated with rays over the whole surface; a given one
-  // lets an incremental run, a merge or a shard of ShardSculpt::kPart trace only the sculpt
-  // within reach of the faces it extracts.
-  const bool local = !mapping && options.search_distance.kind != SearchDistanceSpec::Kind::kAuto &&
-                     ((previous.usable() && (options.incremental || merge)) ||
-                      (shard && options.shard_sculpt == ShardSculpt::kPart));
-  if (mapping) {
-    SetTracerOptions(options, inputs);
-  } else if (!local) {
+  plan.method = report.method;
+  const bool shard = options.shard_count > 0;
+  const bool within_reach = inputs.mapping == nullptr &&
+                            options.search_distance.kind != SearchDistanceSpec::Kind::kAuto &&
+                            ((previous.usable() && (options.incremental || parts != nullptr)) ||
+                             (shard && options.shard_sculpt == ShardSculpt::kPart));
+  plan.tracer = inputs.mapping != nullptr ? ExtractPlan::Tracer::kNone
+                : within_reach            ? ExtractPlan::Tracer::kWithinReach
+                                          : ExtractPlan::Tracer::kWholeSculpt;
+  if (plan.tracer == ExtractPlan::Tracer::kNone) SetTracerOptions(options, inputs);
+  if (plan.tracer == ExtractPlan::Tracer::kWholeSculpt) {
     DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
   }
   DISPEX_ASSIGN_OR_RETURN(ExtractSettings settings, ResolveSettings(options, inputs, report));
-  if (options.check_inputs && (mapping || inputs.tracer != nullptr)) {
-    std::optional<MappingGrids> grids;
-    if (mapping) grids.emplace(*inputs.mapping);
-    DISPEX_ASSIGN_OR_RETURN(PlacementFit fit,
-                            MeasurePlacement(inputs, mapping ? &*grids : nullptr, &settings));
-    DISPEX_RETURN_IF_ERROR(CheckPlacement(fit, report.base_diagonal, inputs.sculpt.source));
-  }
+  DISPEX_RETURN_IF_ERROR(CheckPlacementIfAsked(options, inputs, settings, report));
   Stopwatch keys_clock;
   const FaceKeys face_keys = ComputeFaceKeys(inputs, settings);
-  const std::vector<Hash128>& keys = face_keys.keys;
   inputs.face_keys = &face_keys;
   report.t_keys = keys_clock.seconds();
-  // A shard's faces: its first pass only, no stage that crosses faces (the merge runs those).
-  std::vector<std::uint8_t> in_shard;
-  if (shard) {
-    const std::vector<std::int32_t> order = ShardOrder(inputs.base, inputs.surface);
-    const ShardRange range = PlanShard(inputs.surface, settings.plan, face_keys, order,
-                                       options.shard_index, options.shard_count);
-    report.shard_begin = range.begin;
-    report.shard_end = range.end;
-    report.shard_cost_fraction = range.cost_fraction;
-    in_shard.assign(num_faces, 0);
-    for (auto i = range.begin; i < range.end; ++i) {
-      in_shard[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])] = 1;
+  // A shard runs its faces' first pass only, no stage that crosses faces (the merge runs them).
+  const std::vector<std::uint8_t> in_shard =
+      ShardFaces(options, inputs, settings, face_keys, report);
+  PlanFaces(plan, inputs, face_keys.keys, &previous, in_shard);
+  std::vector<std::uint8_t> reach;
+  if (within_reach) {
+    reach = FacesWithinReach(inputs, face_keys.keys, previous, in_shard, shard ? 0 : kLocalRings);
+    // For a run that is not a shard, the whole sculpt when that is most of it.
+    if (!shard && 2 * std::count(reach.begin(), reach.end(), 1) > plan.faces) {
+      plan.tracer = ExtractPlan::Tracer::kWholeSculpt;
     }
   }
-  if (local) {
-    DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, previous, in_shard, shard ? 0 : kLocalRings,
-                                            face_keys, inputs, report));
+  if (options.plan_only) return Finished(std::move(report), total_clock);
+
+  if (plan.tracer == ExtractPlan::Tracer::kWithinReach) {
+    DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, std::move(reach), shard, inputs, report));
+  } else if (within_reach) {
+    DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
   }
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateMap(options, inputs));
-
   Stopwatch faces_clock;
   DISPEX_ASSIGN_OR_RETURN(
       ProcessedFaces faces,
-      ProcessFaces(inputs, settings, previous.usable() ? &previous : nullptr, keys,
+      ProcessFaces(inputs, settings, previous.usable() ? &previous : nullptr, face_keys.keys,
                    options.progress, options.progress_counter, writer, in_shard));
   report.faces_copied = faces.faces_copied;
   if (shard) {
-    report.faces_extracted = -faces.faces_copied;
-    for (std::size_t f = 0; f < num_faces; ++f) {
-      report.faces_extracted +=
-          in_shard[f] && !inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
-    }
     report.t_sample_trace = faces_clock.seconds();
-    ShardInfo info;
-    info.index = options.shard_index;
-    info.count = options.shard_count;
-    info.begin = report.shard_begin;
-    info.end = report.shard_end;
-    info.map_inputs_key = map_inputs_key;
-    info.base_path = std::filesystem::absolute(options.base_path).lexically_normal().string();
-    info.sculpt_path = std::filesystem::absolute(options.sculpt_path).lexically_normal().string();
-    info.options = ExtractOptionsJson(options).dump();
-    DISPEX_RETURN_IF_ERROR(CommitPart(writer, inputs, in_shard, info, faces, report));
-    report.peak_rss_bytes = PeakResidentBytes();
-    report.t_total = total_clock.seconds();
-    return report;
+    DISPEX_RETURN_IF_ERROR(WritePart(options, inputs, in_shard, faces, writer, report));
+  } else {
+    DISPEX_RETURN_IF_ERROR(WriteMap(options, inputs, settings, faces, writer, faces_clock, report));
   }
-  report.faces_extracted = static_cast<std::int64_t>(num_faces) - faces.faces_copied -
-                           inputs.surface.stats().hole_ptex_faces;
-  DISPEX_RETURN_IF_ERROR(FillMissedFaces(options, inputs, faces, writer, report));
-  if (settings.watertight != WatertightEdges::kOff) {
-    DISPEX_RETURN_IF_ERROR(MatchEdges(inputs, settings, faces, report));
-    if (inputs.widened) {
-      report.tracer += inputs.traced.empty()
-                           ? std::string("; then the whole sculpt, for faces the edges raised")
-                           : fmt::format("; then {} of {} sculpt faces, for faces the edges raised",
-                                         inputs.traced_part.num_faces(), report.sculpt_faces);
-    }
-    DISPEX_RETURN_IF_ERROR(WriteKeptFaces(writer, inputs, faces));
-  }
-  ListDiscontinuousFaces(inputs, faces, report);
-  report.t_sample_trace = faces_clock.seconds();
-  if (mapping) ReportMapping(inputs, faces, report);
-
-  DISPEX_RETURN_IF_ERROR(AddFaceTotals(options, inputs, settings, faces, report));
-  DISPEX_RETURN_IF_ERROR(CommitMap(writer, inputs, keys, faces, report));
-  if (!options.uv_maps_dir.empty()) {
-    DISPEX_RETURN_IF_ERROR(WriteUvMaps(options, inputs, settings, report));
-  }
-  report.peak_rss_bytes = PeakResidentBytes();
-  report.t_total = total_clock.seconds();
-  return report;
+  return Finished(std::move(report), total_clock);
 }
 
 }  // namespace dispex::extract

@@ -2,6 +2,7 @@
 
 #include "dispex/extract.h"
 #include "extract/extract_meta.h"
+#include "extract/extract_plan.h"
 
 namespace dispex {
 
@@ -17,6 +18,7 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
                  {"sculpt_fingerprint", r.sculpt_fingerprint}};
   j["output"] = {{"path", r.output_path}, {"bytes", r.bytes_written}};
   j["inputs_key"] = r.inputs_key;
+  j["plan"] = ExtractPlanJson(r.plan);
   if (r.options.incremental) {
     j["incremental"] = {{"unchanged", r.unchanged},
                         {"faces_copied", r.faces_copied},
@@ -146,6 +148,7 @@ std::string AssetReportSummary(const AssetReport& r) {
 std::string ExtractReportSummary(const ExtractReport& r) {
   const SpectralTotals& s = r.spectral;
   std::string out;
+  if (r.options.plan_only) return ExtractPlanSummary(r.plan);
   if (r.unchanged) {
     return fmt::format(
         "dispex: {} is up to date (made from the same inputs and options): not rewritten, "

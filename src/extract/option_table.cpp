@@ -303,6 +303,12 @@ const Entry kEntries[] = {
        DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
        return ParseShard(s, o.shard_index, o.shard_count);
      })},
+    {{"plan_only", "--plan", OptionKind::kBool,
+      "true: stop once the plan is made (which faces would run), writing nothing", false},
+     DISPEX_SETTER({
+       DISPEX_ASSIGN_OR_RETURN(o.plan_only, BoolValue(v));
+       return Status::Ok();
+     })},
     {{"shard_sculpt", "--shard-sculpt", OptionKind::kChoice, "whole or part", false},
      DISPEX_SETTER({ return SetNamed(o.shard_sculpt, v, ParseShardSculpt); })},
 };

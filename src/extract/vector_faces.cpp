@@ -21,6 +21,7 @@
 #include "extract/edge_matching.h"
 #include "extract/extract_mapping.h"
 #include "extract/extract_meta.h"
+#include "extract/extract_plan.h"
 #include "extract/extract_settings.h"
 #include "extract/face_keys.h"
 #include "extract/face_records.h"
@@ -441,6 +442,8 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
     inputs.grids = std::make_unique<CorrespondenceGrids>(*correspondence, inputs.faces);
   }
   report.method = inputs.interpolate ? ExtractMethod::kInterpolate : ExtractMethod::kMapping;
+  report.plan.method = report.method;
+  report.plan.tracer = ExtractPlan::Tracer::kNone;
   DISPEX_ASSIGN_OR_RETURN(ExtractSettings settings, ResolveSettings(options, inputs, report));
   if (options.check_inputs) {
     const CorrespondenceGrids grids(*correspondence, inputs.faces);
@@ -448,12 +451,18 @@ StatusOr<ExtractReport> ExtractVectorShape(const ExtractOptions& options, Extrac
     DISPEX_RETURN_IF_ERROR(CheckPlacement(fit, report.base_diagonal, inputs.sculpt.source));
   }
   if (CancelRequested()) return Cancelled();
-  DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateVectorMap(options, inputs));
 
   Stopwatch keys_clock;
   const std::vector<Hash128> keys =
       VectorFaceKeys(inputs, settings, *correspondence, *options.vector);
   report.t_keys = keys_clock.seconds();
+  PlanFaces(report.plan, inputs, keys, previous, {});
+  if (options.plan_only) {
+    report.peak_rss_bytes = PeakResidentBytes();
+    report.t_total = total_clock.seconds();
+    return report;
+  }
+  DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateVectorMap(options, inputs));
   Stopwatch faces_clock;
   std::vector<VectorFaceStats> stats, first_pass;
   DISPEX_RETURN_IF_ERROR(ProcessVectorFaces(options, inputs, settings, *correspondence, keys,

@@ -1,0 +1,109 @@
+#include "extract/extract_plan.h"
+
+#include <fmt/format.h>
+
+namespace dispex {
+
+std::string_view ExtractPlanOutputName(ExtractPlan::Output output) {
+  switch (output) {
+    case ExtractPlan::Output::kMap:
+      return "map";
+    case ExtractPlan::Output::kShardPart:
+      return "shard part";
+    case ExtractPlan::Output::kUpToDate:
+      return "up to date";
+  }
+  return "map";
+}
+
+std::string_view ExtractPlanTracerName(ExtractPlan::Tracer tracer) {
+  switch (tracer) {
+    case ExtractPlan::Tracer::kNone:
+      return "none";
+    case ExtractPlan::Tracer::kWholeSculpt:
+      return "whole sculpt";
+    case ExtractPlan::Tracer::kWithinReach:
+      return "within reach";
+  }
+  return "whole sculpt";
+}
+
+std::string ExtractPlanSummary(const ExtractPlan& plan) {
+  if (plan.output == ExtractPlan::Output::kUpToDate) {
+    return "plan: nothing to do, the map is up to date\n";
+  }
+  std::string out =
+      fmt::format("plan: a {} ({}), method {}, BVH: {}\n", ExtractPlanOutputName(plan.output),
+                  plan.channels == 3 ? "vector" : "scalar", ExtractMethodName(plan.method),
+                  ExtractPlanTracerName(plan.tracer));
+  if (plan.faces_run >= 0) {
+    out += fmt::format("  Ptex faces: {} of {} extracted", plan.faces_run, plan.faces);
+    if (plan.faces_copied > 0) {
+      out += fmt::format(", {} copied from {}", plan.faces_copied, plan.faces_from);
+    }
+    if (plan.faces_elsewhere > 0) out += fmt::format(", {} another shard's", plan.faces_elsewhere);
+    if (plan.hole_faces > 0) out += fmt::format(", {} holes", plan.hole_faces);
+    out += "\n";
+  }
+  if (!plan.redo_reason.empty()) out += fmt::format("  why: {}\n", plan.redo_reason);
+  if (plan.uv_maps) out += "  then the UV-space tiles\n";
+  return out;
+}
+
+namespace extract {
+
+void PlanFaces(ExtractPlan& plan, const ExtractInputs& inputs, std::span<const Hash128> keys,
+               const PreviousMap* previous, std::span<const std::uint8_t> in_shard) {
+  plan.faces_run = plan.faces_copied = plan.faces_elsewhere = plan.hole_faces = 0;
+  for (std::size_t f = 0; f < keys.size(); ++f) {
+    if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) {
+      ++plan.hole_faces;
+    } else if (!in_shard.empty() && !in_shard[f]) {
+      ++plan.faces_elsewhere;
+    } else if (previous != nullptr && previous->usable() && previous->Reusable(f, keys[f])) {
+      ++plan.faces_copied;
+    } else {
+      ++plan.faces_run;
+    }
+  }
+}
+
+std::vector<std::uint8_t> FacesWithinReach(const ExtractInputs& inputs,
+                                           std::span<const Hash128> keys,
+                                           const PreviousMap& previous,
+                                           std::span<const std::uint8_t> in_shard, int rings) {
+  const auto n = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
+  std::vector<std::uint8_t> traced(n, 0);
+  std::vector<int> ring;
+  for (std::size_t f = 0; f < n; ++f) {
+    if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
+    if (!in_shard.empty() && !in_shard[f]) continue;
+    if (!previous.usable() || !previous.Reusable(f, keys[f])) {
+      traced[f] = 1;
+      ring.push_back(static_cast<int>(f));
+    }
+  }
+  AddRings(inputs.faces, rings, std::move(ring), traced);
+  return traced;
+}
+
+nlohmann::json ExtractPlanJson(const ExtractPlan& plan) {
+  nlohmann::json j;
+  j["output"] = std::string(ExtractPlanOutputName(plan.output));
+  j["channels"] = plan.channels;
+  j["method"] = std::string(ExtractMethodName(plan.method));
+  j["tracer"] = std::string(ExtractPlanTracerName(plan.tracer));
+  j["faces_from"] = plan.faces_from;
+  j["redo_reason"] = plan.redo_reason;
+  j["faces"] = {{"all", plan.faces},
+                {"extracted", plan.faces_run},
+                {"copied", plan.faces_copied},
+                {"another_shards", plan.faces_elsewhere},
+                {"holes", plan.hole_faces}};
+  j["uv_maps"] = plan.uv_maps;
+  return j;
+}
+
+}  // namespace extract
+
+}  // namespace dispex

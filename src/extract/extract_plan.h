@@ -1,0 +1,33 @@
+// The plan of one map's extraction (ExtractPlan, dispex/extract.h): the stages that decide a
+// part of it fill it in, and the report carries it.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/hash128.h"
+#include "dispex/extract.h"
+#include "extract/extract_inputs.h"
+#include "extract/previous_map.h"
+
+namespace dispex::extract {
+
+// Counts the faces that run, those copied from `previous` (when usable), another shard's
+// (outside `in_shard`, when not empty) and the holes: as ProcessFaces and ProcessVectorFaces
+// decide them from the same keys.
+void PlanFaces(ExtractPlan& plan, const ExtractInputs& inputs, std::span<const Hash128> keys,
+               const PreviousMap* previous, std::span<const std::uint8_t> in_shard);
+
+// The faces whose sculpt a BVH of the sculpt within reach holds: those that run, and `rings`
+// rings of faces around them.
+std::vector<std::uint8_t> FacesWithinReach(const ExtractInputs& inputs,
+                                           std::span<const Hash128> keys,
+                                           const PreviousMap& previous,
+                                           std::span<const std::uint8_t> in_shard, int rings);
+
+nlohmann::json ExtractPlanJson(const ExtractPlan& plan);
+
+}  // namespace dispex::extract
