@@ -276,8 +276,8 @@ struct ExtractPlan {
     kWithinReach,  // a BVH of the sculpt within reach of the faces that run (and their rings)
   };
   Output output = Output::kMap;
-  int channels = 1;                               // 3: a vector map
-  ExtractMethod method = ExtractMethod::kAuto;    // the method that runs (kAuto: not chosen yet)
+  int channels = 1;                             // 3: a vector map
+  ExtractMethod method = ExtractMethod::kAuto;  // the method that runs (kAuto: not chosen yet)
   Tracer tracer = Tracer::kWholeSculpt;
   // Where the faces that do not run get their texels: "" (all run), the previous map's path
   // (incremental), or "N shard parts" (a merge).
@@ -288,8 +288,10 @@ struct ExtractPlan {
   std::int64_t faces = 0, faces_run = -1, faces_copied = -1, faces_elsewhere = 0, hole_faces = 0;
   bool uv_maps = false;  // UV-space tiles written after the map
 };
-std::string_view ExtractPlanOutputName(ExtractPlan::Output output);  // "map", "shard part", "up to date"
-std::string_view ExtractPlanTracerName(ExtractPlan::Tracer tracer);  // "none", "whole sculpt", "within reach"
+std::string_view ExtractPlanOutputName(
+    ExtractPlan::Output output);  // "map", "shard part", "up to date"
+std::string_view ExtractPlanTracerName(
+    ExtractPlan::Tracer tracer);  // "none", "whole sculpt", "within reach"
 // The plan in a few lines for people ("plan: a map (scalar), method mapping, BVH: none ...").
 std::string ExtractPlanSummary(const ExtractPlan& plan);
 

@@ -161,7 +161,7 @@ struct MappingScratch {
   struct Slot {
     std::int32_t face = -1;   // sculpt face
     std::uint8_t corner = 0;  // which of its corners sits at the slot's lower-left corner
-    std::uint8_t state = 0;   // Slot state (mapping_trace.cpp)
+    std::uint8_t state = 0;   // SlotState (mapping_lattice.h)
   };
   struct FanCell {
     std::int32_t face = -1;
