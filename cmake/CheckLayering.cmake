@@ -1,14 +1,16 @@
 # The module layering (docs/ARCHITECTURE.md, "Modules"), checked over the sources:
 #   cmake -DSOURCE_DIR=<repo> -P cmake/CheckLayering.cmake
 # Run by ctest as `layering`. Data flows one way, core -> mesh -> subdiv -> trace -> spectral ->
-# ptex -> extract, with verify and render above, side by side. A file of a module may include
+# ptex -> extract, with verify and render above, side by side, and view (review pages) above
+# them. A file of a module may include
 # the public headers (include/dispex) of its own and lower modules, and the internal headers
 # (src/<module>) of its own module and of core; a public header may include the public headers
 # of its own and lower modules. The include paths already keep other modules' internals out of
 # reach (cmake/Options.cmake); this check also covers the public headers, which every target
 # sees.
 
-set(levels core 0 mesh 1 subdiv 2 trace 3 spectral 4 ptex 5 uvmap 5 extract 6 verify 7 render 7)
+set(levels core 0 mesh 1 subdiv 2 trace 3 spectral 4 ptex 5 uvmap 5 extract 6 verify 7 render 7
+  view 8)
 # The module each public header belongs to.
 set(owners
   status core ids core version core files core cancel core progress core allocator core
@@ -20,7 +22,8 @@ set(owners
   uv_charts uvmap uv_map uvmap
   extract extract
   verify verify
-  render render)
+  render render
+  view view)
 
 function(lookup list key out)
   list(FIND ${list} ${key} i)
@@ -38,9 +41,11 @@ set(errors "")
 # check_file(FILE MODULE): the includes of FILE, which belongs to MODULE.
 function(check_file file module)
   lookup(levels ${module} level)
-  file(STRINGS ${file} lines REGEX "^#include \"[a-z_]+/[a-z_0-9]+\\.h\"")
+  # "dir/name.h" or, inside a module, "dir/sub/name.h": the module is the first folder.
+  file(STRINGS ${file} lines REGEX "^#include \"[a-z_]+/([a-z_]+/)?[a-z_0-9]+\\.h\"")
   foreach(line IN LISTS lines)
-    string(REGEX REPLACE "^#include \"([a-z_]+)/([a-z_0-9]+)\\.h\".*" "\\1;\\2" parts "${line}")
+    string(REGEX REPLACE "^#include \"([a-z_]+)/([a-z_]+/)?([a-z_0-9]+)\\.h\".*" "\\1;\\3" parts
+                         "${line}")
     list(GET parts 0 dir)
     list(GET parts 1 name)
     if(dir STREQUAL "dispex")
@@ -77,8 +82,8 @@ foreach(header IN LISTS public_headers)
   endif()
 endforeach()
 
-foreach(module core mesh subdiv trace spectral ptex uvmap extract verify render)
-  file(GLOB sources ${SOURCE_DIR}/src/${module}/*.h ${SOURCE_DIR}/src/${module}/*.cpp)
+foreach(module core mesh subdiv trace spectral ptex uvmap extract verify render view)
+  file(GLOB_RECURSE sources ${SOURCE_DIR}/src/${module}/*.h ${SOURCE_DIR}/src/${module}/*.cpp)
   foreach(source IN LISTS sources)
     check_file(${source} ${module})
   endforeach()

@@ -35,7 +35,7 @@
 #include "dispex/spectral.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
-#include "extract/mapping_trace.h"
+#include "extract/mapping/mapping_trace.h"
 #include "extract/oversampling.h"
 #include "trace/flush_denormals.h"
 

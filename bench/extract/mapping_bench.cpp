@@ -1,4 +1,4 @@
-// The mapping kernel alone (TraceMapped, src/extract/mapping_trace.h) against dispex's ray
+// The mapping kernel alone (TraceMapped, src/extract/mapping/mapping_trace.h) against dispex's ray
 // kernel on exactly the samples extract takes from a sculpt that is its base refined: each
 // Ptex face's grid of 2^(L+1) samples per side (2^L on sub-faces) is evaluated, then traced
 // both ways; only the tracing is timed (each thread's CPU clock, summed), and the answers are
@@ -23,7 +23,7 @@
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
 #include "extract/extract_inputs.h"
-#include "extract/mapping_trace.h"
+#include "extract/mapping/mapping_trace.h"
 
 using namespace dispex;
 

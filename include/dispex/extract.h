@@ -236,7 +236,7 @@ enum class OptionKind : std::uint8_t {
   kDistance,       // 0.05, "auto" or "2%"
 };
 
-// One extract option set by name, declared once (src/extract/option_table.cpp).
+// One extract option set by name, declared once (src/extract/io/option_table.cpp).
 struct ExtractOptionSpec {
   std::string_view name;  // the ExtractOptions field: manifests, Python keywords, messages
   std::string_view flag;  // the command line's flag

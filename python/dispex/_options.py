@@ -1,6 +1,6 @@
 """Keyword arguments to the JSON values the library takes, by the library's option table.
 
-Each extract option is declared once, in the library (src/extract/option_table.cpp): its name
+Each extract option is declared once, in the library (src/extract/io/option_table.cpp): its name
 (the keyword), its command-line flag, the kind of value it takes. A value of the wrong type
 raises TypeError; a value of the right type is handed to the library as JSON, which checks its
 range (ValueError). NumPy scalars count as the numbers they hold, os.PathLike as paths, and

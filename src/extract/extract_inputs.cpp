@@ -12,7 +12,7 @@
 #include "core/check.h"
 #include "core/system.h"
 #include "dispex/cancel.h"
-#include "extract/face_keys.h"
+#include "extract/incremental/face_keys.h"
 #include "extract/memory_check.h"
 #include "extract/parallel_errors.h"
 

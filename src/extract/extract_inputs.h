@@ -12,8 +12,8 @@
 #include "dispex/ptex.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
-#include "extract/mapping_trace.h"
-#include "extract/vertex_displacements.h"
+#include "extract/mapping/mapping_trace.h"
+#include "extract/mapping/vertex_displacements.h"
 
 namespace dispex::extract {
 

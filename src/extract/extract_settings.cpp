@@ -8,7 +8,7 @@
 
 #include "core/system.h"
 #include "extract/coarse_sampling.h"
-#include "extract/extract_mapping.h"
+#include "extract/mapping/extract_mapping.h"
 
 namespace dispex::extract {
 

@@ -13,7 +13,7 @@
 #include "core/system.h"
 #include "dispex/extract.h"
 #include "extract/extract_inputs.h"
-#include "extract/shard_parts.h"
+#include "extract/incremental/shard_parts.h"
 
 namespace dispex::extract {
 

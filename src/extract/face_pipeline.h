@@ -16,8 +16,8 @@
 #include "extract/extract_inputs.h"
 #include "extract/extract_settings.h"
 #include "extract/hole_fill.h"
-#include "extract/mapping_trace.h"
-#include "extract/vertex_displacements.h"
+#include "extract/mapping/mapping_trace.h"
+#include "extract/mapping/vertex_displacements.h"
 
 namespace dispex::extract {
 

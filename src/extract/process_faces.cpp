@@ -8,9 +8,9 @@
 
 #include "core/progress.h"
 #include "core/system.h"
-#include "extract/extract_mapping.h"
+#include "extract/incremental/previous_map.h"
+#include "extract/mapping/extract_mapping.h"
 #include "extract/parallel_errors.h"
-#include "extract/previous_map.h"
 
 namespace dispex::extract {
 

@@ -19,17 +19,17 @@
 #include "dispex/spectral.h"
 #include "dispex/vector_space.h"
 #include "extract/edge_matching.h"
-#include "extract/extract_mapping.h"
-#include "extract/extract_meta.h"
 #include "extract/extract_plan.h"
 #include "extract/extract_settings.h"
-#include "extract/face_keys.h"
-#include "extract/face_records.h"
+#include "extract/incremental/face_keys.h"
+#include "extract/incremental/face_records.h"
 #include "extract/input_checks.h"
+#include "extract/io/extract_meta.h"
+#include "extract/mapping/extract_mapping.h"
+#include "extract/mapping/vertex_displacements.h"
 #include "extract/parallel_errors.h"
 #include "extract/process_faces.h"
 #include "extract/uv_maps.h"
-#include "extract/vertex_displacements.h"
 
 namespace dispex::extract {
 

@@ -8,7 +8,7 @@
 #include "core/system.h"
 #include "dispex/extract.h"
 #include "extract/extract_inputs.h"
-#include "extract/previous_map.h"
+#include "extract/incremental/previous_map.h"
 
 namespace dispex::extract {
 

@@ -34,7 +34,7 @@
 #include "dispex/verify.h"
 #include "e2e_support.h"
 #include "extract/extract_inputs.h"
-#include "extract/mapping_trace.h"
+#include "extract/mapping/mapping_trace.h"
 
 namespace dispex::extract {
 namespace {

@@ -18,7 +18,7 @@
 #include "dispex/extract.h"
 #include "dispex/mesh.h"
 #include "e2e_support.h"
-#include "extract/extract_meta.h"
+#include "extract/io/extract_meta.h"
 
 namespace dispex {
 namespace {

@@ -4,7 +4,7 @@
 // correspondence: the displacements of the sculpt quad's corners from their limit points,
 // corrected for the blend of the samples around each vertex (D - (m / 4n) L D, L D the sum of
 // the vertex's four neighbours in the sculpt's own edges - 4 D; none at a grid corner or on an
-// open border: src/extract/vertex_displacements.h), bilinear over the quad.
+// open border: src/extract/mapping/vertex_displacements.h), bilinear over the quad.
 //  - At full resolution every texel equals it to float rounding, in every space (rejects a
 //    wrong cell, a rotated or mirrored grid, a wrong frame, derivatives on the wrong scale).
 //  - Under the bound rule every sample's per-face read-back is within the tolerance of it

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "dispex/extract.h"
-#include "extract/manifest_fields.h"
+#include "extract/io/manifest_fields.h"
 
 namespace dispex {
 

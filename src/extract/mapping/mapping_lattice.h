@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "dispex/ptex_sampler.h"
-#include "extract/mapping_trace.h"
+#include "extract/mapping/mapping_trace.h"
 
 namespace dispex::extract::mapping {
 

@@ -8,7 +8,7 @@
 
 #include "dispex/mesh.h"
 #include "dispex/subdiv.h"
-#include "extract/face_keys.h"
+#include "extract/incremental/face_keys.h"
 #include "extract/oversampling.h"
 
 namespace dispex::extract {

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "dispex/extract.h"
-#include "extract/extract_meta.h"
-#include "extract/manifest_fields.h"
+#include "extract/io/extract_meta.h"
+#include "extract/io/manifest_fields.h"
 
 namespace dispex {
 

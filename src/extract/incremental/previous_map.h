@@ -10,9 +10,9 @@
 
 #include "core/hash128.h"
 #include "dispex/ptex.h"
-#include "extract/face_records.h"
+#include "extract/incremental/face_records.h"
+#include "extract/incremental/shard_parts.h"
 #include "extract/process_faces.h"
-#include "extract/shard_parts.h"
 
 namespace dispex::extract {
 

@@ -1,4 +1,4 @@
-#include "extract/vertex_displacements.h"
+#include "extract/mapping/vertex_displacements.h"
 
 #include <algorithm>
 #include <array>

@@ -30,7 +30,7 @@
 #include <span>
 
 #include "dispex/trace.h"
-#include "extract/mapping_trace.h"
+#include "extract/mapping/mapping_trace.h"
 
 namespace dispex::extract {
 

@@ -1,4 +1,4 @@
-#include "extract/shard_parts.h"
+#include "extract/incremental/shard_parts.h"
 
 #include <fmt/format.h>
 
@@ -7,7 +7,7 @@
 
 #include "core/hash128.h"
 #include "dispex/version.h"
-#include "extract/face_records.h"
+#include "extract/incremental/face_records.h"
 
 namespace dispex::extract {
 

@@ -26,7 +26,7 @@
 #include "dispex/mesh.h"
 #include "dispex/status.h"
 #include "dispex/subdiv.h"
-#include "extract/mapping_trace.h"
+#include "extract/mapping/mapping_trace.h"
 
 namespace dispex::extract {
 

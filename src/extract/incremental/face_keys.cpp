@@ -1,4 +1,4 @@
-#include "extract/face_keys.h"
+#include "extract/incremental/face_keys.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/combinable.h>

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dispex/extract.h"
-#include "extract/manifest_fields.h"
+#include "extract/io/manifest_fields.h"
 
 namespace dispex {
 

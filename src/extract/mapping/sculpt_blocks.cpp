@@ -1,11 +1,11 @@
-#include "extract/sculpt_blocks.h"
+#include "extract/mapping/sculpt_blocks.h"
 
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 
-#include "extract/mapping_trace.h"
+#include "extract/mapping/mapping_trace.h"
 
 namespace dispex::extract {
 

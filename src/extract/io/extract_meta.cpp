@@ -1,10 +1,10 @@
-#include "extract/extract_meta.h"
+#include "extract/io/extract_meta.h"
 
 #include <fmt/format.h>
 
 #include <filesystem>
 
-#include "extract/face_records.h"
+#include "extract/incremental/face_records.h"
 
 namespace dispex::extract {
 

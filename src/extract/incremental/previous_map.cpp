@@ -1,4 +1,4 @@
-#include "extract/previous_map.h"
+#include "extract/incremental/previous_map.h"
 
 #include <fmt/format.h>
 

@@ -53,7 +53,7 @@
 #include "dispex/status.h"
 #include "dispex/subdiv.h"
 #include "dispex/trace.h"
-#include "extract/sculpt_blocks.h"
+#include "extract/mapping/sculpt_blocks.h"
 
 namespace dispex::extract {
 

@@ -1,8 +1,8 @@
 #include <fmt/format.h>
 
 #include "dispex/extract.h"
-#include "extract/extract_meta.h"
 #include "extract/extract_plan.h"
+#include "extract/io/extract_meta.h"
 
 namespace dispex {
 

@@ -10,8 +10,8 @@
 #include <limits>
 
 #include "core/vec3.h"
-#include "extract/mapping_lattice.h"
-#include "extract/mapping_trace.h"
+#include "extract/mapping/mapping_lattice.h"
+#include "extract/mapping/mapping_trace.h"
 
 namespace dispex::extract::mapping {
 

@@ -1,4 +1,4 @@
-#include "extract/far_sheets.h"
+#include "extract/mapping/far_sheets.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>

@@ -1,4 +1,4 @@
-#include "extract/shard_plan.h"
+#include "extract/incremental/shard_plan.h"
 
 #include <algorithm>
 #include <array>

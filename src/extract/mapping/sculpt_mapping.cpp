@@ -9,8 +9,8 @@
 #include <cmath>
 
 #include "core/vec3.h"
-#include "extract/mapping_lattice.h"
-#include "extract/mapping_trace.h"
+#include "extract/mapping/mapping_lattice.h"
+#include "extract/mapping/mapping_trace.h"
 #include "extract/parallel_errors.h"
 
 namespace dispex::extract {

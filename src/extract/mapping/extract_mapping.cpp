@@ -1,4 +1,4 @@
-#include "extract/extract_mapping.h"
+#include "extract/mapping/extract_mapping.h"
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
@@ -12,7 +12,7 @@
 
 #include "core/system.h"
 #include "dispex/cancel.h"
-#include "extract/face_keys.h"
+#include "extract/incremental/face_keys.h"
 #include "extract/parallel_errors.h"
 
 namespace dispex::extract {

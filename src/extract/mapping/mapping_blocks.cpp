@@ -1,6 +1,6 @@
 // The samples of one cell traced at once (4 lanes; two blocks at once in AVX2), for the
 // mapping's per-face driver (mapping_trace.cpp).
-#include "extract/mapping_blocks.h"
+#include "extract/mapping/mapping_blocks.h"
 
 #include <algorithm>
 #include <cmath>

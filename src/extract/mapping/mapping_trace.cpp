@@ -1,4 +1,4 @@
-#include "extract/mapping_trace.h"
+#include "extract/mapping/mapping_trace.h"
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
@@ -16,10 +16,10 @@
 
 #include "core/vec3.h"
 #include "dispex/ptex_sampler.h"
-#include "extract/far_sheets.h"
-#include "extract/mapping_blocks.h"
-#include "extract/mapping_lattice.h"
-#include "extract/mapping_rays.h"
+#include "extract/mapping/far_sheets.h"
+#include "extract/mapping/mapping_blocks.h"
+#include "extract/mapping/mapping_lattice.h"
+#include "extract/mapping/mapping_rays.h"
 #include "extract/parallel_errors.h"
 
 namespace dispex::extract {

@@ -1,4 +1,4 @@
-#include "extract/face_records.h"
+#include "extract/incremental/face_records.h"
 
 #include <cstring>
 #include <type_traits>

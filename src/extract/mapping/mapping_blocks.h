@@ -7,7 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "extract/mapping_rays.h"
+#include "extract/mapping/mapping_rays.h"
 
 namespace dispex::extract::mapping {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "core/vec3.h"
-#include "extract/mapping_lattice.h"
+#include "extract/mapping/mapping_lattice.h"
 
 namespace dispex::extract {
 
