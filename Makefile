@@ -38,7 +38,10 @@ demo: configure
 # that tests/allowed-skips.txt does not allow (ctest itself passes a skipped test).
 CHECK_SKIPS = scripts/check-skips.py
 
+# The `browser` tests (the pages of `dispex view` in Chromium headless) run here too: Chromium
+# is installed first (DISPEX_WITH_BROWSER=1).
 test: build
+	@DISPEX_WITH_BROWSER=1 scripts/install-deps.sh
 	@cd $(BUILD) && ctest --output-on-failure -j$(JOBS) --timeout 900 -LE 'blender|slurm' \
 	  --output-junit ctest-junit.xml
 	@$(CHECK_SKIPS) $(BUILD)/ctest-junit.xml
@@ -86,6 +89,7 @@ test-sanitize: deps
 	@cmake -S . -B $(BUILD)-sanitize $(SANITIZE_BUILD_FLAGS) -DDISPEX_SANITIZE=ON \
 	  -DDISPEX_BUILD_BENCH=OFF -DDISPEX_WERROR=$(WERROR) $(CMAKE_FLAGS) >/dev/null
 	@cmake --build $(BUILD)-sanitize -j$(JOBS)
+	@DISPEX_WITH_BROWSER=1 scripts/install-deps.sh
 	@cd $(BUILD)-sanitize && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  ctest --output-on-failure -j$(JOBS) --timeout 900 -LE 'blender|slurm|isa' --output-junit ctest-junit.xml

@@ -2,8 +2,8 @@
 #   cmake -DSOURCE_DIR=<repo> -P cmake/CheckLayering.cmake
 # Run by ctest as `layering`. Data flows one way, core -> mesh -> subdiv -> trace -> spectral ->
 # ptex -> extract, with verify and render above, side by side, and view (review pages) above
-# them. A file of a module may include
-# the public headers (include/dispex) of its own and lower modules, and the internal headers
+# them. A file of a module may include the public headers (include/dispex) of its own and
+# lower modules, and the internal headers
 # (src/<module>) of its own module and of core; a public header may include the public headers
 # of its own and lower modules. The include paths already keep other modules' internals out of
 # reach (cmake/Options.cmake); this check also covers the public headers, which every target

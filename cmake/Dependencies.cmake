@@ -22,6 +22,17 @@ find_package(OpenEXR 3 REQUIRED CONFIG)
 pkg_check_modules(LIBDEFLATE REQUIRED IMPORTED_TARGET libdeflate)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)
 pkg_check_modules(FFTW3F REQUIRED IMPORTED_TARGET fftw3f)
+# three.js for the pages `dispex view` writes (src/view): Debian's libjs-three (r111), embedded
+# into the library when it is built, so the page needs nothing installed where it is opened.
+find_file(DISPEX_THREE_JS three.min.js PATHS /usr/share/javascript/three NO_DEFAULT_PATH
+  DOC "three.js (three.min.js, Debian's libjs-three)")
+find_file(DISPEX_THREE_ORBIT_CONTROLS_JS OrbitControls.js
+  PATHS /usr/share/javascript/three/examples/js/controls NO_DEFAULT_PATH
+  DOC "three.js's OrbitControls.js (examples/js/controls, Debian's libjs-three)")
+if(NOT DISPEX_THREE_JS OR NOT DISPEX_THREE_ORBIT_CONTROLS_JS)
+  message(FATAL_ERROR "three.js not found: install Debian's libjs-three (scripts/install-deps.sh), "
+    "or give -DDISPEX_THREE_JS=.../three.min.js -DDISPEX_THREE_ORBIT_CONTROLS_JS=.../OrbitControls.js")
+endif()
 if(DISPEX_BUILD_PYTHON)
   # Debian's interpreter, the one python3-numpy and python3-pytest are installed for
   # (scripts/install-deps.sh), ahead of any other python3 on PATH; -DPython_EXECUTABLE=...

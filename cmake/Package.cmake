@@ -6,7 +6,7 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(DISPEX_MODULES core mesh subdiv trace spectral ptex uvmap extract verify render)
+set(DISPEX_MODULES core mesh subdiv trace spectral ptex uvmap extract verify render view)
 set(module_objects "")
 foreach(module IN LISTS DISPEX_MODULES)
   list(APPEND module_objects $<TARGET_OBJECTS:dispex_${module}>)

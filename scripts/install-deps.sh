@@ -10,9 +10,15 @@ packages=(
   libfast-float-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libpng-dev libopenexr-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3-dev pybind11-dev python3-numpy python3-pytest mypy
+  libjs-three  # three.js (r111), embedded into the pages `dispex view` writes
 )
 if [[ "${DISPEX_WITH_FORMAT:-0}" == 1 ]]; then
   packages+=(clang-format-14)
+fi
+# Chromium (headless, WebGL on SwiftShader) for the `browser` tests of `make test`: the pages
+# `dispex view` writes, opened in a real browser (tests/view/browser_test.py).
+if [[ "${DISPEX_WITH_BROWSER:-0}" == 1 ]]; then
+  packages+=(chromium)
 fi
 # Blender (headless) for `make test-blender`: a real renderer displacing with the UV maps.
 if [[ "${DISPEX_WITH_BLENDER:-0}" == 1 ]]; then

@@ -13,6 +13,7 @@
 #include "dispex/cancel.h"
 #include "dispex/extract.h"
 #include "dispex/files.h"
+#include "dispex/view.h"
 #include "flag_names.h"
 #include "part_names.h"
 
@@ -32,6 +33,7 @@ struct BatchArgs {
   std::string parts_dir;
   std::string shard_sculpt = "whole";
   std::string report_path;
+  std::string view_dir;
   int threads = 0;
   bool incremental = false;
   bool quiet = false;
@@ -67,11 +69,19 @@ int RunBatch(BatchArgs& args) {
   } else if (!args.parts_dir.empty()) {
     return ReportFailure(Status::Error("--parts-dir needs --shard"), 2);
   }
+  if (!args.view_dir.empty() && !args.shard.empty()) {
+    return ReportFailure(Status::Error("--view shows whole maps: not with --shard"), 2);
+  }
+  const Status outputs =
+      CheckOutputs({{"--report", args.report_path}, {"--view", args.view_dir, true}});
+  if (!outputs.ok()) return ReportFailure(outputs, 2);
   InstallCancelSignalHandlers();
   nlohmann::json report;
   report["manifest"] = args.manifest;
   report["assets"] = nlohmann::json::array();
   int failed = 0;
+  std::vector<ViewIndexEntry> pages;
+  int pages_failed = 0;
   const std::size_t n = assets->size();
   for (std::size_t k = 0; k < n && !CancelRequested(); ++k) {
     const BatchAsset& asset = (*assets)[k];
@@ -83,11 +93,37 @@ int RunBatch(BatchArgs& args) {
     nlohmann::json entry = {{"name", asset.name}, {"output", asset.options.output_path}};
     if (r.ok()) {
       entry["status"] = "ok";
-      entry["report"] = nlohmann::json::parse(ExtractReportJson(*r));
+      const std::string extract_json = ExtractReportJson(*r);
+      entry["report"] = nlohmann::json::parse(extract_json);
       if (!args.quiet) {
         std::fprintf(stderr, "dispex: [%zu/%zu] %s: %s, %.2fs, peak %.0f MB -> %s\n", k + 1, n,
                      asset.name.c_str(), r->unchanged ? "up to date" : "ok", r->t_total,
                      double(r->peak_rss_bytes) / 1e6, asset.options.output_path.c_str());
+      }
+      if (!args.view_dir.empty()) {
+        // The asset's review page (dispex view), its sculpt and its extraction's report in it.
+        ViewPageOptions view;
+        view.base_path = asset.options.base_path;
+        view.map_path = asset.options.output_path;
+        view.sculpt_path = asset.options.sculpt_path;
+        view.extract_report_json = extract_json;
+        view.title = asset.name;
+        view.threads = args.threads;
+        const std::string page = asset.name + ".html";
+        const std::string path = (std::filesystem::path(args.view_dir) / page).string();
+        StatusOr<ViewPageReport> shown = WriteViewPage(view, path);
+        if (shown.ok()) {
+          entry["view"] = path;
+          pages.push_back({asset.name, page, "ok",
+                           fmt::format("{} map, {} Ptex faces, {:.1f} MB page", shown->map_kind,
+                                       shown->ptex_faces, double(shown->page_bytes) / 1e6)});
+        } else {
+          ++pages_failed;
+          entry["view_error"] = shown.status().message();
+          pages.push_back({asset.name, "", "no page", shown.status().message()});
+          std::fprintf(stderr, "dispex: [%zu/%zu] %s: page FAILED: %s\n", k + 1, n,
+                       asset.name.c_str(), shown.status().message().c_str());
+        }
       }
     } else {
       ++failed;
@@ -96,20 +132,30 @@ int RunBatch(BatchArgs& args) {
       entry["error"] = message;
       std::fprintf(stderr, "dispex: [%zu/%zu] %s: FAILED: %s\n", k + 1, n, asset.name.c_str(),
                    message.c_str());
+      pages.push_back({asset.name, "", "failed", message});
     }
     report["assets"].push_back(std::move(entry));
   }
   report["failed"] = failed;
+  if (!args.view_dir.empty()) report["pages_failed"] = pages_failed;
+  if (!args.view_dir.empty()) {
+    const std::string index = MakeViewIndex(
+        std::filesystem::path(args.manifest).filename().string() + " - dispex batch", pages);
+    const std::string path = (std::filesystem::path(args.view_dir) / "index.html").string();
+    Status written = WriteFileAtomically(path, index.data(), index.size());
+    if (!written.ok()) return ReportFailure(written.WithPrefix("--view"));
+    report["view_index"] = path;
+    if (!args.quiet) std::fprintf(stderr, "dispex: %s: %zu pages\n", path.c_str(), pages.size());
+  }
   if (!args.report_path.empty()) {
     const std::string text = report.dump(2) + "\n";
     Status written = WriteFileAtomically(args.report_path, text.data(), text.size());
     if (!written.ok()) return ReportFailure(written.WithPrefix("--report"));
   }
   if (const int sig = CancelSignal()) return ReportFailure(Status::Error("cancelled"), 128 + sig);
-  if (failed > 0) {
-    std::fprintf(stderr, "dispex: %d of %zu assets failed\n", failed, n);
-    return 1;
-  }
+  if (failed > 0) std::fprintf(stderr, "dispex: %d of %zu assets failed\n", failed, n);
+  if (pages_failed > 0) std::fprintf(stderr, "dispex: %d review pages failed\n", pages_failed);
+  if (failed > 0 || pages_failed > 0) return 1;
   if (!args.quiet && n > 1) std::fprintf(stderr, "dispex: all %zu assets done\n", n);
   return 0;
 }
@@ -136,6 +182,9 @@ void SetupBatch(CLI::App& app, int& exit_code) {
                 "re-use each map (or part) already at its output path (docs/INCREMENTAL.md)");
   cmd->add_option("--report", args->report_path,
                   "write one JSON report: every asset's status, error or extraction report");
+  cmd->add_option("--view", args->view_dir,
+                  "also write a review page per asset (dispex view), DIR/<asset>.html, and "
+                  "DIR/index.html linking them");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress lines (failures are still printed)");
   cmd->callback([args, &exit_code] { exit_code = RunBatch(*args); });
 }

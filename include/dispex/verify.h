@@ -302,6 +302,10 @@ struct VerifyReport {
     double max = 0;
   };
   std::vector<WorstFace> worst_faces;  // by map -> sculpt max, at most 10
+  // Per Ptex face, empty when not measured (`dispex view --verify` colours faces by them; NaN,
+  // null in the JSON, for a face without samples or records): the largest map -> sculpt
+  // distance of its samples, and the largest truth error (truth_quantity) at its records.
+  std::vector<double> face_map_to_sculpt_max, face_truth_max;
   // Steps at shared edges, object units, one per point (include/dispex/ptex_sampler.h for
   // the readers): the per-face reader (clamped at the face's border) and the reference
   // filter across faces. Of a vector map, the length of the step of D in object space: each

@@ -17,6 +17,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -737,6 +738,11 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     double sum = 0;
     for (float e : signed_errors) sum += e;
     r.truth_signed_mean = truth.size() ? sum / double(truth.size()) : 0;
+    r.face_truth_max.assign(r.ptex_faces, std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      double& m = r.face_truth_max[static_cast<std::size_t>(truth.faces[i].value)];
+      if (!(m >= double(errors[i]))) m = double(errors[i]);
+    }
     r.truth_tolerance = options.tolerance > 0 ? options.tolerance : r.map_tolerance;
     if (r.truth_tolerance > 0 && options.truth_local_bound && !truth.local_error.empty()) {
       // Sequential, so the worst record is the first of the largest ratio.
@@ -813,6 +819,12 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
         if (face_max[order[i]] > 0) r.worst_faces.push_back({order[i], face_max[order[i]]});
       }
       r.map_to_sculpt = Summarise(d);
+      r.face_map_to_sculpt_max = std::move(face_max);
+      for (std::size_t f = 0; f < r.ptex_faces; ++f) {
+        if (displaced.k[f] == 0) {
+          r.face_map_to_sculpt_max[f] = std::numeric_limits<double>::quiet_NaN();
+        }
+      }
     }
     DISPEX_ASSIGN_OR_RETURN(r.sculpt_to_map,
                             SculptToMesh(sculpt, displaced.mesh, options.max_sculpt_points));
@@ -996,6 +1008,13 @@ std::string VerifyReportJson(const VerifyReport& r) {
   j["warnings"] = r.warnings;
   if (!r.uv_faces_without_tile.empty()) j["uv_faces_without_tile"] = r.uv_faces_without_tile;
   j["seconds"] = r.seconds;
+  // Last, being long: every face's error (null for a face without samples or records).
+  if (!r.face_map_to_sculpt_max.empty() || !r.face_truth_max.empty()) {
+    nlohmann::json per_face = nlohmann::json::object();
+    if (!r.face_map_to_sculpt_max.empty()) per_face["map_to_sculpt_max"] = r.face_map_to_sculpt_max;
+    if (!r.face_truth_max.empty()) per_face["truth_max"] = r.face_truth_max;
+    j["per_face"] = per_face;
+  }
   return j.dump(2) + "\n";
 }
 

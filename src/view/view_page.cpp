@@ -1,0 +1,845 @@
+// MakeViewPage: reads the base, the map and what else the page shows, and puts them with the
+// embedded page and three.js into one HTML file.
+#include <fmt/format.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+
+#include "core/system.h"
+#include "dispex/extract.h"
+#include "dispex/files.h"
+#include "dispex/mesh.h"
+#include "dispex/ptex.h"
+#include "dispex/ptex_sampler.h"
+#include "dispex/render.h"
+#include "dispex/subdiv.h"
+#include "dispex/uv_charts.h"
+#include "dispex/uv_map.h"
+#include "dispex/vector_space.h"
+#include "dispex/version.h"
+#include "dispex/view.h"
+#include "view/decimate.h"
+#include "view/embedded_assets.h"
+#include "view/page_data.h"
+#include "view/surface_grid.h"
+
+namespace dispex {
+
+namespace {
+
+using nlohmann::json;
+using view::Base64Of;
+
+std::string FileName(const std::string& path) {
+  return std::filesystem::path(path).filename().string();
+}
+
+// ---- How the map displaces ------------------------------------------------------------------
+
+// D's normal part.
+float NormalPart(const float* d, const float* n) {
+  return d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+}
+
+// A scalar Ptex map read as the reference Ptex filter reads it, across face edges: P + h N.
+class PtexScalarDisplacement final : public view::MapDisplacement {
+ public:
+  explicit PtexScalarDisplacement(const PtexMapSampler& sampler) : sampler_(sampler) {}
+  void Displace(PtexFaceId face, std::span<const float> uv, const LimitEvaluator::Frames& frames,
+                std::span<float> d, std::span<float> value) const override {
+    for (std::size_t j = 0; j < value.size(); ++j) {
+      const float h =
+          static_cast<float>(sampler_.SampleAcrossFaces(face, uv[2 * j], uv[2 * j + 1]));
+      for (std::size_t c = 0; c < 3; ++c) d[3 * j + c] = h * frames.normals[3 * j + c];
+      value[j] = h;
+    }
+  }
+
+ private:
+  const PtexMapSampler& sampler_;
+};
+
+// A vector Ptex map, each face read on its own (bilinear, clamped at its border) in its frame.
+class PtexVectorDisplacement final : public view::MapDisplacement {
+ public:
+  PtexVectorDisplacement(const PtexFile& map, VectorSpace space) : map_(map), space_(space) {}
+  void Displace(PtexFaceId face, std::span<const float> uv, const LimitEvaluator::Frames& frames,
+                std::span<float> d, std::span<float> value) const override {
+    for (std::size_t j = 0; j < value.size(); ++j) {
+      const float u = uv[2 * j], v = uv[2 * j + 1];
+      const float c[3] = {map_.Sample(face, u, v, 0), map_.Sample(face, u, v, 1),
+                          map_.Sample(face, u, v, 2)};
+      const SurfaceFrame frame = Frame(frames, j);
+      const Float3 vec = VectorFromChannels(space_, frame, c);
+      d[3 * j] = vec.x, d[3 * j + 1] = vec.y, d[3 * j + 2] = vec.z;
+      value[j] = NormalPart(&d[3 * j], &frames.normals[3 * j]);
+    }
+  }
+  static SurfaceFrame Frame(const LimitEvaluator::Frames& f, std::size_t j) {
+    return {{f.du[3 * j], f.du[3 * j + 1], f.du[3 * j + 2]},
+            {f.dv[3 * j], f.dv[3 * j + 1], f.dv[3 * j + 2]},
+            {f.normals[3 * j], f.normals[3 * j + 1], f.normals[3 * j + 2]}};
+  }
+
+ private:
+  const PtexFile& map_;
+  VectorSpace space_;
+};
+
+// A UV-space map through the cage's UVs, bilinear within its UDIM tile: a scalar along the
+// normal, or an object-space vector.
+class UvDisplacement final : public view::MapDisplacement {
+ public:
+  UvDisplacement(const UvMap& map, const PtexUvCharts& charts, bool vector,
+                 std::vector<std::atomic<std::uint8_t>>& missing)
+      : map_(map), charts_(charts), vector_(vector), missing_(missing) {}
+  void Displace(PtexFaceId face, std::span<const float> uv, const LimitEvaluator::Frames& frames,
+                std::span<float> d, std::span<float> value) const override {
+    for (std::size_t j = 0; j < value.size(); ++j) {
+      double at[2];
+      charts_.Evaluate(face, uv[2 * j], uv[2 * j + 1], at);
+      float c[3] = {0, 0, 0};
+      if (!map_.Sample(at[0], at[1], {c, vector_ ? 3u : 1u})) {
+        missing_[static_cast<std::size_t>(face.value)].store(1, std::memory_order_relaxed);
+      }
+      const float* n = &frames.normals[3 * j];
+      if (vector_) {
+        for (std::size_t k = 0; k < 3; ++k) d[3 * j + k] = c[k];
+        value[j] = NormalPart(c, n);
+      } else {
+        for (std::size_t k = 0; k < 3; ++k) d[3 * j + k] = c[0] * n[k];
+        value[j] = c[0];
+      }
+    }
+  }
+
+ private:
+  const UvMap& map_;
+  const PtexUvCharts& charts_;
+  bool vector_;
+  std::vector<std::atomic<std::uint8_t>>& missing_;
+};
+
+// ---- Inputs ---------------------------------------------------------------------------------
+
+StatusOr<json> ReadJsonFile(const std::string& path, const char* what) {
+  DISPEX_RETURN_IF_ERROR(CheckReadableFile(path));
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  json j = json::parse(text.str(), nullptr, false);
+  if (j.is_discarded() || !j.is_object()) {
+    return Status::Error(StatusCode::kBadInput,
+                         fmt::format("{}: not a JSON object (expected {})", path, what))
+        .WithPath(path);
+  }
+  return j;
+}
+
+// The map's dispex:* meta data as JSON: strings (options and statistics parsed), short numeric
+// arrays, the discontinuous faces; the incremental records are left out (binary, large).
+json MetaJson(const PtexFile& map) {
+  json meta = json::object();
+  for (const PtexMetaItem& item : map.meta_data()) {
+    if (item.key.rfind("dispex:", 0) != 0) continue;
+    if (item.key == "dispex:face_keys" || item.key.find("records") != std::string::npos ||
+        item.key == "dispex:inputs_key") {
+      continue;
+    }
+    if (item.type == PtexMetaType::kString) {
+      const std::string text = item.AsString();
+      if (item.key == "dispex:options" || item.key == "dispex:statistics") {
+        json parsed = json::parse(text, nullptr, false);
+        if (!parsed.is_discarded()) {
+          meta[item.key] = std::move(parsed);
+          continue;
+        }
+      }
+      meta[item.key] = text;
+      continue;
+    }
+    const std::vector<double> numbers = item.AsNumbers();
+    if (item.key == "dispex:discontinuous_faces") {
+      meta[item.key] = numbers;
+    } else if (numbers.size() == 1) {
+      meta[item.key] = numbers[0];
+    } else if (numbers.size() <= 64) {
+      meta[item.key] = numbers;
+    }
+  }
+  return meta;
+}
+
+// Per-face misses from the map's first-pass records (dispex:face_records_v1, the records
+// `extract --incremental` re-uses): each record begins with the face's samples (int64),
+// misses, misses recovered by the longer search, misses filled within the face (int32 each),
+// two hit counts (int32) and whether every ray missed (a byte), little-endian. Read only when
+// they add up to the map's statistics (samples, misses, holes filled over the faces with a
+// surface), so that a map whose records mean something else is not misread.
+struct FaceHoles {
+  std::vector<std::int32_t> samples, misses, filled;
+  std::vector<std::uint8_t> all_missed;
+};
+std::optional<FaceHoles> ReadFaceHoles(const PtexFile& map, const LimitSurface& surface,
+                                       const json& statistics, std::string& note) {
+  const PtexMetaItem* item = map.FindMetaData("dispex:face_records_v1");
+  if (item == nullptr) {
+    note = map.FindMetaData("dispex:vector_face_records_v1") != nullptr
+               ? "a vector map reads the sculpt through the correspondence: no rays, no misses"
+               : "the map records no per-face misses (dispex:face_records_v1)";
+    return std::nullopt;
+  }
+  const std::size_t faces = static_cast<std::size_t>(map.num_faces());
+  const std::vector<std::uint8_t>& bytes = item->bytes;
+  if (faces == 0 || bytes.size() % faces != 0 || bytes.size() / faces < 29) {
+    note = "the map's per-face records have an unknown layout";
+    return std::nullopt;
+  }
+  const std::size_t size = bytes.size() / faces;
+  FaceHoles holes;
+  holes.samples.resize(faces), holes.misses.resize(faces), holes.filled.resize(faces);
+  holes.all_missed.resize(faces);
+  std::int64_t samples = 0, misses = 0, filled = 0;
+  for (std::size_t f = 0; f < faces; ++f) {
+    const std::uint8_t* r = bytes.data() + f * size;
+    std::int64_t s = 0;
+    std::int32_t m = 0, fill = 0;
+    std::memcpy(&s, r, 8);
+    std::memcpy(&m, r + 8, 4);
+    std::memcpy(&fill, r + 16, 4);
+    holes.samples[f] = static_cast<std::int32_t>(std::clamp<std::int64_t>(s, 0, INT32_MAX));
+    holes.misses[f] = m;
+    holes.filled[f] = fill;
+    holes.all_missed[f] = r[28] != 0;
+    if (surface.is_hole(PtexFaceId(static_cast<std::int32_t>(f)))) continue;
+    samples += s, misses += m, filled += fill;
+  }
+  if (!statistics.is_object() || statistics.value("samples", std::int64_t{-1}) != samples ||
+      statistics.value("misses", std::int64_t{-1}) != misses ||
+      statistics.value("holes_filled", std::int64_t{-1}) != filled) {
+    note = "the map's per-face records do not add up to its statistics: not shown";
+    return std::nullopt;
+  }
+  return holes;
+}
+
+// Per-face errors from a verify report: every face's (per_face, dispex 0.1 and later), else the
+// ten worst faces it lists.
+struct FaceErrors {
+  std::vector<float> map_to_sculpt, truth;  // object units; NaN where unknown
+  std::string note;
+};
+FaceErrors ReadFaceErrors(const json& report, std::size_t faces) {
+  FaceErrors errors;
+  auto array = [&](const json& values, std::vector<float>& out) {
+    if (!values.is_array() || values.size() != faces) return false;
+    out.resize(faces);
+    for (std::size_t f = 0; f < faces; ++f) {
+      out[f] = values[f].is_number() ? values[f].get<float>() : std::nanf("");
+    }
+    return true;
+  };
+  if (report.contains("per_face") && report["per_face"].is_object()) {
+    const json& per_face = report["per_face"];
+    if (per_face.contains("map_to_sculpt_max"))
+      array(per_face["map_to_sculpt_max"], errors.map_to_sculpt);
+    if (per_face.contains("truth_max")) array(per_face["truth_max"], errors.truth);
+  }
+  if (errors.map_to_sculpt.empty() && errors.truth.empty()) {
+    if (report.contains("worst_faces") && report["worst_faces"].is_array() &&
+        !report["worst_faces"].empty()) {
+      errors.map_to_sculpt.assign(faces, std::nanf(""));
+      for (const json& w : report["worst_faces"]) {
+        const int f = w.value("face", -1);
+        if (f >= 0 && std::size_t(f) < faces)
+          errors.map_to_sculpt[std::size_t(f)] = w.value("max", 0.0f);
+      }
+      errors.note =
+          "the verify report lists the 10 worst faces only (map to sculpt, largest distance): "
+          "the others are grey; a report of dispex verify 0.1 or later has every face";
+    } else {
+      errors.note =
+          "the verify report has no per-face errors (give verify a sculpt or a truth file)";
+    }
+  }
+  return errors;
+}
+
+// ---- The atlas ------------------------------------------------------------------------------
+
+StatusOr<Image> UvTilesImage(const UvMap& map) {
+  const int side = std::min(256, map.resolution());
+  const int gap = 4;
+  const auto tiles = static_cast<int>(map.tiles().size());
+  double m = 0;
+  for (const UvMapTile& tile : map.tiles()) {
+    for (float v : tile.values) {
+      if (std::isfinite(v)) m = std::max(m, std::fabs(double(v)));
+    }
+  }
+  Image image(tiles * side + (tiles + 1) * gap, side + 2 * gap, {255, 255, 255});
+  for (int t = 0; t < tiles; ++t) {
+    const UvMapTile& tile = map.tiles()[static_cast<std::size_t>(t)];
+    const int n = tile.resolution, channels = tile.channels;
+    for (int y = 0; y < side; ++y) {
+      for (int x = 0; x < side; ++x) {
+        const int i = std::min(n - 1, x * n / side);
+        const int j = std::min(n - 1, (side - 1 - y) * n / side);  // row 0 is v = 0
+        const float* v = &tile.values[(std::size_t(j) * n + i) * std::size_t(channels)];
+        image.set(gap + t * (side + gap) + x, gap + y,
+                  channels == 3 ? AtlasVectorColour(-m, m, v)
+                                : AtlasColour(AtlasMode::kSigned, -m, m, v[0]));
+      }
+    }
+  }
+  return image;
+}
+
+// ---- The page -------------------------------------------------------------------------------
+
+std::string ReplaceOnce(std::string text, std::string_view marker, std::string_view by) {
+  const std::size_t at = text.find(marker);
+  if (at == std::string::npos) return text;
+  return text.replace(at, marker.size(), by);
+}
+
+}  // namespace
+
+Status ValidateViewPageOptions(const ViewPageOptions& o) {
+  if (o.base_path.empty()) return Status::Error(StatusCode::kInvalidArgument, "base_path: empty");
+  if (o.map_path.empty()) return Status::Error(StatusCode::kInvalidArgument, "map_path: empty");
+  if (o.max_vertices < 1000 || o.max_vertices > 50'000'000) {
+    return Status::Error(StatusCode::kInvalidArgument,
+                         fmt::format("max_vertices = {}: must be 1000..50000000", o.max_vertices));
+  }
+  if (o.max_sculpt_vertices < 0 || o.max_sculpt_vertices > 10'000'000) {
+    return Status::Error(
+        StatusCode::kInvalidArgument,
+        fmt::format("max_sculpt_vertices = {}: must be 0..10000000", o.max_sculpt_vertices));
+  }
+  if (o.grid < 0 || o.grid > 256) {
+    return Status::Error(StatusCode::kInvalidArgument,
+                         fmt::format("grid = {}: must be 0 (automatic) or 1..256", o.grid));
+  }
+  if (o.max_grid < 1 || o.max_grid > 256) {
+    return Status::Error(StatusCode::kInvalidArgument,
+                         fmt::format("max_grid = {}: must be 1..256", o.max_grid));
+  }
+  if (o.max_atlas_bytes < 0) {
+    return Status::Error(StatusCode::kInvalidArgument,
+                         fmt::format("max_atlas_bytes = {}: must be 0 or more", o.max_atlas_bytes));
+  }
+  if (o.threads < 0) {
+    return Status::Error(StatusCode::kInvalidArgument,
+                         fmt::format("threads = {}: must be 0 or more", o.threads));
+  }
+  return Status::Ok();
+}
+
+StatusOr<std::string> MakeViewPage(const ViewPageOptions& options, ViewPageReport* report_out) {
+  DISPEX_RETURN_IF_ERROR(ValidateViewPageOptions(options));
+  Stopwatch clock, phase;
+  ViewPageReport report;
+  auto phase_done = [&](const char* name) {
+    report.phase_seconds.emplace_back(name, phase.seconds());
+    phase.Reset();
+  };
+  std::optional<tbb::global_control> limit;
+  if (options.threads > 0) {
+    limit.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(options.threads));
+  }
+  json page;
+  page["format"] = 1;
+  page["generator"] = fmt::format("dispex {}", Version());
+  page["title"] = options.title.empty() ? FileName(options.map_path) : options.title;
+  page["inputs"] = {
+      {"base", FileName(options.base_path)},
+      {"map", FileName(options.map_path)},
+      {"sculpt", options.sculpt_path.empty() ? json() : json(FileName(options.sculpt_path))},
+      {"verify",
+       options.verify_report_path.empty() ? json() : json(FileName(options.verify_report_path))},
+      {"extract_report",
+       options.extract_report_path.empty() ? json() : json(FileName(options.extract_report_path))}};
+
+  // The reports first: a file that is not there stops the run before the heavy work.
+  std::optional<json> verify, extract_report;
+  if (!options.verify_report_path.empty()) {
+    DISPEX_ASSIGN_OR_RETURN(
+        verify, ReadJsonFile(options.verify_report_path, "the report of dispex verify --report"));
+  }
+  if (!options.extract_report_path.empty()) {
+    DISPEX_ASSIGN_OR_RETURN(extract_report, ReadJsonFile(options.extract_report_path,
+                                                         "the report of dispex extract --report"));
+  } else if (!options.extract_report_json.empty()) {
+    extract_report = json::parse(options.extract_report_json, nullptr, false);
+    if (extract_report->is_discarded() || !extract_report->is_object()) {
+      return Status::Error(StatusCode::kInvalidArgument, "extract_report_json: not a JSON object");
+    }
+  }
+  if (!options.sculpt_path.empty()) DISPEX_RETURN_IF_ERROR(CheckReadableFile(options.sculpt_path));
+
+  DISPEX_ASSIGN_OR_RETURN(Mesh base, ReadMesh(options.base_path));
+  report.warnings = IgnoredTagWarnings(base);
+  DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
+  const int num_faces = surface.num_ptex_faces();
+  report.ptex_faces = num_faces;
+  std::vector<PtexFaceInfo> faces = PtexFaceTable(surface);
+  phase_done("base");
+
+  // The map.
+  std::optional<PtexFile> ptex;
+  std::optional<UvMap> uv;
+  std::optional<PtexUvCharts> charts;
+  std::optional<PtexMapSampler> sampler;
+  std::vector<std::vector<float>> texels;
+  std::unique_ptr<view::MapDisplacement> displacement;
+  std::vector<std::atomic<std::uint8_t>> uv_missing;
+  json map_json;
+  json statistics;
+  double tolerance = 0;
+  if (IsUvMapPath(options.map_path)) {
+    DISPEX_ASSIGN_OR_RETURN(uv, UvMap::Open(options.map_path));
+    const bool vector = uv->channels() == 3;
+    if (vector) {
+      const std::string space = uv->Attribute("dispex:space");
+      if (!space.empty() && space != "object") {
+        return Status::Error(StatusCode::kBadInput,
+                             fmt::format("{}: 3 channels in dispex:space '{}': UV-space vector "
+                                         "maps are read in object space",
+                                         options.map_path, space));
+      }
+    }
+    DISPEX_ASSIGN_OR_RETURN(charts, PtexUvCharts::Build(base, surface));
+    uv_missing = std::vector<std::atomic<std::uint8_t>>(static_cast<std::size_t>(num_faces));
+    displacement = std::make_unique<UvDisplacement>(*uv, *charts, vector, uv_missing);
+    report.map_kind = vector ? "uv vector" : "uv scalar";
+    if (vector) report.vector_space = "object";
+    json meta = json::object();
+    for (const auto& [key, value] : uv->tiles().front().attributes) {
+      if (key.rfind("dispex:", 0) == 0) meta[key] = value;
+    }
+    json tiles = json::array();
+    for (std::size_t t = 0; t < uv->tiles().size(); ++t) {
+      tiles.push_back({{"udim", uv->tiles()[t].udim}, {"path", FileName(uv->paths()[t])}});
+    }
+    const std::string tau = uv->Attribute("dispex:tolerance");
+    if (!tau.empty()) tolerance = std::strtod(tau.c_str(), nullptr);
+    map_json = {{"kind", report.map_kind},
+                {"space", vector ? json("object") : json()},
+                {"faces", num_faces},
+                {"channels", uv->channels()},
+                {"resolution", uv->resolution()},
+                {"tiles", tiles},
+                {"meta", meta}};
+  } else {
+    DISPEX_ASSIGN_OR_RETURN(ptex, PtexFile::Open(options.map_path));
+    const PtexFile& map = *ptex;
+    if (map.num_faces() != num_faces) {
+      return Status::Error(
+                 StatusCode::kMismatch,
+                 fmt::format("{}: {} faces, but {} has {} Ptex faces: not a map of "
+                             "this base mesh",
+                             options.map_path, map.num_faces(), options.base_path, num_faces))
+          .WithPath(options.map_path);
+    }
+    const PtexMetaItem* space_item = map.FindMetaData(kVectorSpaceMetaKey);
+    const PtexMetaItem* names_item = map.FindMetaData(kVectorChannelsMetaKey);
+    const std::string space_value = space_item ? space_item->AsString() : "";
+    const std::string names_value = names_item ? names_item->AsString() : "";
+    DISPEX_ASSIGN_OR_RETURN(
+        const std::optional<VectorSpace> space,
+        DisplacementMapSpace(map.name(), map.header().num_channels, map.header().alpha_channel,
+                             space_item ? &space_value : nullptr,
+                             names_item ? &names_value : nullptr));
+    for (int f = 0; f < num_faces; ++f) {
+      const PtexFaceInfo& stored = map.face_info(PtexFaceId(f));
+      faces[static_cast<std::size_t>(f)].ulog2 = stored.ulog2;
+      faces[static_cast<std::size_t>(f)].vlog2 = stored.vlog2;
+    }
+    if (space) {
+      displacement = std::make_unique<PtexVectorDisplacement>(map, *space);
+      report.map_kind = "vector";
+      report.vector_space = std::string(VectorSpaceName(*space));
+    } else {
+      texels.resize(static_cast<std::size_t>(num_faces));
+      for (int f = 0; f < num_faces; ++f) {
+        const PtexFaceId face(f);
+        std::vector<float>& t = texels[static_cast<std::size_t>(f)];
+        if (map.BlockInfo(face, 0).encoding == PtexBlockInfo::Encoding::kConstant) {
+          t.resize(1);
+          map.ConstantValue(face, t.data());
+        } else {
+          DISPEX_RETURN_IF_ERROR(map.ReadFace(face, 0, t));
+        }
+      }
+      sampler.emplace(faces, texels);
+      displacement = std::make_unique<PtexScalarDisplacement>(*sampler);
+      report.map_kind = "scalar";
+    }
+    json meta = MetaJson(map);
+    if (meta.contains("dispex:statistics")) statistics = meta["dispex:statistics"];
+    if (meta.contains("dispex:tolerance") && meta["dispex:tolerance"].is_number()) {
+      tolerance = meta["dispex:tolerance"].get<double>();
+    }
+    map_json = {{"kind", report.map_kind},
+                {"space", space ? json(report.vector_space) : json()},
+                {"faces", num_faces},
+                {"channels", map.header().num_channels},
+                {"data_type", std::string(PtexDataTypeName(map.header().data_type))},
+                {"edge_filter", std::string(PtexEdgeFilterModeName(map.header().edge_filter))},
+                {"file_bytes", map.header().file_size},
+                {"meta", meta}};
+  }
+  map_json["tolerance"] = tolerance > 0 ? json(tolerance) : json();
+  phase_done("map");
+
+  // The grid: the finest within the budget. An n-gon's sub-faces take half the quads a side of
+  // a quad face, so a base with n-gons takes even grids only.
+  bool has_ngons = false;
+  for (int f = 0; f < num_faces && !has_ngons; ++f) {
+    has_ngons = surface.num_ptex_faces(surface.base_face(PtexFaceId(f))) != 1;
+  }
+  const int step = has_ngons ? 2 : 1;
+  int grid = options.grid;
+  if (grid % step != 0) {
+    return Status::Error(StatusCode::kInvalidArgument,
+                         fmt::format("grid = {}: must be even: {} has n-gons, whose sub-faces "
+                                     "take half the quads a side",
+                                     grid, options.base_path));
+  }
+  // The mesh's vertices at a grid: a closed quad mesh of Q quads has about Q of them (the
+  // faces' points less those they share).
+  auto estimate = [&](int g) {
+    std::int64_t points = 0;
+    for (std::uint16_t n : view::FaceQuads(surface, g)) {
+      if (n > 0) points += std::int64_t(n) * n + 1;
+    }
+    return points;
+  };
+  if (grid == 0) {
+    grid = step;
+    for (int g = 2 * step; g <= options.max_grid; g += step) {
+      if (estimate(g) > options.max_vertices) break;
+      grid = g;
+    }
+  }
+  view::SurfaceGrid mesh;
+  for (;;) {
+    DISPEX_ASSIGN_OR_RETURN(
+        mesh, view::BuildSurfaceGrid(surface, faces, grid, *displacement, options.map_path));
+    // An open mesh shares fewer points: one step coarser while over the budget.
+    if (options.grid != 0 || std::int64_t(mesh.limit.size()) <= options.max_vertices ||
+        grid - step < step) {
+      break;
+    }
+    grid -= step;
+  }
+  if (std::int64_t(mesh.limit.size()) > options.max_vertices) {
+    report.notes.push_back(fmt::format(
+        "surface: {} vertices at grid {}, over max_vertices = {}{}", mesh.limit.size(), grid,
+        options.max_vertices,
+        options.grid != 0 ? " (the grid was given)" : ": the coarsest grid has that many"));
+  }
+  report.grid = grid;
+  phase_done("surface");
+  report.surface_vertices = static_cast<std::int64_t>(mesh.limit.size());
+  report.surface_triangles = mesh.triangles;
+
+  json surface_json;
+  {
+    double box[6];
+    const auto packed = view::PackPoints(mesh.limit, box);
+    std::vector<float> flat(3 * mesh.displacement.size());
+    for (std::size_t v = 0; v < mesh.displacement.size(); ++v) {
+      flat[3 * v] = mesh.displacement[v].x;
+      flat[3 * v + 1] = mesh.displacement[v].y;
+      flat[3 * v + 2] = mesh.displacement[v].z;
+    }
+    double d_scale = 0, v_scale = 0;
+    const auto d = view::QuantizeValues(flat, d_scale);
+    const auto values = view::QuantizeValues(mesh.value, v_scale);
+    surface_json = {
+        {"grid", grid},
+        {"vertices", mesh.limit.size()},
+        {"triangles", mesh.triangles},
+        {"shared_points", mesh.shared_points},
+        {"quads", Base64Of(mesh.quads)},
+        {"position", Base64Of(packed)},
+        {"box", std::vector<double>(box, box + 6)},
+        {"displacement", Base64Of(d)},
+        {"displacement_scale", d_scale},
+        {"value", Base64Of(values)},
+        {"value_scale", v_scale},
+        {"value_name", report.map_kind.find("vector") != std::string::npos ? "D·N" : "h"},
+        {"border", Base64Of(mesh.border)}};
+  }
+
+  // Per face: resolution, where it lies on the base, misses, errors.
+  json faces_json;
+  {
+    std::vector<std::int8_t> ulog2(static_cast<std::size_t>(num_faces), 0),
+        vlog2(static_cast<std::size_t>(num_faces), 0);
+    std::vector<std::uint8_t> constant(static_cast<std::size_t>(num_faces), 0),
+        sub_face(static_cast<std::size_t>(num_faces), 255),
+        hole(static_cast<std::size_t>(num_faces), 0);
+    std::vector<std::int32_t> base_face(static_cast<std::size_t>(num_faces), 0);
+    for (int f = 0; f < num_faces; ++f) {
+      const PtexFaceId face(f);
+      const auto k = static_cast<std::size_t>(f);
+      base_face[k] = surface.base_face(face).value;
+      if (surface.num_ptex_faces(surface.base_face(face)) != 1) {
+        sub_face[k] = static_cast<std::uint8_t>(surface.sub_face(face));
+      }
+      hole[k] = surface.is_hole(face);
+      if (ptex) {
+        ulog2[k] = ptex->face_info(face).ulog2;
+        vlog2[k] = ptex->face_info(face).vlog2;
+        constant[k] = ptex->BlockInfo(face, 0).encoding == PtexBlockInfo::Encoding::kConstant;
+      }
+    }
+    faces_json = {{"count", num_faces},
+                  {"base_face", Base64Of(base_face)},
+                  {"sub_face", Base64Of(sub_face)},
+                  {"hole", Base64Of(hole)}};
+    if (ptex) {
+      faces_json["ulog2"] = Base64Of(ulog2);
+      faces_json["vlog2"] = Base64Of(vlog2);
+      faces_json["constant"] = Base64Of(constant);
+    } else {
+      report.notes.push_back(
+          fmt::format("resolution: a UV-space map has one resolution, {} texels per tile side; no "
+                      "resolution per face",
+                      uv->resolution()));
+      faces_json["resolution_note"] = report.notes.back();
+    }
+    std::string holes_note;
+    std::optional<FaceHoles> holes;
+    if (ptex) {
+      holes = ReadFaceHoles(*ptex, surface, statistics, holes_note);
+    } else {
+      holes_note = "a UV-space map records no misses per face";
+    }
+    if (holes) {
+      report.holes_per_face = true;
+      faces_json["samples"] = Base64Of(holes->samples);
+      faces_json["misses"] = Base64Of(holes->misses);
+      faces_json["filled"] = Base64Of(holes->filled);
+      faces_json["all_missed"] = Base64Of(holes->all_missed);
+    } else {
+      report.notes.push_back("holes: " + holes_note);
+      faces_json["holes_note"] = holes_note;
+    }
+    if (uv) {
+      std::vector<std::int32_t> without;
+      for (int f = 0; f < num_faces; ++f) {
+        if (uv_missing[static_cast<std::size_t>(f)].load()) without.push_back(f);
+      }
+      faces_json["without_tile"] = without;
+      if (!without.empty()) {
+        report.notes.push_back(
+            fmt::format("uv: {} faces have points whose UVs no tile holds (displaced by 0 there)",
+                        without.size()));
+      }
+    }
+    if (verify) {
+      const json& v = *verify;
+      if (v.contains("ptex_faces") && v["ptex_faces"].is_number_integer() &&
+          v["ptex_faces"].get<std::int64_t>() != num_faces) {
+        return Status::Error(
+                   StatusCode::kMismatch,
+                   fmt::format("{}: a report of a map of {} faces, but {} has {}",
+                               options.verify_report_path, v["ptex_faces"].get<std::int64_t>(),
+                               options.map_path, num_faces))
+            .WithPath(options.verify_report_path);
+      }
+      FaceErrors errors = ReadFaceErrors(v, static_cast<std::size_t>(num_faces));
+      if (!errors.map_to_sculpt.empty())
+        faces_json["error_map_to_sculpt"] = Base64Of(errors.map_to_sculpt);
+      if (!errors.truth.empty()) faces_json["error_truth"] = Base64Of(errors.truth);
+      report.verify_per_face = errors.note.empty();
+      if (!errors.note.empty()) {
+        report.notes.push_back("verify: " + errors.note);
+        faces_json["error_note"] = errors.note;
+      }
+      if (v.contains("map") && v["map"].is_object() && v["map"].value("tolerance", 0.0) > 0 &&
+          tolerance == 0) {
+        tolerance = v["map"].value("tolerance", 0.0);
+        map_json["tolerance"] = tolerance;
+      }
+    }
+  }
+
+  // The sculpt, decimated.
+  json sculpt_json;
+  if (!options.sculpt_path.empty() && options.max_sculpt_vertices > 0) {
+    DISPEX_ASSIGN_OR_RETURN(Mesh sculpt, ReadMesh(options.sculpt_path));
+    report.sculpt_vertices_read = static_cast<std::int64_t>(sculpt.num_vertices());
+    report.sculpt_faces_read = static_cast<std::int64_t>(sculpt.num_faces());
+    view::DecimatedMesh small = view::DecimateByClustering(sculpt, options.max_sculpt_vertices);
+    report.sculpt_vertices = static_cast<std::int64_t>(small.positions.size());
+    report.sculpt_triangles = static_cast<std::int64_t>(small.triangles.size() / 3);
+    report.sculpt_cell = small.cell;
+    double box[6];
+    const auto packed = view::PackPoints(small.positions, box);
+    std::vector<std::int8_t> normals(3 * small.normals.size());
+    for (std::size_t v = 0; v < small.normals.size(); ++v) {
+      const float n[3] = {small.normals[v].x, small.normals[v].y, small.normals[v].z};
+      for (std::size_t c = 0; c < 3; ++c) {
+        normals[3 * v + c] = static_cast<std::int8_t>(std::lround(127.0f * n[c]));
+      }
+    }
+    sculpt_json = {{"vertices_read", report.sculpt_vertices_read},
+                   {"faces_read", report.sculpt_faces_read},
+                   {"vertices", report.sculpt_vertices},
+                   {"triangles", report.sculpt_triangles},
+                   {"cell", small.cell},
+                   {"max_vertices", options.max_sculpt_vertices},
+                   {"box", std::vector<double>(box, box + 6)},
+                   {"position", Base64Of(packed)},
+                   {"normal", Base64Of(normals)},
+                   {"index", Base64Of(small.triangles)}};
+  } else if (!options.sculpt_path.empty()) {
+    report.notes.push_back("sculpt: max_sculpt_vertices = 0, left out");
+  }
+
+  phase_done("sculpt");
+
+  // The atlas.
+  json atlas = json();
+  if (options.max_atlas_bytes > 0) {
+    StatusOr<Image> image = Status::Error("no atlas");
+    // About the atlas's pixels (tiles of 16 to 256 pixels a side and their separators): a PNG
+    // seldom holds an atlas in less than a byte per 8 pixels, so a larger one is not drawn.
+    double pixels = 0;
+    if (ptex) {
+      for (int f = 0; f < num_faces; ++f) {
+        const PtexFaceInfo& info = ptex->face_info(PtexFaceId(f));
+        pixels +=
+            double(std::clamp(info.ures(), 16, 256) + 1) * (std::clamp(info.vres(), 16, 256) + 1);
+      }
+    }
+    if (pixels > 8.0 * double(options.max_atlas_bytes)) {
+      image = Status::Error(
+          fmt::format("about {:.0f} million pixels for {} faces, more than a PNG of "
+                      "max_atlas_bytes ({:.1f} MB) "
+                      "holds: left out (dispex preview draws it)",
+                      pixels / 1e6, num_faces, double(options.max_atlas_bytes) / 1e6));
+    } else if (ptex) {
+      AtlasOptions atlas_options;
+      atlas_options.mode = DefaultAtlasMode(*ptex);
+      atlas_options.labels = num_faces <= 1024;
+      AtlasLayout layout;
+      image = RenderAtlas(*ptex, atlas_options, &layout);
+    } else {
+      image = UvTilesImage(*uv);
+    }
+    if (image.ok()) {
+      DISPEX_ASSIGN_OR_RETURN(std::vector<std::uint8_t> png, EncodePng(*image));
+      if (static_cast<std::int64_t>(png.size()) <= options.max_atlas_bytes) {
+        atlas = "data:image/png;base64," + view::Base64(png);
+        report.atlas = true;
+        report.atlas_bytes = static_cast<std::int64_t>(atlas.get_ref<const std::string&>().size());
+      } else {
+        report.notes.push_back(fmt::format(
+            "atlas: its PNG ({:.1f} MB, {}x{}) is over max_atlas_bytes ({:.1f} MB): left out",
+            double(png.size()) / 1e6, image->width, image->height,
+            double(options.max_atlas_bytes) / 1e6));
+      }
+    } else {
+      report.notes.push_back("atlas: " + image.status().message());
+    }
+  }
+
+  phase_done("atlas");
+
+  // The verify report as it is, less the per-face arrays the faces already hold.
+  json verify_json = json();
+  if (verify) {
+    verify_json = *verify;
+    verify_json.erase("per_face");
+  }
+
+  page["map"] = map_json;
+  page["lod"] = {{"grid", grid},
+                 {"max_vertices", options.max_vertices},
+                 {"max_grid", options.max_grid},
+                 {"grid_given", options.grid != 0}};
+  page["surface"] = surface_json;
+  page["faces"] = faces_json;
+  page["sculpt"] = sculpt_json;
+  page["verify"] = verify_json;
+  page["extract_report"] = extract_report ? *extract_report : json();
+  page["atlas"] = atlas;
+  page["notes"] = report.notes;
+  page["warnings"] = report.warnings;
+  report.surface_bytes = static_cast<std::int64_t>(surface_json.dump().size());
+  report.sculpt_bytes =
+      sculpt_json.is_null() ? 0 : static_cast<std::int64_t>(sculpt_json.dump().size());
+
+  const std::string data =
+      view::ScriptSafeJson(page.dump(-1, ' ', false, json::error_handler_t::replace));
+  const std::string_view three = view::EmbeddedAsset(view::Asset::kThreeJs);
+  report.three_js_bytes = static_cast<std::int64_t>(three.size());
+  std::string html(view::EmbeddedAsset(view::Asset::kPageHtml));
+  html = ReplaceOnce(std::move(html), "@TITLE@",
+                     view::EscapeHtml(page["title"].get<std::string>() + " - dispex view"));
+  html = ReplaceOnce(std::move(html), "@CSS@", view::EmbeddedAsset(view::Asset::kViewerCss));
+  html = ReplaceOnce(std::move(html), "@DATA@", data);
+  html = ReplaceOnce(std::move(html), "@THREE@", three);
+  html = ReplaceOnce(std::move(html), "@ORBIT_CONTROLS@",
+                     view::EmbeddedAsset(view::Asset::kOrbitControlsJs));
+  html = ReplaceOnce(std::move(html), "@VIEWER@", view::EmbeddedAsset(view::Asset::kViewerJs));
+  report.page_bytes = static_cast<std::int64_t>(html.size());
+  phase_done("page");
+  report.seconds = clock.seconds();
+  if (report_out != nullptr) *report_out = std::move(report);
+  return html;
+}
+
+StatusOr<ViewPageReport> WriteViewPage(const ViewPageOptions& options,
+                                       const std::string& output_path) {
+  DISPEX_RETURN_IF_ERROR(CheckOutputFile(output_path).WithPath(output_path));
+  ViewPageReport report;
+  DISPEX_ASSIGN_OR_RETURN(std::string html, MakeViewPage(options, &report));
+  DISPEX_RETURN_IF_ERROR(WriteFileAtomically(output_path, html.data(), html.size()));
+  return report;
+}
+
+std::string ViewPageReportJson(const ViewPageReport& r) {
+  json j;
+  j["map_kind"] = r.map_kind;
+  if (!r.vector_space.empty()) j["vector_space"] = r.vector_space;
+  j["ptex_faces"] = r.ptex_faces;
+  j["grid"] = r.grid;
+  j["surface"] = {{"vertices", r.surface_vertices}, {"triangles", r.surface_triangles}};
+  j["sculpt"] = {{"vertices_read", r.sculpt_vertices_read},
+                 {"faces_read", r.sculpt_faces_read},
+                 {"vertices", r.sculpt_vertices},
+                 {"triangles", r.sculpt_triangles},
+                 {"cell", r.sculpt_cell}};
+  j["atlas"] = r.atlas;
+  j["verify_per_face"] = r.verify_per_face;
+  j["holes_per_face"] = r.holes_per_face;
+  j["bytes"] = {{"page", r.page_bytes},
+                {"three_js", r.three_js_bytes},
+                {"surface", r.surface_bytes},
+                {"sculpt", r.sculpt_bytes},
+                {"atlas", r.atlas_bytes}};
+  j["notes"] = r.notes;
+  j["warnings"] = r.warnings;
+  j["seconds"] = r.seconds;
+  json phases = json::object();
+  for (const auto& [name, seconds] : r.phase_seconds) phases[name] = seconds;
+  j["phases_seconds"] = phases;
+  return j.dump(2) + "\n";
+}
+
+}  // namespace dispex
