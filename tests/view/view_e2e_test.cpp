@@ -72,6 +72,16 @@ void MakeSculptOrDie(const std::string& cage, const std::string& out, int levels
   ASSERT_TRUE(made.ok()) << made.status().message();
 }
 
+// A level-1 smooth sculpt of Spot and its map: dir/sculpt.obj and dir/spot.ptx.
+void MakeSpotMap(const TempDir& dir) {
+  MakeSculptOrDie(kSpot, dir / "sculpt.obj", 1, Pattern::kSmooth, 0.01);
+  ExtractOptions extract;
+  extract.base_path = kSpot;
+  extract.sculpt_path = dir / "sculpt.obj";
+  extract.output_path = dir / "spot.ptx";
+  ASSERT_TRUE(Extract(extract).ok());
+}
+
 void WriteText(const std::string& path, const std::string& text) {
   ASSERT_TRUE(WriteFileAtomically(path, text.data(), text.size()).ok());
 }
@@ -320,12 +330,7 @@ TEST(ViewPage, UvSpaceTiles) {
 
 TEST(ViewPage, ErrorsNameTheFile) {
   TempDir dir;
-  MakeSculptOrDie(kSpot, dir / "sculpt.obj", 1, Pattern::kSmooth, 0.01);
-  ExtractOptions extract;
-  extract.base_path = kSpot;
-  extract.sculpt_path = dir / "sculpt.obj";
-  extract.output_path = dir / "spot.ptx";
-  ASSERT_TRUE(Extract(extract).ok());
+  ASSERT_NO_FATAL_FAILURE(MakeSpotMap(dir));
   ViewPageOptions o;
   o.base_path = DataPath("meshes/opensubdiv/catmark_cube.obj");
   o.map_path = dir / "spot.ptx";
@@ -357,12 +362,7 @@ TEST(ViewPage, ErrorsNameTheFile) {
 
 TEST(ViewCommand, WritesThePageAndReport) {
   TempDir dir;
-  MakeSculptOrDie(kSpot, dir / "sculpt.obj", 1, Pattern::kSmooth, 0.01);
-  ExtractOptions extract;
-  extract.base_path = kSpot;
-  extract.sculpt_path = dir / "sculpt.obj";
-  extract.output_path = dir / "spot.ptx";
-  ASSERT_TRUE(Extract(extract).ok());
+  ASSERT_NO_FATAL_FAILURE(MakeSpotMap(dir));
   const std::string args = kSpot + " " + (dir / "spot.ptx") + " --sculpt " + (dir / "sculpt.obj") +
                            " --max-vertices 5000 -o " + (dir / "pages/spot.html") + " --report " +
                            (dir / "view.json");
