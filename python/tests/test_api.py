@@ -32,6 +32,20 @@ def test_every_option_of_the_table_is_a_flag_of_the_command_line():
     assert not {"threads", "max_memory", "incremental", "uv_maps_dir", "check_inputs"} & recorded
 
 
+# The command line's flags of `extract` that are not options of the map's extraction: where the
+# outputs go and how the run shows itself (a new extraction option belongs in the table).
+CLI_ONLY_FLAGS = {"--output", "--out-dir", "--shapes", "--manifest", "--report", "--preview",
+                  "--quiet", "--progress-lines", "--watch", "--watch-settle", "--help",
+                  "--search-distance-rel"}  # --search-distance's percentage, spelled apart
+
+
+def test_every_flag_of_extract_is_in_the_table_or_the_command_lines_own():
+    help_text = run_cli("extract", "--help").stdout
+    flags = set(re.findall(r"^\s+(?:-\w, )?(--[a-z-]+)", help_text, flags=re.M))
+    table = {spec["flag"] for spec in dispex.option_names().values()}
+    assert flags - CLI_ONLY_FLAGS == table, (flags - CLI_ONLY_FLAGS) ^ table
+
+
 # A value for each option other than its default, and the command line's arguments for it.
 OPTION_VALUES = {
     "oversample": (16, ["--oversample", "16"]),
