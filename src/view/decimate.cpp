@@ -51,104 +51,133 @@ Float3 UnitOr(const double* n) {
   return {float(n[0] / l), float(n[1] / l), float(n[2] / l)};
 }
 
-}  // namespace
-
-DecimatedMesh DecimateByClustering(const Mesh& mesh, std::int64_t max_vertices) {
-  DecimatedMesh out;
-  const std::size_t nv = mesh.num_vertices(), nf = mesh.num_faces();
+// The vertices some face uses, in order.
+std::vector<std::uint32_t> UsedVertices(const Mesh& mesh) {
+  const std::size_t nv = mesh.num_vertices();
   std::vector<std::uint8_t> used(nv, 0);
   for (std::int32_t v : mesh.face_indices) used[static_cast<std::size_t>(v)] = 1;
   std::vector<std::uint32_t> used_ids;
   for (std::size_t v = 0; v < nv; ++v) {
     if (used[v]) used_ids.push_back(static_cast<std::uint32_t>(v));
   }
-  max_vertices = std::max<std::int64_t>(max_vertices, 1);
+  return used_ids;
+}
 
-  if (std::int64_t(used_ids.size()) <= max_vertices) {
-    std::vector<std::uint32_t> remap(nv, 0);
-    for (std::size_t k = 0; k < used_ids.size(); ++k) {
-      remap[used_ids[k]] = static_cast<std::uint32_t>(k);
-      out.positions.push_back(mesh.positions[used_ids[k]]);
-    }
-    std::vector<double> normal(3 * used_ids.size(), 0.0);
-    for (std::size_t f = 0; f < nf; ++f) {
-      const auto face = mesh.face(f);
-      double n[3];
-      FaceAreaVector(mesh, face, n);
-      for (std::int32_t v : face) {
-        double* m = &normal[3 * remap[static_cast<std::size_t>(v)]];
-        m[0] += n[0], m[1] += n[1], m[2] += n[2];
-      }
-      for (std::size_t c = 1; c + 1 < face.size(); ++c) {
-        out.triangles.push_back(remap[static_cast<std::size_t>(face[0])]);
-        out.triangles.push_back(remap[static_cast<std::size_t>(face[c])]);
-        out.triangles.push_back(remap[static_cast<std::size_t>(face[c + 1])]);
-      }
-    }
-    for (std::size_t k = 0; k < used_ids.size(); ++k) out.normals.push_back(UnitOr(&normal[3 * k]));
-    return out;
+// A mesh within the budget as it is: its used vertices, its faces as triangle fans, the
+// vertices' normals from the area vectors of the faces at them.
+DecimatedMesh Triangulated(const Mesh& mesh, std::span<const std::uint32_t> used_ids) {
+  DecimatedMesh out;
+  std::vector<std::uint32_t> remap(mesh.num_vertices(), 0);
+  for (std::size_t k = 0; k < used_ids.size(); ++k) {
+    remap[used_ids[k]] = static_cast<std::uint32_t>(k);
+    out.positions.push_back(mesh.positions[used_ids[k]]);
   }
+  std::vector<double> normal(3 * used_ids.size(), 0.0);
+  for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+    const auto face = mesh.face(f);
+    double n[3];
+    FaceAreaVector(mesh, face, n);
+    for (std::int32_t v : face) {
+      double* m = &normal[3 * remap[static_cast<std::size_t>(v)]];
+      m[0] += n[0], m[1] += n[1], m[2] += n[2];
+    }
+    for (std::size_t c = 1; c + 1 < face.size(); ++c) {
+      out.triangles.push_back(remap[static_cast<std::size_t>(face[0])]);
+      out.triangles.push_back(remap[static_cast<std::size_t>(face[c])]);
+      out.triangles.push_back(remap[static_cast<std::size_t>(face[c + 1])]);
+    }
+  }
+  for (std::size_t k = 0; k < used_ids.size(); ++k) out.normals.push_back(UnitOr(&normal[3 * k]));
+  return out;
+}
 
+// The clustering's grid: the cell size, each used vertex's cell key and the occupied cells
+// (sorted, each once), within max_vertices cells.
+struct CellGrid {
+  double cell = 0;
+  std::vector<std::uint64_t> keys, cells;
+};
+CellGrid ChooseCells(const Mesh& mesh, std::span<const std::uint32_t> used_ids,
+                     std::int64_t max_vertices) {
   const BoundingBox box = ComputeBounds(mesh);
   const double extent = std::max({double(box.max.x) - box.min.x, double(box.max.y) - box.min.y,
                                   double(box.max.z) - box.min.z, 1e-30});
   const double area = MeshArea(mesh);
   // About one vertex per cell of the surface's area; never finer than 2^21 cells per side.
-  double cell = std::max(std::sqrt(std::max(area, 0.0) / double(max_vertices)),
-                         extent / double((1 << 21) - 2));
-  std::vector<std::uint64_t> keys(used_ids.size()), cells;
+  CellGrid grid;
+  double& cell = grid.cell;
+  cell = std::max(std::sqrt(std::max(area, 0.0) / double(max_vertices)),
+                  extent / double((1 << 21) - 2));
+  grid.keys.resize(used_ids.size());
   for (int attempt = 0;; ++attempt) {
     const double inverse = 1.0 / cell;
     tbb::parallel_for(std::size_t{0}, used_ids.size(), [&](std::size_t k) {
-      keys[k] = CellKey(mesh.positions[used_ids[k]], box.min, inverse);
+      grid.keys[k] = CellKey(mesh.positions[used_ids[k]], box.min, inverse);
     });
-    cells = keys;
-    tbb::parallel_sort(cells.begin(), cells.end());
-    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
-    const auto count = static_cast<std::int64_t>(cells.size());
+    grid.cells = grid.keys;
+    tbb::parallel_sort(grid.cells.begin(), grid.cells.end());
+    grid.cells.erase(std::unique(grid.cells.begin(), grid.cells.end()), grid.cells.end());
+    const auto count = static_cast<std::int64_t>(grid.cells.size());
     if (count <= max_vertices || attempt >= 40) break;
     cell *= std::max(1.02, 1.01 * std::sqrt(double(count) / double(max_vertices)));
   }
-  out.cell = cell;
+  return grid;
+}
 
-  // Each used vertex's cell, the cells' means.
-  std::vector<std::uint32_t> cell_of(nv, 0);
+// The vertices gathered into cells: each used vertex's cell, the sums and counts of the cells'
+// points, and each cell's normal.
+struct Clusters {
+  std::vector<std::uint32_t> cell_of;  // per vertex of the mesh
+  std::vector<double> sum;             // per cell: x, y, z
+  std::vector<std::uint32_t> count;
+  std::vector<double> normal;  // per cell: x, y, z
+
+  Float3 Mean(std::uint32_t c) const {
+    const double m = count[c];
+    return Float3{float(sum[3 * c] / m), float(sum[3 * c + 1] / m), float(sum[3 * c + 2] / m)};
+  }
+};
+Clusters Cluster(const Mesh& mesh, std::span<const std::uint32_t> used_ids, const CellGrid& grid) {
+  Clusters out;
+  const std::vector<std::uint64_t>& cells = grid.cells;
+  out.cell_of.assign(mesh.num_vertices(), 0);
   tbb::parallel_for(std::size_t{0}, used_ids.size(), [&](std::size_t k) {
-    cell_of[used_ids[k]] = static_cast<std::uint32_t>(
-        std::lower_bound(cells.begin(), cells.end(), keys[k]) - cells.begin());
+    out.cell_of[used_ids[k]] = static_cast<std::uint32_t>(
+        std::lower_bound(cells.begin(), cells.end(), grid.keys[k]) - cells.begin());
   });
-  std::vector<double> sum(3 * cells.size(), 0.0);
-  std::vector<std::uint32_t> count(cells.size(), 0);
+  out.sum.assign(3 * cells.size(), 0.0);
+  out.count.assign(cells.size(), 0);
   for (std::uint32_t v : used_ids) {
-    const std::uint32_t c = cell_of[v];
+    const std::uint32_t c = out.cell_of[v];
     const Float3& p = mesh.positions[v];
-    sum[3 * c] += p.x, sum[3 * c + 1] += p.y, sum[3 * c + 2] += p.z;
-    ++count[c];
+    out.sum[3 * c] += p.x, out.sum[3 * c + 1] += p.y, out.sum[3 * c + 2] += p.z;
+    ++out.count[c];
   }
 
   // Each cell's normal: the sum of the area vectors of the faces at its vertices (the sculpt's
   // own shading, whatever the clustering did to the triangles).
-  std::vector<double> cell_normal(3 * cells.size(), 0.0);
-  for (std::size_t f = 0; f < nf; ++f) {
+  out.normal.assign(3 * cells.size(), 0.0);
+  for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
     const auto face = mesh.face(f);
     double n[3];
     FaceAreaVector(mesh, face, n);
     for (std::int32_t v : face) {
-      double* m = &cell_normal[3 * cell_of[static_cast<std::size_t>(v)]];
+      double* m = &out.normal[3 * out.cell_of[static_cast<std::size_t>(v)]];
       m[0] += n[0], m[1] += n[1], m[2] += n[2];
     }
   }
+  return out;
+}
 
-  // The triangles between three cells, each once, turned to face along their cells' normals
-  // where the clustering turned them over (a renderer would shade them from behind); then only
-  // the cells they use, with their normals.
+// The triangles between three cells (of the faces' triangle fans), each once, turned to face
+// along their cells' normals where the clustering turned them over (a renderer would shade
+// them from behind); as cell ids.
+std::vector<std::uint32_t> ClusterTriangles(const Mesh& mesh, const Clusters& clusters) {
+  const std::vector<std::uint32_t>& cell_of = clusters.cell_of;
+  const std::vector<double>& cell_normal = clusters.normal;
   std::unordered_set<std::array<std::uint32_t, 3>, TriangleHash> seen;
   std::vector<std::uint32_t> triangles;
-  auto mean = [&](std::uint32_t c) {
-    const double m = count[c];
-    return Float3{float(sum[3 * c] / m), float(sum[3 * c + 1] / m), float(sum[3 * c + 2] / m)};
-  };
-  for (std::size_t f = 0; f < nf; ++f) {
+  for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
     const auto face = mesh.face(f);
     const std::uint32_t a = cell_of[static_cast<std::size_t>(face[0])];
     for (std::size_t c = 1; c + 1 < face.size(); ++c) {
@@ -159,7 +188,7 @@ DecimatedMesh DecimateByClustering(const Mesh& mesh, std::int64_t max_vertices) 
       std::sort(key.begin(), key.end());
       if (!seen.insert(key).second) continue;
       double n[3] = {0, 0, 0};
-      const Float3 p = mean(a), q = mean(b), r = mean(d);
+      const Float3 p = clusters.Mean(a), q = clusters.Mean(b), r = clusters.Mean(d);
       const double u[3] = {double(q.x) - p.x, double(q.y) - p.y, double(q.z) - p.z};
       const double v[3] = {double(r.x) - p.x, double(r.y) - p.y, double(r.z) - p.z};
       n[0] = u[1] * v[2] - u[2] * v[1];
@@ -176,16 +205,36 @@ DecimatedMesh DecimateByClustering(const Mesh& mesh, std::int64_t max_vertices) 
       }
     }
   }
-  std::vector<std::uint32_t> remap(cells.size(), UINT32_MAX);
+  return triangles;
+}
+
+// Only the cells the triangles use, in the order they first use them, with their normals.
+void KeepUsedCells(const Clusters& clusters, std::vector<std::uint32_t> triangles,
+                   DecimatedMesh& out) {
+  std::vector<std::uint32_t> remap(clusters.count.size(), UINT32_MAX);
   for (std::uint32_t& c : triangles) {
     if (remap[c] == UINT32_MAX) {
       remap[c] = static_cast<std::uint32_t>(out.positions.size());
-      out.positions.push_back(mean(c));
-      out.normals.push_back(UnitOr(&cell_normal[3 * c]));
+      out.positions.push_back(clusters.Mean(c));
+      out.normals.push_back(UnitOr(&clusters.normal[3 * c]));
     }
     c = remap[c];
   }
   out.triangles = std::move(triangles);
+}
+
+}  // namespace
+
+DecimatedMesh DecimateByClustering(const Mesh& mesh, std::int64_t max_vertices) {
+  const std::vector<std::uint32_t> used_ids = UsedVertices(mesh);
+  max_vertices = std::max<std::int64_t>(max_vertices, 1);
+  if (std::int64_t(used_ids.size()) <= max_vertices) return Triangulated(mesh, used_ids);
+
+  const CellGrid grid = ChooseCells(mesh, used_ids, max_vertices);
+  const Clusters clusters = Cluster(mesh, used_ids, grid);
+  DecimatedMesh out;
+  out.cell = grid.cell;
+  KeepUsedCells(clusters, ClusterTriangles(mesh, clusters), out);
   return out;
 }
 

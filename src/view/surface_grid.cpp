@@ -62,36 +62,34 @@ struct Scratch {
   std::vector<float> uv, p, n, du, dv, d, value;
 };
 
-}  // namespace
+// Every face's grid points, face after face from start[f]: P, D, the value.
+struct GridSamples {
+  std::vector<std::size_t> start;  // per face, and one past the last
+  std::vector<Float3> p, d;
+  std::vector<float> value;
+  std::size_t slots() const { return start.back(); }
+};
 
-StatusOr<SurfaceGrid> BuildSurfaceGrid(const LimitSurface& surface,
-                                       std::span<const PtexFaceInfo> faces, int grid,
-                                       const MapDisplacement& map, const std::string& map_name) {
-  SurfaceGrid out;
-  out.grid = grid;
-  out.quads = FaceQuads(surface, grid);
-  const std::size_t num_faces = out.quads.size();
-  std::vector<std::size_t> start(num_faces + 1, 0);
-  for (std::size_t f = 0; f < num_faces; ++f) {
-    const std::size_t n = out.quads[f];
+// Where each face's points begin: (n + 1)^2 points for a face of n > 0 quads a side.
+std::vector<std::size_t> FaceStarts(std::span<const std::uint16_t> quads) {
+  std::vector<std::size_t> start(quads.size() + 1, 0);
+  for (std::size_t f = 0; f < quads.size(); ++f) {
+    const std::size_t n = quads[f];
     start[f + 1] = start[f] + (n > 0 ? (n + 1) * (n + 1) : 0);
-    out.triangles += 2 * std::int64_t(n) * std::int64_t(n);
   }
-  const std::size_t slots = start[num_faces];
-  if (slots >= (std::size_t{1} << 31)) {
-    return Status::Error(fmt::format("{} grid points: too many for a page", slots));
-  }
-  std::vector<Float3> p(slots), d(slots);
-  std::vector<float> value(slots);
+  return start;
+}
 
-  // Every face's grid, evaluated and displaced.
+// Every face's grid, evaluated and displaced; the error of the lowest face that fails.
+Status EvaluateFaces(const LimitSurface& surface, std::span<const std::uint16_t> quads,
+                     const MapDisplacement& map, GridSamples& out) {
   tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
   tbb::enumerable_thread_specific<Scratch> scratches;
   std::mutex mutex;
   Status error;
   int error_face = -1;
-  tbb::parallel_for(std::size_t{0}, num_faces, [&](std::size_t f) {
-    const int n = out.quads[f];
+  tbb::parallel_for(std::size_t{0}, quads.size(), [&](std::size_t f) {
+    const int n = quads[f];
     if (n == 0) return;
     auto& evaluator = evaluators.local();
     if (!evaluator) evaluator.emplace(surface);
@@ -116,36 +114,48 @@ StatusOr<SurfaceGrid> BuildSurfaceGrid(const LimitSurface& surface,
       return;
     }
     map.Displace(face, s.uv, frames, s.d, s.value);
+    const std::size_t at = out.start[f];
     for (std::size_t j = 0; j < points; ++j) {
-      p[start[f] + j] = {s.p[3 * j], s.p[3 * j + 1], s.p[3 * j + 2]};
-      d[start[f] + j] = {s.d[3 * j], s.d[3 * j + 1], s.d[3 * j + 2]};
-      value[start[f] + j] = s.value[j];
+      out.p[at + j] = {s.p[3 * j], s.p[3 * j + 1], s.p[3 * j + 2]};
+      out.d[at + j] = {s.d[3 * j], s.d[3 * j + 1], s.d[3 * j + 2]};
+      out.value[at + j] = s.value[j];
     }
   });
-  DISPEX_RETURN_IF_ERROR(error);
-  for (std::size_t j = 0; j < slots; ++j) {
+  return error;
+}
+
+// An error naming the first face whose D or value is not finite.
+Status CheckFinite(const GridSamples& samples, const std::string& map_name) {
+  const std::vector<Float3>& d = samples.d;
+  for (std::size_t j = 0; j < samples.slots(); ++j) {
     if (!std::isfinite(d[j].x) || !std::isfinite(d[j].y) || !std::isfinite(d[j].z) ||
-        !std::isfinite(value[j])) {
-      std::size_t f = static_cast<std::size_t>(std::upper_bound(start.begin(), start.end(), j) -
-                                               start.begin() - 1);
+        !std::isfinite(samples.value[j])) {
+      std::size_t f =
+          static_cast<std::size_t>(std::upper_bound(samples.start.begin(), samples.start.end(), j) -
+                                   samples.start.begin() - 1);
       return Status::Error(
           fmt::format("{}: face {} holds values that are not finite", map_name, f));
     }
   }
+  return Status::Ok();
+}
 
-  // The points faces share: along every edge between two faces, each point of one side that
-  // is a point of the other's grid.
+// The points faces share: along every edge between two faces, each point of one side that
+// is a point of the other's grid.
+DisjointSets SharedPoints(std::span<const PtexFaceInfo> faces, std::span<const std::uint16_t> quads,
+                          std::span<const std::size_t> start) {
+  const std::size_t num_faces = quads.size();
   auto on_edge = [&](std::size_t f, int edge, double t) {
-    const int n = out.quads[f];
+    const int n = quads[f];
     double u = 0, v = 0;
     PtexEdgePoint(edge, t, u, v);
     const auto i = static_cast<std::size_t>(std::lround(u * n));
     const auto j = static_cast<std::size_t>(std::lround(v * n));
     return static_cast<std::uint32_t>(start[f] + j * std::size_t(n + 1) + i);
   };
-  DisjointSets sets(slots);
+  DisjointSets sets(start[num_faces]);
   for (std::size_t f = 0; f < num_faces; ++f) {
-    const int n = out.quads[f];
+    const int n = quads[f];
     if (n == 0) continue;
     for (int edge = 0; edge < 4; ++edge) {
       for (int k = 0; k <= n; ++k) {
@@ -155,16 +165,22 @@ StatusOr<SurfaceGrid> BuildSurfaceGrid(const LimitSurface& surface,
           continue;
         }
         const auto g = static_cast<std::size_t>(other.face.value);
-        if (g >= num_faces || out.quads[g] == 0) continue;
-        const double at = other.t * out.quads[g];
+        if (g >= num_faces || quads[g] == 0) continue;
+        const double at = other.t * quads[g];
         const double r = std::round(at);
         if (std::fabs(at - r) > 1e-6) continue;
-        sets.Join(on_edge(f, edge, t), on_edge(g, other.edge, r / out.quads[g]));
+        sets.Join(on_edge(f, edge, t), on_edge(g, other.edge, r / quads[g]));
       }
     }
   }
+  return sets;
+}
 
-  // Vertex ids: interior points first, then each border point's set once.
+// Vertex ids: interior points first, then each border point's set once, as the mean of the
+// points in it (out.limit, displacement, value, border, shared_points).
+void NumberVertices(const GridSamples& samples, DisjointSets& sets, SurfaceGrid& out) {
+  const std::vector<std::size_t>& start = samples.start;
+  const std::size_t num_faces = out.quads.size();
   auto border_point = [&](std::size_t f, std::size_t j) {
     const std::size_t n = out.quads[f], x = j % (n + 1), y = j / (n + 1);
     return x == 0 || y == 0 || x == n || y == n;
@@ -174,7 +190,7 @@ StatusOr<SurfaceGrid> BuildSurfaceGrid(const LimitSurface& surface,
     const std::size_t n = out.quads[f];
     if (n > 1) interior += (n - 1) * (n - 1);
   }
-  std::vector<std::uint32_t> id(slots, UINT32_MAX);
+  std::vector<std::uint32_t> id(samples.slots(), UINT32_MAX);
   std::vector<std::uint32_t> members;  // per vertex: how many points it is the mean of
   std::size_t next_interior = 0, next_border = interior;
   out.limit.resize(interior);
@@ -186,11 +202,13 @@ StatusOr<SurfaceGrid> BuildSurfaceGrid(const LimitSurface& surface,
     const std::size_t points = start[f + 1] - start[f];
     for (std::size_t j = 0; j < points; ++j) {
       const std::size_t slot = start[f] + j;
+      const Float3& p = samples.p[slot];
+      const Float3& d = samples.d[slot];
       if (!border_point(f, j)) {
         id[slot] = static_cast<std::uint32_t>(next_interior);
-        out.limit[next_interior] = p[slot];
-        out.displacement[next_interior] = d[slot];
-        out.value[next_interior] = value[slot];
+        out.limit[next_interior] = p;
+        out.displacement[next_interior] = d;
+        out.value[next_interior] = samples.value[slot];
         ++next_interior;
         continue;
       }
@@ -205,9 +223,9 @@ StatusOr<SurfaceGrid> BuildSurfaceGrid(const LimitSurface& surface,
       out.border.push_back(v);
       ++members[v];
       double* s = &sums[7 * (v - interior)];
-      s[0] += p[slot].x, s[1] += p[slot].y, s[2] += p[slot].z;
-      s[3] += d[slot].x, s[4] += d[slot].y, s[5] += d[slot].z;
-      s[6] += value[slot];
+      s[0] += p.x, s[1] += p.y, s[2] += p.z;
+      s[3] += d.x, s[4] += d.y, s[5] += d.z;
+      s[6] += samples.value[slot];
     }
   }
   const std::size_t borders = next_border - interior;
@@ -223,6 +241,28 @@ StatusOr<SurfaceGrid> BuildSurfaceGrid(const LimitSurface& surface,
     out.displacement[v] = {float(s[3] / m), float(s[4] / m), float(s[5] / m)};
     out.value[v] = float(s[6] / m);
   }
+}
+
+}  // namespace
+
+StatusOr<SurfaceGrid> BuildSurfaceGrid(const LimitSurface& surface,
+                                       std::span<const PtexFaceInfo> faces, int grid,
+                                       const MapDisplacement& map, const std::string& map_name) {
+  SurfaceGrid out;
+  out.grid = grid;
+  out.quads = FaceQuads(surface, grid);
+  for (std::uint16_t n : out.quads) out.triangles += 2 * std::int64_t(n) * std::int64_t(n);
+  GridSamples samples;
+  samples.start = FaceStarts(out.quads);
+  const std::size_t slots = samples.slots();
+  if (slots >= (std::size_t{1} << 31)) {
+    return Status::Error(fmt::format("{} grid points: too many for a page", slots));
+  }
+  samples.p.resize(slots), samples.d.resize(slots), samples.value.resize(slots);
+  DISPEX_RETURN_IF_ERROR(EvaluateFaces(surface, out.quads, map, samples));
+  DISPEX_RETURN_IF_ERROR(CheckFinite(samples, map_name));
+  DisjointSets sets = SharedPoints(faces, out.quads, samples.start);
+  NumberVertices(samples, sets, out);
   return out;
 }
 

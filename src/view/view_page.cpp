@@ -311,6 +311,546 @@ std::string ReplaceOnce(std::string text, std::string_view marker, std::string_v
   return text.replace(at, marker.size(), by);
 }
 
+// ---- MakeViewPage's steps -------------------------------------------------------------------
+
+// The page's header: its format, generator, title and the inputs' file names.
+json PageHeader(const ViewPageOptions& options) {
+  json page;
+  page["format"] = 1;
+  page["generator"] = fmt::format("dispex {}", Version());
+  page["title"] = options.title.empty() ? FileName(options.map_path) : options.title;
+  auto name_or_null = [](const std::string& path) {
+    return path.empty() ? json() : json(FileName(path));
+  };
+  page["inputs"] = {{"base", FileName(options.base_path)},
+                    {"map", FileName(options.map_path)},
+                    {"sculpt", name_or_null(options.sculpt_path)},
+                    {"verify", name_or_null(options.verify_report_path)},
+                    {"extract_report", name_or_null(options.extract_report_path)}};
+  return page;
+}
+
+// The reports (verify, extract), read first: a file that is not there stops the run before
+// the heavy work; so does a sculpt that cannot be read.
+struct Reports {
+  std::optional<json> verify, extract;
+};
+StatusOr<Reports> ReadReports(const ViewPageOptions& options) {
+  Reports reports;
+  if (!options.verify_report_path.empty()) {
+    DISPEX_ASSIGN_OR_RETURN(reports.verify, ReadJsonFile(options.verify_report_path,
+                                                         "the report of dispex verify --report"));
+  }
+  if (!options.extract_report_path.empty()) {
+    DISPEX_ASSIGN_OR_RETURN(reports.extract, ReadJsonFile(options.extract_report_path,
+                                                          "the report of dispex extract --report"));
+  } else if (!options.extract_report_json.empty()) {
+    reports.extract = json::parse(options.extract_report_json, nullptr, false);
+    if (reports.extract->is_discarded() || !reports.extract->is_object()) {
+      return Status::Error(StatusCode::kInvalidArgument, "extract_report_json: not a JSON object");
+    }
+  }
+  if (!options.sculpt_path.empty()) DISPEX_RETURN_IF_ERROR(CheckReadableFile(options.sculpt_path));
+  return reports;
+}
+
+// The map as read, and how it displaces the limit surface. `displacement` refers to the other
+// members, so a MapSource stays where it was made.
+struct MapSource {
+  MapSource() = default;
+  MapSource(const MapSource&) = delete;
+  MapSource& operator=(const MapSource&) = delete;
+
+  std::optional<PtexFile> ptex;
+  std::optional<UvMap> uv;
+  std::optional<PtexUvCharts> charts;
+  std::optional<PtexMapSampler> sampler;
+  std::vector<std::vector<float>> texels;
+  std::unique_ptr<view::MapDisplacement> displacement;
+  std::vector<std::atomic<std::uint8_t>> uv_missing;  // per face: points no tile holds
+  json map_json;
+  json statistics;  // the Ptex map's dispex:statistics
+  double tolerance = 0;
+};
+
+// A UV-space map (tiles), read through the cage's UVs.
+Status ReadUvMap(const ViewPageOptions& options, const Mesh& base, const LimitSurface& surface,
+                 ViewPageReport& report, MapSource& map) {
+  const int num_faces = surface.num_ptex_faces();
+  DISPEX_ASSIGN_OR_RETURN(map.uv, UvMap::Open(options.map_path));
+  const UvMap& uv = *map.uv;
+  const bool vector = uv.channels() == 3;
+  if (vector) {
+    const std::string space = uv.Attribute("dispex:space");
+    if (!space.empty() && space != "object") {
+      return Status::Error(StatusCode::kBadInput,
+                           fmt::format("{}: 3 channels in dispex:space '{}': UV-space vector "
+                                       "maps are read in object space",
+                                       options.map_path, space));
+    }
+  }
+  DISPEX_ASSIGN_OR_RETURN(map.charts, PtexUvCharts::Build(base, surface));
+  map.uv_missing = std::vector<std::atomic<std::uint8_t>>(static_cast<std::size_t>(num_faces));
+  map.displacement = std::make_unique<UvDisplacement>(uv, *map.charts, vector, map.uv_missing);
+  report.map_kind = vector ? "uv vector" : "uv scalar";
+  if (vector) report.vector_space = "object";
+  json meta = json::object();
+  for (const auto& [key, value] : uv.tiles().front().attributes) {
+    if (key.rfind("dispex:", 0) == 0) meta[key] = value;
+  }
+  json tiles = json::array();
+  for (std::size_t t = 0; t < uv.tiles().size(); ++t) {
+    tiles.push_back({{"udim", uv.tiles()[t].udim}, {"path", FileName(uv.paths()[t])}});
+  }
+  const std::string tau = uv.Attribute("dispex:tolerance");
+  if (!tau.empty()) map.tolerance = std::strtod(tau.c_str(), nullptr);
+  map.map_json = {{"kind", report.map_kind},
+                  {"space", vector ? json("object") : json()},
+                  {"faces", num_faces},
+                  {"channels", uv.channels()},
+                  {"resolution", uv.resolution()},
+                  {"tiles", tiles},
+                  {"meta", meta}};
+  return Status::Ok();
+}
+
+// A scalar Ptex map's texels, every face's (one for a constant face).
+Status ReadScalarTexels(const PtexFile& ptex, std::vector<std::vector<float>>& texels) {
+  texels.resize(static_cast<std::size_t>(ptex.num_faces()));
+  for (int f = 0; f < ptex.num_faces(); ++f) {
+    const PtexFaceId face(f);
+    std::vector<float>& t = texels[static_cast<std::size_t>(f)];
+    if (ptex.BlockInfo(face, 0).encoding == PtexBlockInfo::Encoding::kConstant) {
+      t.resize(1);
+      ptex.ConstantValue(face, t.data());
+    } else {
+      DISPEX_RETURN_IF_ERROR(ptex.ReadFace(face, 0, t));
+    }
+  }
+  return Status::Ok();
+}
+
+// A Ptex map, scalar or vector; `faces` takes its resolutions.
+Status ReadPtexMap(const ViewPageOptions& options, int num_faces, std::vector<PtexFaceInfo>& faces,
+                   ViewPageReport& report, MapSource& map) {
+  DISPEX_ASSIGN_OR_RETURN(map.ptex, PtexFile::Open(options.map_path));
+  const PtexFile& ptex = *map.ptex;
+  if (ptex.num_faces() != num_faces) {
+    return Status::Error(
+               StatusCode::kMismatch,
+               fmt::format("{}: {} faces, but {} has {} Ptex faces: not a map of "
+                           "this base mesh",
+                           options.map_path, ptex.num_faces(), options.base_path, num_faces))
+        .WithPath(options.map_path);
+  }
+  const PtexMetaItem* space_item = ptex.FindMetaData(kVectorSpaceMetaKey);
+  const PtexMetaItem* names_item = ptex.FindMetaData(kVectorChannelsMetaKey);
+  const std::string space_value = space_item ? space_item->AsString() : "";
+  const std::string names_value = names_item ? names_item->AsString() : "";
+  DISPEX_ASSIGN_OR_RETURN(
+      const std::optional<VectorSpace> space,
+      DisplacementMapSpace(ptex.name(), ptex.header().num_channels, ptex.header().alpha_channel,
+                           space_item ? &space_value : nullptr,
+                           names_item ? &names_value : nullptr));
+  for (int f = 0; f < num_faces; ++f) {
+    const PtexFaceInfo& stored = ptex.face_info(PtexFaceId(f));
+    faces[static_cast<std::size_t>(f)].ulog2 = stored.ulog2;
+    faces[static_cast<std::size_t>(f)].vlog2 = stored.vlog2;
+  }
+  if (space) {
+    map.displacement = std::make_unique<PtexVectorDisplacement>(ptex, *space);
+    report.map_kind = "vector";
+    report.vector_space = std::string(VectorSpaceName(*space));
+  } else {
+    DISPEX_RETURN_IF_ERROR(ReadScalarTexels(ptex, map.texels));
+    map.sampler.emplace(faces, map.texels);
+    map.displacement = std::make_unique<PtexScalarDisplacement>(*map.sampler);
+    report.map_kind = "scalar";
+  }
+  json meta = MetaJson(ptex);
+  if (meta.contains("dispex:statistics")) map.statistics = meta["dispex:statistics"];
+  if (meta.contains("dispex:tolerance") && meta["dispex:tolerance"].is_number()) {
+    map.tolerance = meta["dispex:tolerance"].get<double>();
+  }
+  map.map_json = {{"kind", report.map_kind},
+                  {"space", space ? json(report.vector_space) : json()},
+                  {"faces", num_faces},
+                  {"channels", ptex.header().num_channels},
+                  {"data_type", std::string(PtexDataTypeName(ptex.header().data_type))},
+                  {"edge_filter", std::string(PtexEdgeFilterModeName(ptex.header().edge_filter))},
+                  {"file_bytes", ptex.header().file_size},
+                  {"meta", meta}};
+  return Status::Ok();
+}
+
+Status ReadMap(const ViewPageOptions& options, const Mesh& base, const LimitSurface& surface,
+               std::vector<PtexFaceInfo>& faces, ViewPageReport& report, MapSource& map) {
+  if (IsUvMapPath(options.map_path)) {
+    DISPEX_RETURN_IF_ERROR(ReadUvMap(options, base, surface, report, map));
+  } else {
+    DISPEX_RETURN_IF_ERROR(ReadPtexMap(options, surface.num_ptex_faces(), faces, report, map));
+  }
+  map.map_json["tolerance"] = map.tolerance > 0 ? json(map.tolerance) : json();
+  return Status::Ok();
+}
+
+// The grid's step: an n-gon's sub-faces take half the quads a side of a quad face, so a base
+// with n-gons takes even grids only.
+int GridStep(const LimitSurface& surface) {
+  bool has_ngons = false;
+  for (int f = 0; f < surface.num_ptex_faces() && !has_ngons; ++f) {
+    has_ngons = surface.num_ptex_faces(surface.base_face(PtexFaceId(f))) != 1;
+  }
+  return has_ngons ? 2 : 1;
+}
+
+// The grid to begin with: the one given, else the finest within the budget.
+StatusOr<int> ChooseGrid(const ViewPageOptions& options, const LimitSurface& surface, int step) {
+  int grid = options.grid;
+  if (grid % step != 0) {
+    return Status::Error(StatusCode::kInvalidArgument,
+                         fmt::format("grid = {}: must be even: {} has n-gons, whose sub-faces "
+                                     "take half the quads a side",
+                                     grid, options.base_path));
+  }
+  // The mesh's vertices at a grid: a closed quad mesh of Q quads has about Q of them (the
+  // faces' points less those they share).
+  auto estimate = [&](int g) {
+    std::int64_t points = 0;
+    for (std::uint16_t n : view::FaceQuads(surface, g)) {
+      if (n > 0) points += std::int64_t(n) * n + 1;
+    }
+    return points;
+  };
+  if (grid == 0) {
+    grid = step;
+    for (int g = 2 * step; g <= options.max_grid; g += step) {
+      if (estimate(g) > options.max_vertices) break;
+      grid = g;
+    }
+  }
+  return grid;
+}
+
+// The displaced surface's mesh at the grid chosen; `report.grid` takes the grid it was built at.
+StatusOr<view::SurfaceGrid> BuildSurfaceMesh(const ViewPageOptions& options,
+                                             const LimitSurface& surface,
+                                             std::span<const PtexFaceInfo> faces,
+                                             const view::MapDisplacement& displacement,
+                                             ViewPageReport& report) {
+  const int step = GridStep(surface);
+  DISPEX_ASSIGN_OR_RETURN(int grid, ChooseGrid(options, surface, step));
+  view::SurfaceGrid mesh;
+  for (;;) {
+    DISPEX_ASSIGN_OR_RETURN(
+        mesh, view::BuildSurfaceGrid(surface, faces, grid, displacement, options.map_path));
+    // An open mesh shares fewer points: one step coarser while over the budget.
+    if (options.grid != 0 || std::int64_t(mesh.limit.size()) <= options.max_vertices ||
+        grid - step < step) {
+      break;
+    }
+    grid -= step;
+  }
+  if (std::int64_t(mesh.limit.size()) > options.max_vertices) {
+    report.notes.push_back(fmt::format(
+        "surface: {} vertices at grid {}, over max_vertices = {}{}", mesh.limit.size(), grid,
+        options.max_vertices,
+        options.grid != 0 ? " (the grid was given)" : ": the coarsest grid has that many"));
+  }
+  report.grid = grid;
+  return mesh;
+}
+
+// The surface on the page: packed positions, quantized displacements and values.
+json SurfaceJson(const view::SurfaceGrid& mesh, int grid, const std::string& map_kind) {
+  double box[6];
+  const auto packed = view::PackPoints(mesh.limit, box);
+  std::vector<float> flat(3 * mesh.displacement.size());
+  for (std::size_t v = 0; v < mesh.displacement.size(); ++v) {
+    flat[3 * v] = mesh.displacement[v].x;
+    flat[3 * v + 1] = mesh.displacement[v].y;
+    flat[3 * v + 2] = mesh.displacement[v].z;
+  }
+  double d_scale = 0, v_scale = 0;
+  const auto d = view::QuantizeValues(flat, d_scale);
+  const auto values = view::QuantizeValues(mesh.value, v_scale);
+  return {{"grid", grid},
+          {"vertices", mesh.limit.size()},
+          {"triangles", mesh.triangles},
+          {"shared_points", mesh.shared_points},
+          {"quads", Base64Of(mesh.quads)},
+          {"position", Base64Of(packed)},
+          {"box", std::vector<double>(box, box + 6)},
+          {"displacement", Base64Of(d)},
+          {"displacement_scale", d_scale},
+          {"value", Base64Of(values)},
+          {"value_scale", v_scale},
+          {"value_name", map_kind.find("vector") != std::string::npos ? "D·N" : "h"},
+          {"border", Base64Of(mesh.border)}};
+}
+
+// Per face: where it lies on the base, whether it is a hole, and a Ptex map's resolution.
+json FaceTableJson(const LimitSurface& surface, const PtexFile* ptex, const UvMap* uv,
+                   ViewPageReport& report) {
+  const int num_faces = surface.num_ptex_faces();
+  std::vector<std::int8_t> ulog2(static_cast<std::size_t>(num_faces), 0),
+      vlog2(static_cast<std::size_t>(num_faces), 0);
+  std::vector<std::uint8_t> constant(static_cast<std::size_t>(num_faces), 0),
+      sub_face(static_cast<std::size_t>(num_faces), 255),
+      hole(static_cast<std::size_t>(num_faces), 0);
+  std::vector<std::int32_t> base_face(static_cast<std::size_t>(num_faces), 0);
+  for (int f = 0; f < num_faces; ++f) {
+    const PtexFaceId face(f);
+    const auto k = static_cast<std::size_t>(f);
+    base_face[k] = surface.base_face(face).value;
+    if (surface.num_ptex_faces(surface.base_face(face)) != 1) {
+      sub_face[k] = static_cast<std::uint8_t>(surface.sub_face(face));
+    }
+    hole[k] = surface.is_hole(face);
+    if (ptex) {
+      ulog2[k] = ptex->face_info(face).ulog2;
+      vlog2[k] = ptex->face_info(face).vlog2;
+      constant[k] = ptex->BlockInfo(face, 0).encoding == PtexBlockInfo::Encoding::kConstant;
+    }
+  }
+  json faces_json = {{"count", num_faces},
+                     {"base_face", Base64Of(base_face)},
+                     {"sub_face", Base64Of(sub_face)},
+                     {"hole", Base64Of(hole)}};
+  if (ptex) {
+    faces_json["ulog2"] = Base64Of(ulog2);
+    faces_json["vlog2"] = Base64Of(vlog2);
+    faces_json["constant"] = Base64Of(constant);
+  } else {
+    report.notes.push_back(
+        fmt::format("resolution: a UV-space map has one resolution, {} texels per tile side; no "
+                    "resolution per face",
+                    uv->resolution()));
+    faces_json["resolution_note"] = report.notes.back();
+  }
+  return faces_json;
+}
+
+// Per face: the samples the extraction missed and filled (a Ptex map's records), or why not.
+void AddFaceHoles(const LimitSurface& surface, const MapSource& map, ViewPageReport& report,
+                  json& faces_json) {
+  std::string holes_note;
+  std::optional<FaceHoles> holes;
+  if (map.ptex) {
+    holes = ReadFaceHoles(*map.ptex, surface, map.statistics, holes_note);
+  } else {
+    holes_note = "a UV-space map records no misses per face";
+  }
+  if (holes) {
+    report.holes_per_face = true;
+    faces_json["samples"] = Base64Of(holes->samples);
+    faces_json["misses"] = Base64Of(holes->misses);
+    faces_json["filled"] = Base64Of(holes->filled);
+    faces_json["all_missed"] = Base64Of(holes->all_missed);
+  } else {
+    report.notes.push_back("holes: " + holes_note);
+    faces_json["holes_note"] = holes_note;
+  }
+}
+
+// A UV-space map's faces with points no tile holds.
+void AddFacesWithoutTile(const MapSource& map, ViewPageReport& report, json& faces_json) {
+  std::vector<std::int32_t> without;
+  for (std::size_t f = 0; f < map.uv_missing.size(); ++f) {
+    if (map.uv_missing[f].load()) without.push_back(static_cast<std::int32_t>(f));
+  }
+  faces_json["without_tile"] = without;
+  if (!without.empty()) {
+    report.notes.push_back(fmt::format(
+        "uv: {} faces have points whose UVs no tile holds (displaced by 0 there)", without.size()));
+  }
+}
+
+// Per face: the verify report's errors; its tolerance where the map records none.
+Status AddFaceErrors(const ViewPageOptions& options, const json& verify, int num_faces,
+                     MapSource& map, ViewPageReport& report, json& faces_json) {
+  if (verify.contains("ptex_faces") && verify["ptex_faces"].is_number_integer() &&
+      verify["ptex_faces"].get<std::int64_t>() != num_faces) {
+    return Status::Error(
+               StatusCode::kMismatch,
+               fmt::format("{}: a report of a map of {} faces, but {} has {}",
+                           options.verify_report_path, verify["ptex_faces"].get<std::int64_t>(),
+                           options.map_path, num_faces))
+        .WithPath(options.verify_report_path);
+  }
+  FaceErrors errors = ReadFaceErrors(verify, static_cast<std::size_t>(num_faces));
+  if (!errors.map_to_sculpt.empty())
+    faces_json["error_map_to_sculpt"] = Base64Of(errors.map_to_sculpt);
+  if (!errors.truth.empty()) faces_json["error_truth"] = Base64Of(errors.truth);
+  report.verify_per_face = errors.note.empty();
+  if (!errors.note.empty()) {
+    report.notes.push_back("verify: " + errors.note);
+    faces_json["error_note"] = errors.note;
+  }
+  if (verify.contains("map") && verify["map"].is_object() &&
+      verify["map"].value("tolerance", 0.0) > 0 && map.tolerance == 0) {
+    map.tolerance = verify["map"].value("tolerance", 0.0);
+    map.map_json["tolerance"] = map.tolerance;
+  }
+  return Status::Ok();
+}
+
+// Per face: resolution, where it lies on the base, misses, errors.
+StatusOr<json> FacesJson(const ViewPageOptions& options, const LimitSurface& surface,
+                         const std::optional<json>& verify, MapSource& map,
+                         ViewPageReport& report) {
+  json faces_json =
+      FaceTableJson(surface, map.ptex ? &*map.ptex : nullptr, map.uv ? &*map.uv : nullptr, report);
+  AddFaceHoles(surface, map, report, faces_json);
+  if (map.uv) AddFacesWithoutTile(map, report, faces_json);
+  if (verify) {
+    DISPEX_RETURN_IF_ERROR(
+        AddFaceErrors(options, *verify, surface.num_ptex_faces(), map, report, faces_json));
+  }
+  return faces_json;
+}
+
+// The sculpt, decimated (null when there is none or it is left out).
+StatusOr<json> SculptJson(const ViewPageOptions& options, ViewPageReport& report) {
+  if (options.sculpt_path.empty()) return json();
+  if (options.max_sculpt_vertices <= 0) {
+    report.notes.push_back("sculpt: max_sculpt_vertices = 0, left out");
+    return json();
+  }
+  DISPEX_ASSIGN_OR_RETURN(Mesh sculpt, ReadMesh(options.sculpt_path));
+  report.sculpt_vertices_read = static_cast<std::int64_t>(sculpt.num_vertices());
+  report.sculpt_faces_read = static_cast<std::int64_t>(sculpt.num_faces());
+  view::DecimatedMesh small = view::DecimateByClustering(sculpt, options.max_sculpt_vertices);
+  report.sculpt_vertices = static_cast<std::int64_t>(small.positions.size());
+  report.sculpt_triangles = static_cast<std::int64_t>(small.triangles.size() / 3);
+  report.sculpt_cell = small.cell;
+  double box[6];
+  const auto packed = view::PackPoints(small.positions, box);
+  std::vector<std::int8_t> normals(3 * small.normals.size());
+  for (std::size_t v = 0; v < small.normals.size(); ++v) {
+    const float n[3] = {small.normals[v].x, small.normals[v].y, small.normals[v].z};
+    for (std::size_t c = 0; c < 3; ++c) {
+      normals[3 * v + c] = static_cast<std::int8_t>(std::lround(127.0f * n[c]));
+    }
+  }
+  return json{{"vertices_read", report.sculpt_vertices_read},
+              {"faces_read", report.sculpt_faces_read},
+              {"vertices", report.sculpt_vertices},
+              {"triangles", report.sculpt_triangles},
+              {"cell", small.cell},
+              {"max_vertices", options.max_sculpt_vertices},
+              {"box", std::vector<double>(box, box + 6)},
+              {"position", Base64Of(packed)},
+              {"normal", Base64Of(normals)},
+              {"index", Base64Of(small.triangles)}};
+}
+
+// The atlas's image: a Ptex map's faces, or a UV-space map's tiles; an error (the note) where
+// it is left out.
+StatusOr<Image> AtlasImage(const ViewPageOptions& options, const MapSource& map, int num_faces) {
+  // About the atlas's pixels (tiles of 16 to 256 pixels a side and their separators): a PNG
+  // seldom holds an atlas in less than a byte per 8 pixels, so a larger one is not drawn.
+  double pixels = 0;
+  if (map.ptex) {
+    for (int f = 0; f < num_faces; ++f) {
+      const PtexFaceInfo& info = map.ptex->face_info(PtexFaceId(f));
+      pixels +=
+          double(std::clamp(info.ures(), 16, 256) + 1) * (std::clamp(info.vres(), 16, 256) + 1);
+    }
+  }
+  if (pixels > 8.0 * double(options.max_atlas_bytes)) {
+    return Status::Error(
+        fmt::format("about {:.0f} million pixels for {} faces, more than a PNG of "
+                    "max_atlas_bytes ({:.1f} MB) "
+                    "holds: left out (dispex preview draws it)",
+                    pixels / 1e6, num_faces, double(options.max_atlas_bytes) / 1e6));
+  }
+  if (map.ptex) {
+    AtlasOptions atlas_options;
+    atlas_options.mode = DefaultAtlasMode(*map.ptex);
+    atlas_options.labels = num_faces <= 1024;
+    AtlasLayout layout;
+    return RenderAtlas(*map.ptex, atlas_options, &layout);
+  }
+  return UvTilesImage(*map.uv);
+}
+
+// The atlas as a PNG data URL (null when left out, with a note).
+StatusOr<json> AtlasJson(const ViewPageOptions& options, const MapSource& map, int num_faces,
+                         ViewPageReport& report) {
+  json atlas = json();
+  if (options.max_atlas_bytes <= 0) return atlas;
+  StatusOr<Image> image = AtlasImage(options, map, num_faces);
+  if (!image.ok()) {
+    report.notes.push_back("atlas: " + image.status().message());
+    return atlas;
+  }
+  DISPEX_ASSIGN_OR_RETURN(std::vector<std::uint8_t> png, EncodePng(*image));
+  if (static_cast<std::int64_t>(png.size()) <= options.max_atlas_bytes) {
+    atlas = "data:image/png;base64," + view::Base64(png);
+    report.atlas = true;
+    report.atlas_bytes = static_cast<std::int64_t>(atlas.get_ref<const std::string&>().size());
+  } else {
+    report.notes.push_back(fmt::format(
+        "atlas: its PNG ({:.1f} MB, {}x{}) is over max_atlas_bytes ({:.1f} MB): left out",
+        double(png.size()) / 1e6, image->width, image->height,
+        double(options.max_atlas_bytes) / 1e6));
+  }
+  return atlas;
+}
+
+// The page's parts, each a JSON value.
+struct PageParts {
+  json surface, faces, sculpt, atlas;
+};
+
+// The page's data: the header with every part, the notes and warnings so far; the parts'
+// sizes go to the report.
+void AddPageData(const ViewPageOptions& options, const MapSource& map, const Reports& reports,
+                 const PageParts& parts, ViewPageReport& report, json& page) {
+  // The verify report as it is, less the per-face arrays the faces already hold.
+  json verify_json = json();
+  if (reports.verify) {
+    verify_json = *reports.verify;
+    verify_json.erase("per_face");
+  }
+  page["map"] = map.map_json;
+  page["lod"] = {{"grid", report.grid},
+                 {"max_vertices", options.max_vertices},
+                 {"max_grid", options.max_grid},
+                 {"grid_given", options.grid != 0}};
+  page["surface"] = parts.surface;
+  page["faces"] = parts.faces;
+  page["sculpt"] = parts.sculpt;
+  page["verify"] = verify_json;
+  page["extract_report"] = reports.extract ? *reports.extract : json();
+  page["atlas"] = parts.atlas;
+  page["notes"] = report.notes;
+  page["warnings"] = report.warnings;
+  report.surface_bytes = static_cast<std::int64_t>(parts.surface.dump().size());
+  report.sculpt_bytes =
+      parts.sculpt.is_null() ? 0 : static_cast<std::int64_t>(parts.sculpt.dump().size());
+}
+
+// The HTML file: the embedded page with the title, the data, three.js and the viewer in it.
+std::string AssembleHtml(const json& page, ViewPageReport& report) {
+  const std::string data =
+      view::ScriptSafeJson(page.dump(-1, ' ', false, json::error_handler_t::replace));
+  const std::string_view three = view::EmbeddedAsset(view::Asset::kThreeJs);
+  report.three_js_bytes = static_cast<std::int64_t>(three.size());
+  std::string html(view::EmbeddedAsset(view::Asset::kPageHtml));
+  html = ReplaceOnce(std::move(html), "@TITLE@",
+                     view::EscapeHtml(page["title"].get<std::string>() + " - dispex view"));
+  html = ReplaceOnce(std::move(html), "@CSS@", view::EmbeddedAsset(view::Asset::kViewerCss));
+  html = ReplaceOnce(std::move(html), "@DATA@", data);
+  html = ReplaceOnce(std::move(html), "@THREE@", three);
+  html = ReplaceOnce(std::move(html), "@ORBIT_CONTROLS@",
+                     view::EmbeddedAsset(view::Asset::kOrbitControlsJs));
+  html = ReplaceOnce(std::move(html), "@VIEWER@", view::EmbeddedAsset(view::Asset::kViewerJs));
+  report.page_bytes = static_cast<std::int64_t>(html.size());
+  return html;
+}
+
 }  // namespace
 
 Status ValidateViewPageOptions(const ViewPageOptions& o) {
@@ -356,36 +896,10 @@ StatusOr<std::string> MakeViewPage(const ViewPageOptions& options, ViewPageRepor
   if (options.threads > 0) {
     limit.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(options.threads));
   }
-  json page;
-  page["format"] = 1;
-  page["generator"] = fmt::format("dispex {}", Version());
-  page["title"] = options.title.empty() ? FileName(options.map_path) : options.title;
-  page["inputs"] = {
-      {"base", FileName(options.base_path)},
-      {"map", FileName(options.map_path)},
-      {"sculpt", options.sculpt_path.empty() ? json() : json(FileName(options.sculpt_path))},
-      {"verify",
-       options.verify_report_path.empty() ? json() : json(FileName(options.verify_report_path))},
-      {"extract_report",
-       options.extract_report_path.empty() ? json() : json(FileName(options.extract_report_path))}};
+  json page = PageHeader(options);
 
-  // The reports first: a file that is not there stops the run before the heavy work.
-  std::optional<json> verify, extract_report;
-  if (!options.verify_report_path.empty()) {
-    DISPEX_ASSIGN_OR_RETURN(
-        verify, ReadJsonFile(options.verify_report_path, "the report of dispex verify --report"));
-  }
-  if (!options.extract_report_path.empty()) {
-    DISPEX_ASSIGN_OR_RETURN(extract_report, ReadJsonFile(options.extract_report_path,
-                                                         "the report of dispex extract --report"));
-  } else if (!options.extract_report_json.empty()) {
-    extract_report = json::parse(options.extract_report_json, nullptr, false);
-    if (extract_report->is_discarded() || !extract_report->is_object()) {
-      return Status::Error(StatusCode::kInvalidArgument, "extract_report_json: not a JSON object");
-    }
-  }
-  if (!options.sculpt_path.empty()) DISPEX_RETURN_IF_ERROR(CheckReadableFile(options.sculpt_path));
-
+  // The inputs: the reports, the base and its limit surface, the map.
+  DISPEX_ASSIGN_OR_RETURN(Reports reports, ReadReports(options));
   DISPEX_ASSIGN_OR_RETURN(Mesh base, ReadMesh(options.base_path));
   report.warnings = IgnoredTagWarnings(base);
   DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
@@ -393,411 +907,29 @@ StatusOr<std::string> MakeViewPage(const ViewPageOptions& options, ViewPageRepor
   report.ptex_faces = num_faces;
   std::vector<PtexFaceInfo> faces = PtexFaceTable(surface);
   phase_done("base");
-
-  // The map.
-  std::optional<PtexFile> ptex;
-  std::optional<UvMap> uv;
-  std::optional<PtexUvCharts> charts;
-  std::optional<PtexMapSampler> sampler;
-  std::vector<std::vector<float>> texels;
-  std::unique_ptr<view::MapDisplacement> displacement;
-  std::vector<std::atomic<std::uint8_t>> uv_missing;
-  json map_json;
-  json statistics;
-  double tolerance = 0;
-  if (IsUvMapPath(options.map_path)) {
-    DISPEX_ASSIGN_OR_RETURN(uv, UvMap::Open(options.map_path));
-    const bool vector = uv->channels() == 3;
-    if (vector) {
-      const std::string space = uv->Attribute("dispex:space");
-      if (!space.empty() && space != "object") {
-        return Status::Error(StatusCode::kBadInput,
-                             fmt::format("{}: 3 channels in dispex:space '{}': UV-space vector "
-                                         "maps are read in object space",
-                                         options.map_path, space));
-      }
-    }
-    DISPEX_ASSIGN_OR_RETURN(charts, PtexUvCharts::Build(base, surface));
-    uv_missing = std::vector<std::atomic<std::uint8_t>>(static_cast<std::size_t>(num_faces));
-    displacement = std::make_unique<UvDisplacement>(*uv, *charts, vector, uv_missing);
-    report.map_kind = vector ? "uv vector" : "uv scalar";
-    if (vector) report.vector_space = "object";
-    json meta = json::object();
-    for (const auto& [key, value] : uv->tiles().front().attributes) {
-      if (key.rfind("dispex:", 0) == 0) meta[key] = value;
-    }
-    json tiles = json::array();
-    for (std::size_t t = 0; t < uv->tiles().size(); ++t) {
-      tiles.push_back({{"udim", uv->tiles()[t].udim}, {"path", FileName(uv->paths()[t])}});
-    }
-    const std::string tau = uv->Attribute("dispex:tolerance");
-    if (!tau.empty()) tolerance = std::strtod(tau.c_str(), nullptr);
-    map_json = {{"kind", report.map_kind},
-                {"space", vector ? json("object") : json()},
-                {"faces", num_faces},
-                {"channels", uv->channels()},
-                {"resolution", uv->resolution()},
-                {"tiles", tiles},
-                {"meta", meta}};
-  } else {
-    DISPEX_ASSIGN_OR_RETURN(ptex, PtexFile::Open(options.map_path));
-    const PtexFile& map = *ptex;
-    if (map.num_faces() != num_faces) {
-      return Status::Error(
-                 StatusCode::kMismatch,
-                 fmt::format("{}: {} faces, but {} has {} Ptex faces: not a map of "
-                             "this base mesh",
-                             options.map_path, map.num_faces(), options.base_path, num_faces))
-          .WithPath(options.map_path);
-    }
-    const PtexMetaItem* space_item = map.FindMetaData(kVectorSpaceMetaKey);
-    const PtexMetaItem* names_item = map.FindMetaData(kVectorChannelsMetaKey);
-    const std::string space_value = space_item ? space_item->AsString() : "";
-    const std::string names_value = names_item ? names_item->AsString() : "";
-    DISPEX_ASSIGN_OR_RETURN(
-        const std::optional<VectorSpace> space,
-        DisplacementMapSpace(map.name(), map.header().num_channels, map.header().alpha_channel,
-                             space_item ? &space_value : nullptr,
-                             names_item ? &names_value : nullptr));
-    for (int f = 0; f < num_faces; ++f) {
-      const PtexFaceInfo& stored = map.face_info(PtexFaceId(f));
-      faces[static_cast<std::size_t>(f)].ulog2 = stored.ulog2;
-      faces[static_cast<std::size_t>(f)].vlog2 = stored.vlog2;
-    }
-    if (space) {
-      displacement = std::make_unique<PtexVectorDisplacement>(map, *space);
-      report.map_kind = "vector";
-      report.vector_space = std::string(VectorSpaceName(*space));
-    } else {
-      texels.resize(static_cast<std::size_t>(num_faces));
-      for (int f = 0; f < num_faces; ++f) {
-        const PtexFaceId face(f);
-        std::vector<float>& t = texels[static_cast<std::size_t>(f)];
-        if (map.BlockInfo(face, 0).encoding == PtexBlockInfo::Encoding::kConstant) {
-          t.resize(1);
-          map.ConstantValue(face, t.data());
-        } else {
-          DISPEX_RETURN_IF_ERROR(map.ReadFace(face, 0, t));
-        }
-      }
-      sampler.emplace(faces, texels);
-      displacement = std::make_unique<PtexScalarDisplacement>(*sampler);
-      report.map_kind = "scalar";
-    }
-    json meta = MetaJson(map);
-    if (meta.contains("dispex:statistics")) statistics = meta["dispex:statistics"];
-    if (meta.contains("dispex:tolerance") && meta["dispex:tolerance"].is_number()) {
-      tolerance = meta["dispex:tolerance"].get<double>();
-    }
-    map_json = {{"kind", report.map_kind},
-                {"space", space ? json(report.vector_space) : json()},
-                {"faces", num_faces},
-                {"channels", map.header().num_channels},
-                {"data_type", std::string(PtexDataTypeName(map.header().data_type))},
-                {"edge_filter", std::string(PtexEdgeFilterModeName(map.header().edge_filter))},
-                {"file_bytes", map.header().file_size},
-                {"meta", meta}};
-  }
-  map_json["tolerance"] = tolerance > 0 ? json(tolerance) : json();
+  MapSource map;
+  DISPEX_RETURN_IF_ERROR(ReadMap(options, base, surface, faces, report, map));
   phase_done("map");
 
-  // The grid: the finest within the budget. An n-gon's sub-faces take half the quads a side of
-  // a quad face, so a base with n-gons takes even grids only.
-  bool has_ngons = false;
-  for (int f = 0; f < num_faces && !has_ngons; ++f) {
-    has_ngons = surface.num_ptex_faces(surface.base_face(PtexFaceId(f))) != 1;
-  }
-  const int step = has_ngons ? 2 : 1;
-  int grid = options.grid;
-  if (grid % step != 0) {
-    return Status::Error(StatusCode::kInvalidArgument,
-                         fmt::format("grid = {}: must be even: {} has n-gons, whose sub-faces "
-                                     "take half the quads a side",
-                                     grid, options.base_path));
-  }
-  // The mesh's vertices at a grid: a closed quad mesh of Q quads has about Q of them (the
-  // faces' points less those they share).
-  auto estimate = [&](int g) {
-    std::int64_t points = 0;
-    for (std::uint16_t n : view::FaceQuads(surface, g)) {
-      if (n > 0) points += std::int64_t(n) * n + 1;
-    }
-    return points;
-  };
-  if (grid == 0) {
-    grid = step;
-    for (int g = 2 * step; g <= options.max_grid; g += step) {
-      if (estimate(g) > options.max_vertices) break;
-      grid = g;
-    }
-  }
-  view::SurfaceGrid mesh;
-  for (;;) {
-    DISPEX_ASSIGN_OR_RETURN(
-        mesh, view::BuildSurfaceGrid(surface, faces, grid, *displacement, options.map_path));
-    // An open mesh shares fewer points: one step coarser while over the budget.
-    if (options.grid != 0 || std::int64_t(mesh.limit.size()) <= options.max_vertices ||
-        grid - step < step) {
-      break;
-    }
-    grid -= step;
-  }
-  if (std::int64_t(mesh.limit.size()) > options.max_vertices) {
-    report.notes.push_back(fmt::format(
-        "surface: {} vertices at grid {}, over max_vertices = {}{}", mesh.limit.size(), grid,
-        options.max_vertices,
-        options.grid != 0 ? " (the grid was given)" : ": the coarsest grid has that many"));
-  }
-  report.grid = grid;
+  // The surface grid.
+  PageParts parts;
+  DISPEX_ASSIGN_OR_RETURN(view::SurfaceGrid mesh,
+                          BuildSurfaceMesh(options, surface, faces, *map.displacement, report));
   phase_done("surface");
   report.surface_vertices = static_cast<std::int64_t>(mesh.limit.size());
   report.surface_triangles = mesh.triangles;
+  parts.surface = SurfaceJson(mesh, report.grid, report.map_kind);
 
-  json surface_json;
-  {
-    double box[6];
-    const auto packed = view::PackPoints(mesh.limit, box);
-    std::vector<float> flat(3 * mesh.displacement.size());
-    for (std::size_t v = 0; v < mesh.displacement.size(); ++v) {
-      flat[3 * v] = mesh.displacement[v].x;
-      flat[3 * v + 1] = mesh.displacement[v].y;
-      flat[3 * v + 2] = mesh.displacement[v].z;
-    }
-    double d_scale = 0, v_scale = 0;
-    const auto d = view::QuantizeValues(flat, d_scale);
-    const auto values = view::QuantizeValues(mesh.value, v_scale);
-    surface_json = {
-        {"grid", grid},
-        {"vertices", mesh.limit.size()},
-        {"triangles", mesh.triangles},
-        {"shared_points", mesh.shared_points},
-        {"quads", Base64Of(mesh.quads)},
-        {"position", Base64Of(packed)},
-        {"box", std::vector<double>(box, box + 6)},
-        {"displacement", Base64Of(d)},
-        {"displacement_scale", d_scale},
-        {"value", Base64Of(values)},
-        {"value_scale", v_scale},
-        {"value_name", report.map_kind.find("vector") != std::string::npos ? "D·N" : "h"},
-        {"border", Base64Of(mesh.border)}};
-  }
-
-  // Per face: resolution, where it lies on the base, misses, errors.
-  json faces_json;
-  {
-    std::vector<std::int8_t> ulog2(static_cast<std::size_t>(num_faces), 0),
-        vlog2(static_cast<std::size_t>(num_faces), 0);
-    std::vector<std::uint8_t> constant(static_cast<std::size_t>(num_faces), 0),
-        sub_face(static_cast<std::size_t>(num_faces), 255),
-        hole(static_cast<std::size_t>(num_faces), 0);
-    std::vector<std::int32_t> base_face(static_cast<std::size_t>(num_faces), 0);
-    for (int f = 0; f < num_faces; ++f) {
-      const PtexFaceId face(f);
-      const auto k = static_cast<std::size_t>(f);
-      base_face[k] = surface.base_face(face).value;
-      if (surface.num_ptex_faces(surface.base_face(face)) != 1) {
-        sub_face[k] = static_cast<std::uint8_t>(surface.sub_face(face));
-      }
-      hole[k] = surface.is_hole(face);
-      if (ptex) {
-        ulog2[k] = ptex->face_info(face).ulog2;
-        vlog2[k] = ptex->face_info(face).vlog2;
-        constant[k] = ptex->BlockInfo(face, 0).encoding == PtexBlockInfo::Encoding::kConstant;
-      }
-    }
-    faces_json = {{"count", num_faces},
-                  {"base_face", Base64Of(base_face)},
-                  {"sub_face", Base64Of(sub_face)},
-                  {"hole", Base64Of(hole)}};
-    if (ptex) {
-      faces_json["ulog2"] = Base64Of(ulog2);
-      faces_json["vlog2"] = Base64Of(vlog2);
-      faces_json["constant"] = Base64Of(constant);
-    } else {
-      report.notes.push_back(
-          fmt::format("resolution: a UV-space map has one resolution, {} texels per tile side; no "
-                      "resolution per face",
-                      uv->resolution()));
-      faces_json["resolution_note"] = report.notes.back();
-    }
-    std::string holes_note;
-    std::optional<FaceHoles> holes;
-    if (ptex) {
-      holes = ReadFaceHoles(*ptex, surface, statistics, holes_note);
-    } else {
-      holes_note = "a UV-space map records no misses per face";
-    }
-    if (holes) {
-      report.holes_per_face = true;
-      faces_json["samples"] = Base64Of(holes->samples);
-      faces_json["misses"] = Base64Of(holes->misses);
-      faces_json["filled"] = Base64Of(holes->filled);
-      faces_json["all_missed"] = Base64Of(holes->all_missed);
-    } else {
-      report.notes.push_back("holes: " + holes_note);
-      faces_json["holes_note"] = holes_note;
-    }
-    if (uv) {
-      std::vector<std::int32_t> without;
-      for (int f = 0; f < num_faces; ++f) {
-        if (uv_missing[static_cast<std::size_t>(f)].load()) without.push_back(f);
-      }
-      faces_json["without_tile"] = without;
-      if (!without.empty()) {
-        report.notes.push_back(
-            fmt::format("uv: {} faces have points whose UVs no tile holds (displaced by 0 there)",
-                        without.size()));
-      }
-    }
-    if (verify) {
-      const json& v = *verify;
-      if (v.contains("ptex_faces") && v["ptex_faces"].is_number_integer() &&
-          v["ptex_faces"].get<std::int64_t>() != num_faces) {
-        return Status::Error(
-                   StatusCode::kMismatch,
-                   fmt::format("{}: a report of a map of {} faces, but {} has {}",
-                               options.verify_report_path, v["ptex_faces"].get<std::int64_t>(),
-                               options.map_path, num_faces))
-            .WithPath(options.verify_report_path);
-      }
-      FaceErrors errors = ReadFaceErrors(v, static_cast<std::size_t>(num_faces));
-      if (!errors.map_to_sculpt.empty())
-        faces_json["error_map_to_sculpt"] = Base64Of(errors.map_to_sculpt);
-      if (!errors.truth.empty()) faces_json["error_truth"] = Base64Of(errors.truth);
-      report.verify_per_face = errors.note.empty();
-      if (!errors.note.empty()) {
-        report.notes.push_back("verify: " + errors.note);
-        faces_json["error_note"] = errors.note;
-      }
-      if (v.contains("map") && v["map"].is_object() && v["map"].value("tolerance", 0.0) > 0 &&
-          tolerance == 0) {
-        tolerance = v["map"].value("tolerance", 0.0);
-        map_json["tolerance"] = tolerance;
-      }
-    }
-  }
-
-  // The sculpt, decimated.
-  json sculpt_json;
-  if (!options.sculpt_path.empty() && options.max_sculpt_vertices > 0) {
-    DISPEX_ASSIGN_OR_RETURN(Mesh sculpt, ReadMesh(options.sculpt_path));
-    report.sculpt_vertices_read = static_cast<std::int64_t>(sculpt.num_vertices());
-    report.sculpt_faces_read = static_cast<std::int64_t>(sculpt.num_faces());
-    view::DecimatedMesh small = view::DecimateByClustering(sculpt, options.max_sculpt_vertices);
-    report.sculpt_vertices = static_cast<std::int64_t>(small.positions.size());
-    report.sculpt_triangles = static_cast<std::int64_t>(small.triangles.size() / 3);
-    report.sculpt_cell = small.cell;
-    double box[6];
-    const auto packed = view::PackPoints(small.positions, box);
-    std::vector<std::int8_t> normals(3 * small.normals.size());
-    for (std::size_t v = 0; v < small.normals.size(); ++v) {
-      const float n[3] = {small.normals[v].x, small.normals[v].y, small.normals[v].z};
-      for (std::size_t c = 0; c < 3; ++c) {
-        normals[3 * v + c] = static_cast<std::int8_t>(std::lround(127.0f * n[c]));
-      }
-    }
-    sculpt_json = {{"vertices_read", report.sculpt_vertices_read},
-                   {"faces_read", report.sculpt_faces_read},
-                   {"vertices", report.sculpt_vertices},
-                   {"triangles", report.sculpt_triangles},
-                   {"cell", small.cell},
-                   {"max_vertices", options.max_sculpt_vertices},
-                   {"box", std::vector<double>(box, box + 6)},
-                   {"position", Base64Of(packed)},
-                   {"normal", Base64Of(normals)},
-                   {"index", Base64Of(small.triangles)}};
-  } else if (!options.sculpt_path.empty()) {
-    report.notes.push_back("sculpt: max_sculpt_vertices = 0, left out");
-  }
-
+  // The per-face values, the sculpt, the atlas.
+  DISPEX_ASSIGN_OR_RETURN(parts.faces, FacesJson(options, surface, reports.verify, map, report));
+  DISPEX_ASSIGN_OR_RETURN(parts.sculpt, SculptJson(options, report));
   phase_done("sculpt");
-
-  // The atlas.
-  json atlas = json();
-  if (options.max_atlas_bytes > 0) {
-    StatusOr<Image> image = Status::Error("no atlas");
-    // About the atlas's pixels (tiles of 16 to 256 pixels a side and their separators): a PNG
-    // seldom holds an atlas in less than a byte per 8 pixels, so a larger one is not drawn.
-    double pixels = 0;
-    if (ptex) {
-      for (int f = 0; f < num_faces; ++f) {
-        const PtexFaceInfo& info = ptex->face_info(PtexFaceId(f));
-        pixels +=
-            double(std::clamp(info.ures(), 16, 256) + 1) * (std::clamp(info.vres(), 16, 256) + 1);
-      }
-    }
-    if (pixels > 8.0 * double(options.max_atlas_bytes)) {
-      image = Status::Error(
-          fmt::format("about {:.0f} million pixels for {} faces, more than a PNG of "
-                      "max_atlas_bytes ({:.1f} MB) "
-                      "holds: left out (dispex preview draws it)",
-                      pixels / 1e6, num_faces, double(options.max_atlas_bytes) / 1e6));
-    } else if (ptex) {
-      AtlasOptions atlas_options;
-      atlas_options.mode = DefaultAtlasMode(*ptex);
-      atlas_options.labels = num_faces <= 1024;
-      AtlasLayout layout;
-      image = RenderAtlas(*ptex, atlas_options, &layout);
-    } else {
-      image = UvTilesImage(*uv);
-    }
-    if (image.ok()) {
-      DISPEX_ASSIGN_OR_RETURN(std::vector<std::uint8_t> png, EncodePng(*image));
-      if (static_cast<std::int64_t>(png.size()) <= options.max_atlas_bytes) {
-        atlas = "data:image/png;base64," + view::Base64(png);
-        report.atlas = true;
-        report.atlas_bytes = static_cast<std::int64_t>(atlas.get_ref<const std::string&>().size());
-      } else {
-        report.notes.push_back(fmt::format(
-            "atlas: its PNG ({:.1f} MB, {}x{}) is over max_atlas_bytes ({:.1f} MB): left out",
-            double(png.size()) / 1e6, image->width, image->height,
-            double(options.max_atlas_bytes) / 1e6));
-      }
-    } else {
-      report.notes.push_back("atlas: " + image.status().message());
-    }
-  }
-
+  DISPEX_ASSIGN_OR_RETURN(parts.atlas, AtlasJson(options, map, num_faces, report));
   phase_done("atlas");
 
-  // The verify report as it is, less the per-face arrays the faces already hold.
-  json verify_json = json();
-  if (verify) {
-    verify_json = *verify;
-    verify_json.erase("per_face");
-  }
-
-  page["map"] = map_json;
-  page["lod"] = {{"grid", grid},
-                 {"max_vertices", options.max_vertices},
-                 {"max_grid", options.max_grid},
-                 {"grid_given", options.grid != 0}};
-  page["surface"] = surface_json;
-  page["faces"] = faces_json;
-  page["sculpt"] = sculpt_json;
-  page["verify"] = verify_json;
-  page["extract_report"] = extract_report ? *extract_report : json();
-  page["atlas"] = atlas;
-  page["notes"] = report.notes;
-  page["warnings"] = report.warnings;
-  report.surface_bytes = static_cast<std::int64_t>(surface_json.dump().size());
-  report.sculpt_bytes =
-      sculpt_json.is_null() ? 0 : static_cast<std::int64_t>(sculpt_json.dump().size());
-
-  const std::string data =
-      view::ScriptSafeJson(page.dump(-1, ' ', false, json::error_handler_t::replace));
-  const std::string_view three = view::EmbeddedAsset(view::Asset::kThreeJs);
-  report.three_js_bytes = static_cast<std::int64_t>(three.size());
-  std::string html(view::EmbeddedAsset(view::Asset::kPageHtml));
-  html = ReplaceOnce(std::move(html), "@TITLE@",
-                     view::EscapeHtml(page["title"].get<std::string>() + " - dispex view"));
-  html = ReplaceOnce(std::move(html), "@CSS@", view::EmbeddedAsset(view::Asset::kViewerCss));
-  html = ReplaceOnce(std::move(html), "@DATA@", data);
-  html = ReplaceOnce(std::move(html), "@THREE@", three);
-  html = ReplaceOnce(std::move(html), "@ORBIT_CONTROLS@",
-                     view::EmbeddedAsset(view::Asset::kOrbitControlsJs));
-  html = ReplaceOnce(std::move(html), "@VIEWER@", view::EmbeddedAsset(view::Asset::kViewerJs));
-  report.page_bytes = static_cast<std::int64_t>(html.size());
+  // The page data, the page, the report.
+  AddPageData(options, map, reports, parts, report, page);
+  std::string html = AssembleHtml(page, report);
   phase_done("page");
   report.seconds = clock.seconds();
   if (report_out != nullptr) *report_out = std::move(report);
