@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <set>
+#include <span>
 
 #include "core/check.h"
 #include "core/system.h"
@@ -122,31 +123,35 @@ void RemoveStaleTiles(const std::string& dir, const std::string& shape,
   }
 }
 
-}  // namespace
-
-Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
-                   const ExtractSettings& settings, ExtractReport& report,
-                   const SculptCorrespondence* correspondence) {
-  Stopwatch clock;
+// Scalar maps traced by rays need the whole sculpt's tracer: build it unless the run's tracer
+// already is that.
+Status BuildTracerIfNeeded(const ExtractOptions& options, const ExtractSettings& settings,
+                           ExtractInputs& inputs, ExtractReport& report) {
   const bool vector = options.vector.has_value();
-  DISPEX_CHECK(!vector || (*options.vector == VectorSpace::kObject && correspondence != nullptr));
-  const int channels = vector ? 3 : 1;
-  DISPEX_ASSIGN_OR_RETURN(PtexUvCharts charts, PtexUvCharts::Build(inputs.base, inputs.surface));
-  DISPEX_ASSIGN_OR_RETURN(UvRaster raster,
-                          RasterizeUvCharts(charts, inputs.surface, options.uv_resolution));
   if (!vector && !settings.interpolate &&
       (inputs.mapping != nullptr || inputs.tracer == nullptr || !inputs.traced.empty())) {
     DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
   }
-  const int num_faces = inputs.surface.num_ptex_faces();
-  const FaceTexels by_face = GroupByFace(raster, num_faces);
-  const int n = raster.resolution;
-  const std::size_t tile_texels = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
-  std::vector<std::vector<float>> values(raster.tiles.size(),
-                                         std::vector<float>(tile_texels * channels, 0));
-  std::vector<std::vector<std::uint8_t>> filled(raster.tiles.size(),
-                                                std::vector<std::uint8_t>(tile_texels, 0));
-  std::vector<std::int64_t> face_misses(static_cast<std::size_t>(num_faces), 0);
+  return Status::Ok();
+}
+
+// The tiles being filled: each tile's values (`channels` a texel) and which texels hold one.
+struct UvTileValues {
+  UvTileValues(const UvRaster& raster, int channels) {
+    const int n = raster.resolution;
+    const std::size_t tile_texels = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+    values.assign(raster.tiles.size(), std::vector<float>(tile_texels * channels, 0));
+    filled.assign(raster.tiles.size(), std::vector<std::uint8_t>(tile_texels, 0));
+  }
+  std::vector<std::vector<float>> values;
+  std::vector<std::vector<std::uint8_t>> filled;
+};
+
+// A face's texels: (tile index, texel index) pairs, a slice of FaceTexels::texels.
+using TexelSpan = std::span<const std::pair<std::uint32_t, std::uint32_t>>;
+
+// The Ptex faces that hold at least one texel, in face order.
+std::vector<int> FacesWithTexels(const FaceTexels& by_face, int num_faces) {
   std::vector<int> faces;
   for (int f = 0; f < num_faces; ++f) {
     if (by_face.offsets[static_cast<std::size_t>(f) + 1] >
@@ -154,76 +159,115 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
       faces.push_back(f);
     }
   }
+  return faces;
+}
+
+// The texels' (u, v) on their face, interleaved into `uv`.
+void GatherTexelUvs(const UvRaster& raster, TexelSpan texels, std::vector<float>& uv) {
+  uv.resize(2 * texels.size());
+  for (std::size_t k = 0; k < texels.size(); ++k) {
+    const auto [tile, texel] = texels[k];
+    const UvTexelPlace& p = raster.tiles[tile].places[texel];
+    uv[2 * k] = p.u;
+    uv[2 * k + 1] = p.v;
+  }
+}
+
+// Interpolated, no rays: the face's grid of vertex displacements read at each texel.
+Status InterpolateTexels(PtexFaceId face, TexelSpan texels, bool vector,
+                         const ExtractInputs& inputs, UvScratch& w, UvTileValues& tiles) {
+  DISPEX_RETURN_IF_ERROR(w.face.grid.Evaluate(face, *inputs.grids, inputs.sculpt, w.face.evaluator,
+                                              /*normals=*/!vector));
+  w.face.grid.SetSampling(0);  // UV texels sit at no fixed place against the vertices
+  for (std::size_t k = 0; k < texels.size(); ++k) {
+    const auto [tile, texel] = texels[k];
+    const double u = w.uv[2 * k], v = w.uv[2 * k + 1];
+    if (vector) {
+      double d[3];
+      w.face.grid.DisplacementAt(u, v, d);
+      float* out = &tiles.values[tile][3 * static_cast<std::size_t>(texel)];
+      for (int a = 0; a < 3; ++a) out[a] = static_cast<float>(d[a]);
+    } else {
+      tiles.values[tile][texel] = static_cast<float>(w.face.grid.HeightAt(u, v));
+    }
+    tiles.filled[tile][texel] = 1;
+  }
+  return Status::Ok();
+}
+
+// A vector map, no rays: the sculpt's point through the correspondence less the limit point.
+Status ReadVectorTexels(PtexFaceId face, TexelSpan texels,
+                        const SculptCorrespondence& correspondence, const ExtractInputs& inputs,
+                        UvScratch& w, UvTileValues& tiles) {
+  w.positions.resize(3 * texels.size());
+  DISPEX_RETURN_IF_ERROR(w.face.evaluator.EvaluatePoints(face, w.uv, w.positions, {}));
+  for (std::size_t k = 0; k < texels.size(); ++k) {
+    const auto [tile, texel] = texels[k];
+    const Float3 sculpt =
+        SculptPointAt(correspondence, inputs.sculpt, face, w.uv[2 * k], w.uv[2 * k + 1]);
+    float* out = &tiles.values[tile][3 * static_cast<std::size_t>(texel)];
+    out[0] = static_cast<float>(double(sculpt.x) - w.positions[3 * k]);
+    out[1] = static_cast<float>(double(sculpt.y) - w.positions[3 * k + 1]);
+    out[2] = static_cast<float>(double(sculpt.z) - w.positions[3 * k + 2]);
+    tiles.filled[tile][texel] = 1;
+  }
+  return Status::Ok();
+}
+
+// A scalar map traced: rays along the limit normal; the texels that miss are counted in
+// `misses` and left unfilled (for dilation).
+Status TraceTexels(PtexFaceId face, TexelSpan texels, const ExtractSettings& settings,
+                   const ExtractInputs& inputs, UvScratch& w, UvTileValues& tiles,
+                   std::int64_t& misses) {
+  const std::size_t count = texels.size();
+  w.positions.resize(3 * count);
+  w.normals.resize(3 * count);
+  w.t.resize(count);
+  w.flags.resize(count);
+  DISPEX_RETURN_IF_ERROR(w.face.evaluator.EvaluatePoints(face, w.uv, w.positions, w.normals));
+  const std::span<const Float3> origins(reinterpret_cast<const Float3*>(w.positions.data()), count);
+  const std::span<const Float3> normals(reinterpret_cast<const Float3*>(w.normals.data()), count);
+  TraceRays(*inputs.tracer, settings, origins, normals, w.t, w.flags, w.face);
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto [tile, texel] = texels[k];
+    if (!(w.flags[k] & HitFlags::kHit)) {
+      ++misses;
+      continue;
+    }
+    tiles.values[tile][texel] = w.t[k];
+    tiles.filled[tile][texel] = 1;
+  }
+  return Status::Ok();
+}
+
+// Every face's texels, in parallel over the faces: interpolated, vector or traced. Counts
+// each face's misses in `face_misses` (num_faces long).
+Status ExtractTexels(const ExtractSettings& settings, const ExtractInputs& inputs,
+                     const SculptCorrespondence* correspondence, bool vector,
+                     const UvRaster& raster, const FaceTexels& by_face, UvTileValues& tiles,
+                     std::vector<std::int64_t>& face_misses) {
+  const std::vector<int> faces = FacesWithTexels(by_face, inputs.surface.num_ptex_faces());
   tbb::enumerable_thread_specific<UvScratch> scratches([&] { return UvScratch(inputs.surface); });
-  const Status traced = ForEachFace(
+  const Status extracted = ForEachFace(
       static_cast<int>(faces.size()), [&](int k) { return faces[static_cast<std::size_t>(k)]; },
       scratches, nullptr,
       [&](PtexFaceId face, UvScratch& w) {
         const auto f = static_cast<std::size_t>(face.value);
         const std::size_t begin = by_face.offsets[f], count = by_face.offsets[f + 1] - begin;
-        w.uv.resize(2 * count);
-        for (std::size_t k = 0; k < count; ++k) {
-          const auto [tile, texel] = by_face.texels[begin + k];
-          const UvTexelPlace& p = raster.tiles[tile].places[texel];
-          w.uv[2 * k] = p.u;
-          w.uv[2 * k + 1] = p.v;
-        }
-        if (settings.interpolate) {  // no rays: the face's grid of vertex displacements
-          DISPEX_RETURN_IF_ERROR(w.face.grid.Evaluate(face, *inputs.grids, inputs.sculpt,
-                                                      w.face.evaluator, /*normals=*/!vector));
-          w.face.grid.SetSampling(0);  // UV texels sit at no fixed place against the vertices
-          for (std::size_t k = 0; k < count; ++k) {
-            const auto [tile, texel] = by_face.texels[begin + k];
-            const double u = w.uv[2 * k], v = w.uv[2 * k + 1];
-            if (vector) {
-              double d[3];
-              w.face.grid.DisplacementAt(u, v, d);
-              float* out = &values[tile][3 * static_cast<std::size_t>(texel)];
-              for (int a = 0; a < 3; ++a) out[a] = static_cast<float>(d[a]);
-            } else {
-              values[tile][texel] = static_cast<float>(w.face.grid.HeightAt(u, v));
-            }
-            filled[tile][texel] = 1;
-          }
-          return Status::Ok();
-        }
-        w.positions.resize(3 * count);
-        if (vector) {  // no rays: the limit points alone
-          DISPEX_RETURN_IF_ERROR(w.face.evaluator.EvaluatePoints(face, w.uv, w.positions, {}));
-          for (std::size_t k = 0; k < count; ++k) {
-            const auto [tile, texel] = by_face.texels[begin + k];
-            const Float3 sculpt =
-                SculptPointAt(*correspondence, inputs.sculpt, face, w.uv[2 * k], w.uv[2 * k + 1]);
-            float* out = &values[tile][3 * static_cast<std::size_t>(texel)];
-            out[0] = static_cast<float>(double(sculpt.x) - w.positions[3 * k]);
-            out[1] = static_cast<float>(double(sculpt.y) - w.positions[3 * k + 1]);
-            out[2] = static_cast<float>(double(sculpt.z) - w.positions[3 * k + 2]);
-            filled[tile][texel] = 1;
-          }
-          return Status::Ok();
-        }
-        w.normals.resize(3 * count);
-        w.t.resize(count);
-        w.flags.resize(count);
-        DISPEX_RETURN_IF_ERROR(w.face.evaluator.EvaluatePoints(face, w.uv, w.positions, w.normals));
-        const std::span<const Float3> origins(reinterpret_cast<const Float3*>(w.positions.data()),
-                                              count);
-        const std::span<const Float3> normals(reinterpret_cast<const Float3*>(w.normals.data()),
-                                              count);
-        TraceRays(*inputs.tracer, settings, origins, normals, w.t, w.flags, w.face);
-        for (std::size_t k = 0; k < count; ++k) {
-          const auto [tile, texel] = by_face.texels[begin + k];
-          if (!(w.flags[k] & HitFlags::kHit)) {
-            ++face_misses[f];
-            continue;
-          }
-          values[tile][texel] = w.t[k];
-          filled[tile][texel] = 1;
-        }
-        return Status::Ok();
+        const TexelSpan texels = TexelSpan(by_face.texels).subspan(begin, count);
+        GatherTexelUvs(raster, texels, w.uv);
+        if (settings.interpolate) return InterpolateTexels(face, texels, vector, inputs, w, tiles);
+        if (vector) return ReadVectorTexels(face, texels, *correspondence, inputs, w, tiles);
+        return TraceTexels(face, texels, settings, inputs, w, tiles, face_misses[f]);
       });
-  DISPEX_RETURN_IF_ERROR(traced);
+  DISPEX_RETURN_IF_ERROR(extracted);
   if (!vector && !settings.interpolate) DISPEX_RETURN_IF_ERROR(inputs.tracer->status());
+  return Status::Ok();
+}
+
+// The raster's and the misses' part of the report, and their warnings.
+void ReportTexels(const ExtractOptions& options, const UvRaster& raster,
+                  const std::vector<std::int64_t>& face_misses, ExtractReport& report) {
   for (std::int64_t m : face_misses) report.uv_texels_missed += m;
   report.uv_texels_inside = raster.inside;
   report.uv_overlap_texels = raster.overlap_texels;
@@ -254,35 +298,65 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
         fmt::format("{} of {} UV map texels missed the sculpt and were filled by dilation",
                     report.uv_texels_missed, raster.inside));
   }
+}
 
+// Dilates the tiles with a texel centre inside and writes them, all or none, then removes the
+// stale tiles of an earlier run. Moves the values out of `tiles`.
+Status WriteTiles(const ExtractOptions& options, const UvRaster& raster, int channels,
+                  UvTileValues& tiles, ExtractReport& report) {
   std::error_code ec;
   fs::create_directories(options.uv_maps_dir, ec);
   if (ec) {
     return Status::Error(
         fmt::format("{}: cannot create the directory: {}", options.uv_maps_dir, ec.message()));
   }
+  const int n = raster.resolution;
   const std::string shape = fs::path(options.output_path).stem().string();
   const auto attributes = TileAttributes(options, report);
-  std::vector<UvMapTile> tiles;
+  std::vector<UvMapTile> out;
   std::vector<std::string> paths;
   for (std::size_t t = 0; t < raster.tiles.size(); ++t) {
     if (CancelRequested()) return Cancelled();
     if (raster.tiles[t].inside == 0) continue;  // nothing of the surface (warned above)
-    UvMapTile& tile = tiles.emplace_back();
+    UvMapTile& tile = out.emplace_back();
     tile.udim = raster.tiles[t].udim;
     tile.resolution = n;
     tile.channels = channels;
-    DilateTile(n, channels, options.uv_padding, values[t], filled[t]);
-    tile.values = std::move(values[t]);
+    DilateTile(n, channels, options.uv_padding, tiles.values[t], tiles.filled[t]);
+    tile.values = std::move(tiles.values[t]);
     tile.attributes = attributes;
     tile.attributes.emplace_back("dispex:udim", fmt::format("{}", tile.udim));
     paths.push_back(UvMapTilePath(options.uv_maps_dir, shape, tile.udim));
   }
   // All the tiles or none: a failure leaves the previous run's set as it was.
-  DISPEX_RETURN_IF_ERROR(WriteUvMapTiles(paths, tiles, options.data_type == PtexDataType::kHalf));
+  DISPEX_RETURN_IF_ERROR(WriteUvMapTiles(paths, out, options.data_type == PtexDataType::kHalf));
   report.uv_map_paths = paths;
   const std::set<std::string> written(paths.begin(), paths.end());
   RemoveStaleTiles(options.uv_maps_dir, shape, written, report);
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
+                   const ExtractSettings& settings, ExtractReport& report,
+                   const SculptCorrespondence* correspondence) {
+  Stopwatch clock;
+  const bool vector = options.vector.has_value();
+  DISPEX_CHECK(!vector || (*options.vector == VectorSpace::kObject && correspondence != nullptr));
+  const int channels = vector ? 3 : 1;
+  DISPEX_ASSIGN_OR_RETURN(PtexUvCharts charts, PtexUvCharts::Build(inputs.base, inputs.surface));
+  DISPEX_ASSIGN_OR_RETURN(UvRaster raster,
+                          RasterizeUvCharts(charts, inputs.surface, options.uv_resolution));
+  DISPEX_RETURN_IF_ERROR(BuildTracerIfNeeded(options, settings, inputs, report));
+  const int num_faces = inputs.surface.num_ptex_faces();
+  const FaceTexels by_face = GroupByFace(raster, num_faces);
+  UvTileValues tiles(raster, channels);
+  std::vector<std::int64_t> face_misses(static_cast<std::size_t>(num_faces), 0);
+  DISPEX_RETURN_IF_ERROR(
+      ExtractTexels(settings, inputs, correspondence, vector, raster, by_face, tiles, face_misses));
+  ReportTexels(options, raster, face_misses, report);
+  DISPEX_RETURN_IF_ERROR(WriteTiles(options, raster, channels, tiles, report));
   report.t_uv_maps = clock.seconds();
   return Status::Ok();
 }
