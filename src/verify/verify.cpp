@@ -6,6 +6,8 @@
 // the nearest point of the sculpt. Sculpt -> map: each sculpt vertex's distance to the nearest
 // point of the displaced surface, tessellated on the same grid. Truth: the map against the
 // exact displacement of a generated sculpt at each of its vertices' (face, u, v).
+//
+// The report as written (JSON, the summary): verify_report.cpp.
 #include "dispex/verify.h"
 
 #include <fmt/format.h>
@@ -606,260 +608,327 @@ void EdgeThresholds(VerifyReport& r, const VerifyOptions& options) {
   }
 }
 
-}  // namespace
+// The map under test, open: its reader (MapReader) and what it points into, and what the map
+// records of the sculpt it was made from. Built in place: `reader` points into it.
+struct MapUnderTest {
+  MapReader reader;
+  std::optional<PtexFile> ptex;
+  std::optional<UvMap> uv;
+  std::optional<PtexUvCharts> charts;
+  std::vector<PtexFaceInfo> faces;                      // a Ptex map's (MapFacesOnSurface)
+  std::vector<std::vector<std::vector<float>>> fields;  // a Ptex map's (EdgeFields)
+  std::optional<PtexMapSampler> sampler;
+  std::string sculpt_fingerprint;
+  std::int64_t sculpt_vertices = 0;  // as the map records it (0: not recorded)
+  std::vector<std::atomic<std::uint8_t>> uv_missing;
+};
 
-StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
-  if (!options.displaced_path.empty()) return VerifyDisplacedMesh(options);
-  Stopwatch clock;
+Status CheckOptions(const VerifyOptions& options) {
   if (options.samples_per_face < 0 || options.samples_per_face > 512) {
     return Status::Error(
         fmt::format("samples_per_face = {}: must be 0..512", options.samples_per_face));
   }
-  std::optional<tbb::global_control> limit;
-  if (options.threads > 0) {
-    limit.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(options.threads));
-  }
-  DISPEX_ASSIGN_OR_RETURN(Mesh base, ReadMesh(options.base_path));
-  DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
-  VerifyReport r;
-  r.ptex_faces = static_cast<std::size_t>(surface.num_ptex_faces());
-  r.diagonal = ComputeBounds(base).diagonal();
-  r.warnings = IgnoredTagWarnings(base);
-  MapReader reader;
-  reader.name = options.map_path;
-  std::optional<PtexFile> ptex;
-  std::optional<UvMap> uv;
-  std::optional<PtexUvCharts> charts;
-  std::vector<PtexFaceInfo> map_faces;
-  std::vector<std::vector<std::vector<float>>> map_fields;
-  std::optional<PtexMapSampler> sampler;
-  std::string map_sculpt_fingerprint;
-  std::int64_t map_sculpt_vertices = 0;  // as the map records it (0: not recorded)
-  std::vector<std::atomic<std::uint8_t>> uv_missing;
-  if (IsUvMapPath(options.map_path)) {
-    DISPEX_ASSIGN_OR_RETURN(uv, UvMap::Open(options.map_path));
-    if (uv->channels() == 3) {
-      const std::string uv_space = uv->Attribute("dispex:space");
-      if (uv_space.empty()) {
-        r.warnings.push_back(
-            options.map_path +
-            ": 3 channels and no dispex:space: read as an object-space vector map");
-      } else if (uv_space != "object") {
-        return Status::Error(fmt::format(
-            "{}: 3 channels in dispex:space '{}': UV-space vector maps are read in object space",
-            options.map_path, uv_space));
-      }
-      reader.space = VectorSpace::kObject;
-      r.map_vector = true;
-      r.map_space = VectorSpace::kObject;
-    }
-    DISPEX_ASSIGN_OR_RETURN(charts, PtexUvCharts::Build(base, surface));
-    reader.uv = &*uv;
-    uv_missing =
-        std::vector<std::atomic<std::uint8_t>>(static_cast<std::size_t>(surface.num_ptex_faces()));
-    reader.uv_missing = &uv_missing;
-    reader.charts = &*charts;
-    const std::string tolerance = uv->Attribute("dispex:tolerance");
-    if (!tolerance.empty()) r.map_tolerance = std::strtod(tolerance.c_str(), nullptr);
-  } else {
-    DISPEX_ASSIGN_OR_RETURN(ptex, PtexFile::Open(options.map_path));
-    const PtexFile& map = *ptex;
-    if (map.num_faces() != surface.num_ptex_faces()) {
+  return Status::Ok();
+}
+
+// A UV-space map (UDIM tiles), read through the cage's UVs: 3 channels are an object-space
+// vector map; its tolerance from the tiles' attributes.
+Status OpenUvMap(const VerifyOptions& options, const Mesh& base, const LimitSurface& surface,
+                 MapUnderTest& m, VerifyReport& r) {
+  DISPEX_ASSIGN_OR_RETURN(m.uv, UvMap::Open(options.map_path));
+  if (m.uv->channels() == 3) {
+    const std::string uv_space = m.uv->Attribute("dispex:space");
+    if (uv_space.empty()) {
+      r.warnings.push_back(options.map_path +
+                           ": 3 channels and no dispex:space: read as an object-space vector map");
+    } else if (uv_space != "object") {
       return Status::Error(fmt::format(
-          "{}: {} faces, but {} has {} Ptex faces: not a map of this "
-          "base mesh",
-          options.map_path, map.num_faces(), options.base_path, surface.num_ptex_faces()));
+          "{}: 3 channels in dispex:space '{}': UV-space vector maps are read in object space",
+          options.map_path, uv_space));
     }
-    DISPEX_ASSIGN_OR_RETURN(const std::optional<VectorSpace> space, MapSpace(map));
-    r.map_vector = space.has_value();
-    if (space) {
-      r.map_space = *space;
-      const PtexEdgeFilterMode expected = *space == VectorSpace::kObject
-                                              ? PtexEdgeFilterMode::kNone
-                                              : PtexEdgeFilterMode::kTangentVector;
-      if (map.header().edge_filter != expected) {
-        r.warnings.push_back(fmt::format(
-            "{}: a {} vector map with edge filter mode {} ({} expected): filters across faces "
-            "will not turn its vectors as they should",
-            options.map_path, VectorSpaceName(*space),
-            PtexEdgeFilterModeName(map.header().edge_filter), PtexEdgeFilterModeName(expected)));
-      }
-    }
-    if (const PtexMetaItem* stats = map.FindMetaData("dispex:statistics")) {
-      auto j = nlohmann::json::parse(stats->AsString(), nullptr, false);
-      if (j.is_object()) {
-        r.map_misses = j.value("misses", std::int64_t{-1});
-        r.map_holes_filled = j.value("holes_filled", std::int64_t{-1});
-        r.map_faces_filled_from_neighbours =
-            j.value("faces_filled_from_neighbours", std::int64_t{-1});
-        r.map_tolerance = j.value("tolerance", 0.0);
-        if (j.contains("sculpt") && j["sculpt"].is_object()) {
-          map_sculpt_vertices = j["sculpt"].value("vertices", std::int64_t{0});
-        }
-      }
-    }
-    if (const PtexMetaItem* fingerprint = map.FindMetaData("dispex:sculpt_fingerprint")) {
-      map_sculpt_fingerprint = fingerprint->AsString();
-    }
-    reader.ptex = &map;
-    reader.space = space;
-    map_faces = MapFacesOnSurface(surface, map);
-    DISPEX_RETURN_IF_ERROR(EdgeFields(surface, map, space, map_faces, map_fields));
-    DISPEX_RETURN_IF_ERROR(MeasureEdges(base, surface, map, map_faces, map_fields, options, r));
-    if (!options.truth_path.empty() && !space) {
-      sampler.emplace(map_faces, map_fields[0]);
-      reader.across = &*sampler;
-    }
+    m.reader.space = VectorSpace::kObject;
+    r.map_vector = true;
+    r.map_space = VectorSpace::kObject;
   }
-  const std::optional<VectorSpace> space = reader.space;
+  DISPEX_ASSIGN_OR_RETURN(m.charts, PtexUvCharts::Build(base, surface));
+  m.reader.uv = &*m.uv;
+  m.uv_missing =
+      std::vector<std::atomic<std::uint8_t>>(static_cast<std::size_t>(surface.num_ptex_faces()));
+  m.reader.uv_missing = &m.uv_missing;
+  m.reader.charts = &*m.charts;
+  const std::string tolerance = m.uv->Attribute("dispex:tolerance");
+  if (!tolerance.empty()) r.map_tolerance = std::strtod(tolerance.c_str(), nullptr);
+  return Status::Ok();
+}
 
-  if (!options.truth_path.empty()) {
-    DISPEX_ASSIGN_OR_RETURN(GroundTruth truth, ReadGroundTruth(options.truth_path));
-    // One record per sculpt vertex: another count is another sculpt's truth.
-    if (map_sculpt_vertices > 0 && static_cast<std::int64_t>(truth.size()) != map_sculpt_vertices) {
-      return Status::Error(fmt::format(
-          "{}: {} records, but {} was made from a sculpt of {} vertices: the truth of another "
-          "sculpt",
-          options.truth_path, truth.size(), options.map_path, map_sculpt_vertices));
-    }
-    for (std::size_t i = 0; i < truth.size(); ++i) {
-      int f = truth.faces[i].value;
-      float u = truth.uvs[2 * i], v = truth.uvs[2 * i + 1];
-      if (f < 0 || f >= surface.num_ptex_faces() || !(u >= 0 && u <= 1 && v >= 0 && v <= 1)) {
-        return Status::Error(fmt::format("{}: record {} names face {} at ({}, {}), outside {}",
-                                         options.truth_path, i, f, u, v, options.map_path));
-      }
-    }
-    r.truth_version = truth.version();
-    r.truth_quantity = TruthQuantity(space.has_value(), !truth.d.empty());
-    DISPEX_ASSIGN_OR_RETURN(TruthComparison compared, CompareTruth(surface, reader, truth));
-    std::vector<float>& errors = compared.errors;
-    const std::vector<float>& signed_errors = compared.signed_errors;
-    double sum = 0;
-    for (float e : signed_errors) sum += e;
-    r.truth_signed_mean = truth.size() ? sum / double(truth.size()) : 0;
-    r.face_truth_max.assign(r.ptex_faces, std::numeric_limits<double>::quiet_NaN());
-    for (std::size_t i = 0; i < truth.size(); ++i) {
-      double& m = r.face_truth_max[static_cast<std::size_t>(truth.faces[i].value)];
-      if (!(m >= double(errors[i]))) m = double(errors[i]);
-    }
-    r.truth_tolerance = options.tolerance > 0 ? options.tolerance : r.map_tolerance;
-    if (r.truth_tolerance > 0 && options.truth_local_bound && !truth.local_error.empty()) {
-      // Sequential, so the worst record is the first of the largest ratio.
-      r.truth_local_checked = true;
-      r.truth_local_tolerance_factor = options.truth_local_tolerance_factor;
-      std::vector<float> local_errors;
-      local_errors.reserve(truth.size());
-      for (std::size_t i = 0; i < truth.size(); ++i) {
-        double bound = options.truth_local_tolerance_factor * r.truth_tolerance +
-                       2.0 * double(truth.local_error[i]);
-        if (std::isinf(bound)) {
-          ++r.truth_unbounded;
-          continue;
-        }
-        local_errors.push_back(truth.local_error[i]);
-        double ratio = double(errors[i]) / bound;
-        if (ratio > 1) ++r.truth_over_bound;
-        if (ratio > r.truth_worst_ratio || !std::isfinite(ratio)) {
-          r.truth_worst_ratio = ratio;
-          VerifyReport::TruthRecord& w = r.truth_worst;
-          w = {i,          truth.faces[i].value,   truth.uvs[2 * i],    truth.uvs[2 * i + 1],
-               truth.h[i], compared.map_normal[i], truth.local_error[i]};
-          if (!truth.d.empty()) {
-            w.vector = true;
-            const Float3& m = compared.map_d[i];
-            for (int c = 0; c < 3; ++c) w.d[c] = truth.d[3 * i + static_cast<std::size_t>(c)];
-            w.map_d[0] = m.x, w.map_d[1] = m.y, w.map_d[2] = m.z;
-          }
-        }
-      }
-      r.truth_local_error = Summarise(local_errors);
-    }
-    r.truth = Summarise(errors);
-    r.measured_truth = true;
-    if (r.truth.count && !std::isfinite(r.truth.max)) {
-      return Status::Error(options.map_path + ": the map holds values that are not finite");
-    }
-    if (r.truth_tolerance > 0) {
-      r.truth_rms_limit = options.truth_rms_factor * r.truth_tolerance;
-      r.truth_p99_limit = options.truth_p99_factor * r.truth_tolerance;
-    }
+// A vector map whose edge filter mode is not its space's: a warning.
+void CheckEdgeFilter(const PtexFile& map, VectorSpace space, const std::string& map_path,
+                     VerifyReport& r) {
+  const PtexEdgeFilterMode expected = space == VectorSpace::kObject
+                                          ? PtexEdgeFilterMode::kNone
+                                          : PtexEdgeFilterMode::kTangentVector;
+  if (map.header().edge_filter != expected) {
+    r.warnings.push_back(fmt::format(
+        "{}: a {} vector map with edge filter mode {} ({} expected): filters across faces "
+        "will not turn its vectors as they should",
+        map_path, VectorSpaceName(space), PtexEdgeFilterModeName(map.header().edge_filter),
+        PtexEdgeFilterModeName(expected)));
   }
+}
 
-  if (!options.sculpt_path.empty()) {
-    DISPEX_ASSIGN_OR_RETURN(Mesh sculpt, ReadMesh(options.sculpt_path));
-    if (!map_sculpt_fingerprint.empty() && MeshFingerprint(sculpt) != map_sculpt_fingerprint) {
-      r.warnings.push_back(fmt::format(
-          "{}: not the sculpt {} was made from (its fingerprint differs): an edited sculpt, or "
-          "another one",
-          options.sculpt_path, options.map_path));
-    }
-    DISPEX_ASSIGN_OR_RETURN(DisplacedSurface displaced,
-                            Displace(surface, reader, options.samples_per_face));
-    r.samples_per_face_min = 1 << 30;
-    for (int k : displaced.k) {
-      if (k == 0) continue;
-      r.samples_per_face_min = std::min(r.samples_per_face_min, k);
-      r.samples_per_face_max = std::max(r.samples_per_face_max, k);
-    }
-    if (displaced.samples.empty()) return Status::Error(options.base_path + ": no surface");
-    {
-      DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> sculpt_tracer, ClosestPointTracer(sculpt));
-      std::vector<float> d = ClosestDistances(*sculpt_tracer, displaced.samples);
-      std::vector<double> face_max(r.ptex_faces, 0.0);
-      for (std::size_t i = 0; i < d.size(); ++i) {
-        double& m = face_max[static_cast<std::size_t>(displaced.sample_face[i])];
-        m = std::max(m, double(d[i]));
-      }
-      std::vector<int> order(r.ptex_faces);
-      std::iota(order.begin(), order.end(), 0);
-      std::stable_sort(order.begin(), order.end(),
-                       [&](int a, int b) { return face_max[a] > face_max[b]; });
-      for (std::size_t i = 0; i < std::min<std::size_t>(10, order.size()); ++i) {
-        if (face_max[order[i]] > 0) r.worst_faces.push_back({order[i], face_max[order[i]]});
-      }
-      r.map_to_sculpt = Summarise(d);
-      r.face_map_to_sculpt_max = std::move(face_max);
-      for (std::size_t f = 0; f < r.ptex_faces; ++f) {
-        if (displaced.k[f] == 0) {
-          r.face_map_to_sculpt_max[f] = std::numeric_limits<double>::quiet_NaN();
-        }
+// What a Ptex map records of its extraction (dispex:statistics) and of its sculpt (vertices,
+// fingerprint).
+void ReadMapRecords(const PtexFile& map, MapUnderTest& m, VerifyReport& r) {
+  if (const PtexMetaItem* stats = map.FindMetaData("dispex:statistics")) {
+    auto j = nlohmann::json::parse(stats->AsString(), nullptr, false);
+    if (j.is_object()) {
+      r.map_misses = j.value("misses", std::int64_t{-1});
+      r.map_holes_filled = j.value("holes_filled", std::int64_t{-1});
+      r.map_faces_filled_from_neighbours =
+          j.value("faces_filled_from_neighbours", std::int64_t{-1});
+      r.map_tolerance = j.value("tolerance", 0.0);
+      if (j.contains("sculpt") && j["sculpt"].is_object()) {
+        m.sculpt_vertices = j["sculpt"].value("vertices", std::int64_t{0});
       }
     }
-    DISPEX_ASSIGN_OR_RETURN(r.sculpt_to_map,
-                            SculptToMesh(sculpt, displaced.mesh, options.max_sculpt_points));
-    r.measured_distances = true;
   }
+  if (const PtexMetaItem* fingerprint = map.FindMetaData("dispex:sculpt_fingerprint")) {
+    m.sculpt_fingerprint = fingerprint->AsString();
+  }
+}
 
-  for (std::size_t f = 0; f < uv_missing.size(); ++f) {
-    if (uv_missing[f].load()) r.uv_faces_without_tile.push_back(static_cast<int>(f));
+// A Ptex map of this base (one face per Ptex face), scalar or vector (MapSpace).
+Status OpenPtexMap(const VerifyOptions& options, const LimitSurface& surface, MapUnderTest& m,
+                   VerifyReport& r) {
+  DISPEX_ASSIGN_OR_RETURN(m.ptex, PtexFile::Open(options.map_path));
+  const PtexFile& map = *m.ptex;
+  if (map.num_faces() != surface.num_ptex_faces()) {
+    return Status::Error(fmt::format(
+        "{}: {} faces, but {} has {} Ptex faces: not a map of this "
+        "base mesh",
+        options.map_path, map.num_faces(), options.base_path, surface.num_ptex_faces()));
   }
-  if (!r.uv_faces_without_tile.empty()) {
-    std::string list;
-    for (std::size_t i = 0; i < r.uv_faces_without_tile.size() && i < 10; ++i) {
-      list += fmt::format("{}{}", i ? ", " : "", r.uv_faces_without_tile[i]);
+  DISPEX_ASSIGN_OR_RETURN(const std::optional<VectorSpace> space, MapSpace(map));
+  r.map_vector = space.has_value();
+  if (space) {
+    r.map_space = *space;
+    CheckEdgeFilter(map, *space, options.map_path, r);
+  }
+  ReadMapRecords(map, m, r);
+  m.reader.ptex = &map;
+  m.reader.space = space;
+  return Status::Ok();
+}
+
+// A Ptex map's steps at shared face edges (EdgeFields, MeasureEdges).
+Status MeasureEdgeSteps(const VerifyOptions& options, const Mesh& base, const LimitSurface& surface,
+                        MapUnderTest& m, VerifyReport& r) {
+  const PtexFile& map = *m.ptex;
+  m.faces = MapFacesOnSurface(surface, map);
+  DISPEX_RETURN_IF_ERROR(EdgeFields(surface, map, m.reader.space, m.faces, m.fields));
+  return MeasureEdges(base, surface, map, m.faces, m.fields, options, r);
+}
+
+// A scalar Ptex map compared with a truth is read across face edges (MapReader::TruthScalar),
+// from the texels EdgeFields read.
+void ReadAcrossFaces(const VerifyOptions& options, MapUnderTest& m) {
+  if (!options.truth_path.empty() && !m.reader.space) {
+    m.sampler.emplace(m.faces, m.fields[0]);
+    m.reader.across = &*m.sampler;
+  }
+}
+
+// The truth file, checked: one record per vertex of the sculpt the map was made from (where
+// the map records their count), each at a point of a Ptex face of the base.
+StatusOr<GroundTruth> ReadCheckedTruth(const VerifyOptions& options, const LimitSurface& surface,
+                                       std::int64_t map_sculpt_vertices) {
+  DISPEX_ASSIGN_OR_RETURN(GroundTruth truth, ReadGroundTruth(options.truth_path));
+  // One record per sculpt vertex: another count is another sculpt's truth.
+  if (map_sculpt_vertices > 0 && static_cast<std::int64_t>(truth.size()) != map_sculpt_vertices) {
+    return Status::Error(fmt::format(
+        "{}: {} records, but {} was made from a sculpt of {} vertices: the truth of another "
+        "sculpt",
+        options.truth_path, truth.size(), options.map_path, map_sculpt_vertices));
+  }
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    int f = truth.faces[i].value;
+    float u = truth.uvs[2 * i], v = truth.uvs[2 * i + 1];
+    if (f < 0 || f >= surface.num_ptex_faces() || !(u >= 0 && u <= 1 && v >= 0 && v <= 1)) {
+      return Status::Error(fmt::format("{}: record {} names face {} at ({}, {}), outside {}",
+                                       options.truth_path, i, f, u, v, options.map_path));
     }
-    if (r.uv_faces_without_tile.size() > 10) list += ", ...";
-    r.warnings.push_back(
-        fmt::format("{}: {} Ptex faces have points whose UVs no tile holds (read as 0): {}",
-                    options.map_path, r.uv_faces_without_tile.size(), list));
   }
-  const double limit_abs = DistanceLimit(options, r.diagonal);
-  const char* option = options.max_error_rel > 0 ? "max_error_rel" : "max_error";
+  return truth;
+}
+
+// The truth's signed mean and every face's largest error (NaN for a face without records).
+void TruthPerFace(const GroundTruth& truth, const TruthComparison& compared, VerifyReport& r) {
+  double sum = 0;
+  for (float e : compared.signed_errors) sum += e;
+  r.truth_signed_mean = truth.size() ? sum / double(truth.size()) : 0;
+  r.face_truth_max.assign(r.ptex_faces, std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    double& m = r.face_truth_max[static_cast<std::size_t>(truth.faces[i].value)];
+    if (!(m >= double(compared.errors[i]))) m = double(compared.errors[i]);
+  }
+}
+
+// The per-record bound k tau + 2 x the sculpt's local linear error: the records over it, those
+// unbounded, the worst record and the local errors' statistics.
+void TruthLocalBound(const VerifyOptions& options, const GroundTruth& truth,
+                     const TruthComparison& compared, VerifyReport& r) {
+  // Sequential, so the worst record is the first of the largest ratio.
+  r.truth_local_checked = true;
+  r.truth_local_tolerance_factor = options.truth_local_tolerance_factor;
+  std::vector<float> local_errors;
+  local_errors.reserve(truth.size());
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    double bound = options.truth_local_tolerance_factor * r.truth_tolerance +
+                   2.0 * double(truth.local_error[i]);
+    if (std::isinf(bound)) {
+      ++r.truth_unbounded;
+      continue;
+    }
+    local_errors.push_back(truth.local_error[i]);
+    double ratio = double(compared.errors[i]) / bound;
+    if (ratio > 1) ++r.truth_over_bound;
+    if (ratio > r.truth_worst_ratio || !std::isfinite(ratio)) {
+      r.truth_worst_ratio = ratio;
+      VerifyReport::TruthRecord& w = r.truth_worst;
+      w = {i,          truth.faces[i].value,   truth.uvs[2 * i],    truth.uvs[2 * i + 1],
+           truth.h[i], compared.map_normal[i], truth.local_error[i]};
+      if (!truth.d.empty()) {
+        w.vector = true;
+        const Float3& m = compared.map_d[i];
+        for (int c = 0; c < 3; ++c) w.d[c] = truth.d[3 * i + static_cast<std::size_t>(c)];
+        w.map_d[0] = m.x, w.map_d[1] = m.y, w.map_d[2] = m.z;
+      }
+    }
+  }
+  r.truth_local_error = Summarise(local_errors);
+}
+
+// The map against the truth file: the errors' statistics, per face, against the per-record
+// bound, and the truth's RMS and p99 limits.
+Status MeasureTruth(const VerifyOptions& options, const LimitSurface& surface,
+                    const MapUnderTest& m, VerifyReport& r) {
+  DISPEX_ASSIGN_OR_RETURN(GroundTruth truth, ReadCheckedTruth(options, surface, m.sculpt_vertices));
+  r.truth_version = truth.version();
+  r.truth_quantity = TruthQuantity(m.reader.space.has_value(), !truth.d.empty());
+  DISPEX_ASSIGN_OR_RETURN(TruthComparison compared, CompareTruth(surface, m.reader, truth));
+  TruthPerFace(truth, compared, r);
+  r.truth_tolerance = options.tolerance > 0 ? options.tolerance : r.map_tolerance;
+  if (r.truth_tolerance > 0 && options.truth_local_bound && !truth.local_error.empty()) {
+    TruthLocalBound(options, truth, compared, r);
+  }
+  r.truth = Summarise(compared.errors);  // last: reorders the errors
+  r.measured_truth = true;
+  if (r.truth.count && !std::isfinite(r.truth.max)) {
+    return Status::Error(options.map_path + ": the map holds values that are not finite");
+  }
+  if (r.truth_tolerance > 0) {
+    r.truth_rms_limit = options.truth_rms_factor * r.truth_tolerance;
+    r.truth_p99_limit = options.truth_p99_factor * r.truth_tolerance;
+  }
+  return Status::Ok();
+}
+
+// The samples per side of the displaced surface's faces, smallest and largest (holes aside).
+void SamplesPerFaceRange(const DisplacedSurface& displaced, VerifyReport& r) {
+  r.samples_per_face_min = 1 << 30;
+  for (int k : displaced.k) {
+    if (k == 0) continue;
+    r.samples_per_face_min = std::min(r.samples_per_face_min, k);
+    r.samples_per_face_max = std::max(r.samples_per_face_max, k);
+  }
+}
+
+// Map -> sculpt: each sample's distance to the sculpt, every face's largest (NaN for holes)
+// and the 10 worst faces.
+Status MapToSculpt(const Mesh& sculpt, const DisplacedSurface& displaced, VerifyReport& r) {
+  DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> sculpt_tracer, ClosestPointTracer(sculpt));
+  std::vector<float> d = ClosestDistances(*sculpt_tracer, displaced.samples);
+  std::vector<double> face_max(r.ptex_faces, 0.0);
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    double& m = face_max[static_cast<std::size_t>(displaced.sample_face[i])];
+    m = std::max(m, double(d[i]));
+  }
+  std::vector<int> order(r.ptex_faces);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return face_max[a] > face_max[b]; });
+  for (std::size_t i = 0; i < std::min<std::size_t>(10, order.size()); ++i) {
+    if (face_max[order[i]] > 0) r.worst_faces.push_back({order[i], face_max[order[i]]});
+  }
+  r.map_to_sculpt = Summarise(d);
+  r.face_map_to_sculpt_max = std::move(face_max);
+  for (std::size_t f = 0; f < r.ptex_faces; ++f) {
+    if (displaced.k[f] == 0) r.face_map_to_sculpt_max[f] = std::numeric_limits<double>::quiet_NaN();
+  }
+  return Status::Ok();
+}
+
+// The sculpt against the displaced surface, both ways (map -> sculpt, sculpt -> map).
+Status MeasureDistances(const VerifyOptions& options, const LimitSurface& surface,
+                        const MapUnderTest& m, VerifyReport& r) {
+  DISPEX_ASSIGN_OR_RETURN(Mesh sculpt, ReadMesh(options.sculpt_path));
+  if (!m.sculpt_fingerprint.empty() && MeshFingerprint(sculpt) != m.sculpt_fingerprint) {
+    r.warnings.push_back(fmt::format(
+        "{}: not the sculpt {} was made from (its fingerprint differs): an edited sculpt, or "
+        "another one",
+        options.sculpt_path, options.map_path));
+  }
+  DISPEX_ASSIGN_OR_RETURN(DisplacedSurface displaced,
+                          Displace(surface, m.reader, options.samples_per_face));
+  SamplesPerFaceRange(displaced, r);
+  if (displaced.samples.empty()) return Status::Error(options.base_path + ": no surface");
+  DISPEX_RETURN_IF_ERROR(MapToSculpt(sculpt, displaced, r));
+  DISPEX_ASSIGN_OR_RETURN(r.sculpt_to_map,
+                          SculptToMesh(sculpt, displaced.mesh, options.max_sculpt_points));
+  r.measured_distances = true;
+  return Status::Ok();
+}
+
+// A UV-space map's Ptex faces with points that no tile holds: listed, and a warning.
+void UvFacesWithoutTile(const MapUnderTest& m, const std::string& map_path, VerifyReport& r) {
+  for (std::size_t f = 0; f < m.uv_missing.size(); ++f) {
+    if (m.uv_missing[f].load()) r.uv_faces_without_tile.push_back(static_cast<int>(f));
+  }
+  if (r.uv_faces_without_tile.empty()) return;
+  std::string list;
+  for (std::size_t i = 0; i < r.uv_faces_without_tile.size() && i < 10; ++i) {
+    list += fmt::format("{}{}", i ? ", " : "", r.uv_faces_without_tile[i]);
+  }
+  if (r.uv_faces_without_tile.size() > 10) list += ", ...";
+  r.warnings.push_back(
+      fmt::format("{}: {} Ptex faces have points whose UVs no tile holds (read as 0): {}", map_path,
+                  r.uv_faces_without_tile.size(), list));
+}
+
+// The sculpt's points' mean distance to the displaced surface, in tolerances: over
+// max_mean_tolerances, not the sculpt the map was made from.
+void MeanDistanceBound(const VerifyOptions& options, VerifyReport& r) {
   r.distance_tolerance = options.tolerance > 0 ? options.tolerance : r.map_tolerance;
-  if (r.measured_distances && options.max_mean_tolerances > 0 && r.distance_tolerance > 0) {
-    // The sculpt's own points: the displaced surface's points also carry the sagging of the
-    // sculpt's facets between its vertices, many tolerances on a coarse sculpt.
-    const ErrorStats& s = r.sculpt_to_map;
-    if (r.passed && s.mean > options.max_mean_tolerances * r.distance_tolerance) {
-      r.passed = false;
-      r.failure = fmt::format(
-          "sculpt->map mean distance {:.4g} is {:.3g} tolerances, over max_mean_tolerances {} x "
-          "{:.4g}: is this the sculpt the map was made from?",
-          s.mean, s.mean / r.distance_tolerance, options.max_mean_tolerances, r.distance_tolerance);
-    }
+  if (!r.measured_distances || !(options.max_mean_tolerances > 0) || !(r.distance_tolerance > 0)) {
+    return;
   }
-  if (r.measured_truth && r.truth_over_bound > 0) {
+  // The sculpt's own points: the displaced surface's points also carry the sagging of the
+  // sculpt's facets between its vertices, many tolerances on a coarse sculpt.
+  const ErrorStats& s = r.sculpt_to_map;
+  if (r.passed && s.mean > options.max_mean_tolerances * r.distance_tolerance) {
+    r.passed = false;
+    r.failure = fmt::format(
+        "sculpt->map mean distance {:.4g} is {:.3g} tolerances, over max_mean_tolerances {} x "
+        "{:.4g}: is this the sculpt the map was made from?",
+        s.mean, s.mean / r.distance_tolerance, options.max_mean_tolerances, r.distance_tolerance);
+  }
+}
+
+// The truth's bounds in tolerances: per record (a failure there is the report's failure), then
+// RMS and p99.
+void TruthBounds(const VerifyOptions& options, VerifyReport& r) {
+  if (!r.measured_truth) return;
+  if (r.truth_over_bound > 0) {
     const auto& w = r.truth_worst;
     r.passed = false;
     const std::string values =
@@ -873,18 +942,27 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
         r.truth_worst_ratio, w.index, w.face, w.u, w.v, values,
         r.truth_local_tolerance_factor * r.truth_tolerance + 2.0 * w.local_error);
   }
-  if (r.measured_truth && r.passed && r.truth_rms_limit > 0 && r.truth.rms > r.truth_rms_limit) {
+  if (r.passed && r.truth_rms_limit > 0 && r.truth.rms > r.truth_rms_limit) {
     r.passed = false;
     r.failure =
         fmt::format("truth RMS error {:.4g} ({}) exceeds truth_rms_factor {} x tolerance {:.4g}",
                     r.truth.rms, r.truth_quantity, options.truth_rms_factor, r.truth_tolerance);
   }
-  if (r.measured_truth && r.passed && r.truth_p99_limit > 0 && r.truth.p99 > r.truth_p99_limit) {
+  if (r.passed && r.truth_p99_limit > 0 && r.truth.p99 > r.truth_p99_limit) {
     r.passed = false;
     r.failure =
         fmt::format("truth p99 error {:.4g} ({}) exceeds truth_p99_factor {} x tolerance {:.4g}",
                     r.truth.p99, r.truth_quantity, options.truth_p99_factor, r.truth_tolerance);
   }
+}
+
+// The bounds and the verdict: the first bound failed is the report's failure (a truth record
+// over its bound overrides the mean distance's).
+void ApplyBounds(const VerifyOptions& options, VerifyReport& r) {
+  const double limit_abs = DistanceLimit(options, r.diagonal);
+  const char* option = options.max_error_rel > 0 ? "max_error_rel" : "max_error";
+  MeanDistanceBound(options, r);
+  TruthBounds(options, r);
   if (r.measured_truth) Threshold(r, "truth", r.truth, limit_abs, option);
   if (r.measured_distances) {
     Threshold(r, "map->sculpt", r.map_to_sculpt, limit_abs, option);
@@ -898,196 +976,41 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     P99Threshold(r, "map->sculpt", r.map_to_sculpt, options.max_p99);
     P99Threshold(r, "sculpt->map", r.sculpt_to_map, options.max_p99);
   }
-  r.seconds = clock.seconds();
-  return r;
 }
 
-namespace {
-nlohmann::json StatsJson(const ErrorStats& s, double diagonal) {
-  return {{"count", s.count},
-          {"mean", s.mean},
-          {"rms", s.rms},
-          {"p99", s.p99},
-          {"max", s.max},
-          {"rms_rel", s.rms / diagonal},
-          {"p99_rel", s.p99 / diagonal},
-          {"max_rel", s.max / diagonal}};
-}
-// With `tau` > 0, the mean, p99 and max in tolerances too.
-std::string StatsLine(const char* what, const ErrorStats& s, double diagonal, double tau = 0) {
-  const std::string tolerances =
-      tau > 0 ? fmt::format("mean / p99 / max {:.3g} / {:.3g} / {:.3g} tolerances; ", s.mean / tau,
-                            s.p99 / tau, s.max / tau)
-              : "";
-  return fmt::format(
-      "  {:<12} rms {:.4g}  p99 {:.4g}  max {:.4g}  (max {:.3g} of the diagonal; {}"
-      "{} points)\n",
-      what, s.rms, s.p99, s.max, s.max / diagonal, tolerances, s.count);
-}
 }  // namespace
 
-std::string VerifyReportJson(const VerifyReport& r) {
-  nlohmann::json j;
-  j["diagonal"] = r.diagonal;
-  j["ptex_faces"] = r.ptex_faces;
-  j["map_kind"] = r.displaced_mesh ? "displaced mesh" : r.map_vector ? "vector" : "scalar";
-  if (r.map_vector) j["vector_space"] = VectorSpaceName(r.map_space);
-  if (r.measured_distances) {
-    j["samples_per_face"] = {r.samples_per_face_min, r.samples_per_face_max};
-    j["map_to_sculpt"] = StatsJson(r.map_to_sculpt, r.diagonal);
-    j["sculpt_to_map"] = StatsJson(r.sculpt_to_map, r.diagonal);
-    nlohmann::json worst = nlohmann::json::array();
-    for (const auto& w : r.worst_faces) worst.push_back({{"face", w.face}, {"max", w.max}});
-    j["worst_faces"] = worst;
+StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
+  if (!options.displaced_path.empty()) return VerifyDisplacedMesh(options);
+  Stopwatch clock;
+  DISPEX_RETURN_IF_ERROR(CheckOptions(options));
+  std::optional<tbb::global_control> limit;
+  if (options.threads > 0) {
+    limit.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(options.threads));
   }
-  if (r.measured_truth) {
-    j["truth"] = StatsJson(r.truth, r.diagonal);
-    j["truth"]["version"] = r.truth_version;
-    j["truth"]["quantity"] = r.truth_quantity;
-    j["truth"]["signed_mean"] = r.truth_signed_mean;
-    nlohmann::json bound = {{"tolerance", r.truth_tolerance},
-                            {"rms_limit", r.truth_rms_limit},
-                            {"p99_limit", r.truth_p99_limit},
-                            {"local_checked", r.truth_local_checked},
-                            {"local_tolerance_factor", r.truth_local_tolerance_factor}};
-    if (r.truth_local_checked) {
-      const auto& w = r.truth_worst;
-      bound["records_over"] = r.truth_over_bound;
-      bound["records_unbounded"] = r.truth_unbounded;
-      bound["worst_ratio"] = r.truth_worst_ratio;
-      bound["local_error"] = StatsJson(r.truth_local_error, r.diagonal);
-      bound["worst_record"] = {{"index", w.index},
-                               {"face", w.face},
-                               {"u", w.u},
-                               {"v", w.v},
-                               {"h", w.h},
-                               {"map", w.map},
-                               {"local_error", w.local_error}};
-      if (w.vector) {
-        bound["worst_record"]["d"] = {w.d[0], w.d[1], w.d[2]};
-        bound["worst_record"]["map_d"] = {w.map_d[0], w.map_d[1], w.map_d[2]};
-      }
-    }
-    j["truth"]["bound"] = bound;
+  DISPEX_ASSIGN_OR_RETURN(Mesh base, ReadMesh(options.base_path));
+  DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
+  VerifyReport r;
+  r.ptex_faces = static_cast<std::size_t>(surface.num_ptex_faces());
+  r.diagonal = ComputeBounds(base).diagonal();
+  r.warnings = IgnoredTagWarnings(base);
+  MapUnderTest m;
+  m.reader.name = options.map_path;
+  if (IsUvMapPath(options.map_path)) {
+    DISPEX_RETURN_IF_ERROR(OpenUvMap(options, base, surface, m, r));
+  } else {
+    DISPEX_RETURN_IF_ERROR(OpenPtexMap(options, surface, m, r));
+    DISPEX_RETURN_IF_ERROR(MeasureEdgeSteps(options, base, surface, m, r));
+    ReadAcrossFaces(options, m);
   }
-  if (r.measured_edges) {
-    auto steps = [&](const ErrorStats& s) {
-      nlohmann::json out = StatsJson(s, r.diagonal);
-      if (r.edge_tolerance > 0) {
-        out["p99_tolerances"] = s.p99 / r.edge_tolerance;
-        out["max_tolerances"] = s.max / r.edge_tolerance;
-      }
-      return out;
-    };
-    nlohmann::json worst = nlohmann::json::array();
-    for (const auto& w : r.worst_edges) {
-      worst.push_back({{"face", w.face},
-                       {"edge", w.edge},
-                       {"neighbour", w.neighbour},
-                       {"t", w.t},
-                       {"step", w.step},
-                       {"reader", w.reader}});
-    }
-    j["edges"] = {{"object_space", r.edges_object_space},
-                  {"shared", r.edges},
-                  {"sharp_creases", r.crease_edges},
-                  {"discontinuous", r.discontinuous_edges},
-                  {"tolerance", r.edge_tolerance},
-                  {"max_limit", r.edge_max_limit},
-                  {"p99_limit", r.edge_p99_limit},
-                  {"per_face", steps(r.edge_per_face)},
-                  {"across_faces", steps(r.edge_across_faces)},
-                  {"worst", worst}};
+  if (!options.truth_path.empty()) DISPEX_RETURN_IF_ERROR(MeasureTruth(options, surface, m, r));
+  if (!options.sculpt_path.empty()) {
+    DISPEX_RETURN_IF_ERROR(MeasureDistances(options, surface, m, r));
   }
-  j["map"] = {{"misses", r.map_misses},
-              {"holes_filled", r.map_holes_filled},
-              {"faces_filled_from_neighbours", r.map_faces_filled_from_neighbours},
-              {"tolerance", r.map_tolerance}};
-  j["passed"] = r.passed;
-  if (!r.passed) j["failure"] = r.failure;
-  j["warnings"] = r.warnings;
-  if (!r.uv_faces_without_tile.empty()) j["uv_faces_without_tile"] = r.uv_faces_without_tile;
-  j["seconds"] = r.seconds;
-  // Last, being long: every face's error (null for a face without samples or records).
-  if (!r.face_map_to_sculpt_max.empty() || !r.face_truth_max.empty()) {
-    nlohmann::json per_face = nlohmann::json::object();
-    if (!r.face_map_to_sculpt_max.empty()) per_face["map_to_sculpt_max"] = r.face_map_to_sculpt_max;
-    if (!r.face_truth_max.empty()) per_face["truth_max"] = r.face_truth_max;
-    j["per_face"] = per_face;
-  }
-  return j.dump(2) + "\n";
-}
-
-std::string VerifyReportSummary(const VerifyReport& r) {
-  if (r.displaced_mesh) {
-    return fmt::format(
-               "verify: a displaced mesh against the sculpt, bounding-box diagonal {:.4g}\n",
-               r.diagonal) +
-           StatsLine("displaced->sculpt", r.map_to_sculpt, r.diagonal) +
-           StatsLine("sculpt->displaced", r.sculpt_to_map, r.diagonal);
-  }
-  std::string out = fmt::format(
-      "verify: {} Ptex faces, bounding-box diagonal {:.4g}, {}\n", r.ptex_faces, r.diagonal,
-      r.map_vector ? fmt::format("vector map ({} space: P + D)", VectorSpaceName(r.map_space))
-                   : std::string("scalar map (P + h N)"));
-  if (r.measured_distances) {
-    out += StatsLine("map->sculpt", r.map_to_sculpt, r.diagonal, r.distance_tolerance);
-    out += StatsLine("sculpt->map", r.sculpt_to_map, r.diagonal, r.distance_tolerance);
-    if (!r.worst_faces.empty()) {
-      out += "  worst faces:";
-      for (const auto& w : r.worst_faces) out += fmt::format(" {} ({:.3g})", w.face, w.max);
-      out += "\n";
-    }
-  }
-  if (r.measured_truth) {
-    out += StatsLine("truth", r.truth, r.diagonal);
-    out += fmt::format("  truth (version {}) measured as {}\n", r.truth_version, r.truth_quantity);
-    if (r.truth_local_checked) {
-      out += fmt::format(
-          "  truth bound {} x tolerance {:.4g} + 2 x local linear error: {} of {} records "
-          "over, worst {:.3g} x the bound; RMS {:.3g} and p99 {:.3g} tolerances\n",
-          r.truth_local_tolerance_factor, r.truth_tolerance, r.truth_over_bound, r.truth.count,
-          r.truth_worst_ratio, r.truth.rms / r.truth_tolerance, r.truth.p99 / r.truth_tolerance);
-      if (r.truth_unbounded > 0) {
-        out +=
-            fmt::format("  {} records near folded sculpt faces not bounded\n", r.truth_unbounded);
-      }
-    }
-  }
-  if (r.measured_edges) {
-    auto line = [&](const char* what, const ErrorStats& s) {
-      std::string tolerances;
-      if (r.edge_tolerance > 0) {
-        tolerances = fmt::format(" ({:.3g} / {:.3g} tolerances)", s.p99 / r.edge_tolerance,
-                                 s.max / r.edge_tolerance);
-      }
-      return fmt::format("  {:<12} p99 {:.4g}  max {:.4g}{}\n", what, s.p99, s.max, tolerances);
-    };
-    out += fmt::format(
-        "  edge steps{} on {} shared edges ({} points; not measured: {} on sharp "
-        "creases, {} beside faces the map lists as discontinuous):\n",
-        r.edges_object_space ? " of |D| in object space" : "",
-        r.edges - r.crease_edges - r.discontinuous_edges, r.edge_per_face.count, r.crease_edges,
-        r.discontinuous_edges);
-    out += line("per-face", r.edge_per_face);
-    out += line("across-faces", r.edge_across_faces);
-    if (!r.worst_edges.empty()) {
-      out += "  worst edges:";
-      for (std::size_t i = 0; i < std::min<std::size_t>(3, r.worst_edges.size()); ++i) {
-        const auto& w = r.worst_edges[i];
-        out += fmt::format(" face {} edge {} ({}, {:.3g})", w.face, w.edge, w.reader, w.step);
-      }
-      out += "\n";
-    }
-  }
-  if (r.map_misses >= 0) {
-    out += fmt::format(
-        "  map: {} misses ({} filled in-face, {} faces from neighbours), "
-        "tolerance {:.4g}\n",
-        r.map_misses, r.map_holes_filled, r.map_faces_filled_from_neighbours, r.map_tolerance);
-  }
-  out += r.passed ? "  passed\n" : "  FAILED: " + r.failure + "\n";
-  return out;
+  UvFacesWithoutTile(m, options.map_path, r);
+  ApplyBounds(options, r);
+  r.seconds = clock.seconds();
+  return r;
 }
 
 }  // namespace dispex
