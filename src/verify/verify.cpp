@@ -7,7 +7,8 @@
 // point of the displaced surface, tessellated on the same grid. Truth: the map against the
 // exact displacement of a generated sculpt at each of its vertices' (face, u, v).
 //
-// The report as written (JSON, the summary): verify_report.cpp.
+// The report as written (JSON, the summary): verify_report.cpp. The steps at face edges:
+// edge_steps.cpp.
 #include "dispex/verify.h"
 
 #include <fmt/format.h>
@@ -37,29 +38,15 @@
 #include "dispex/uv_charts.h"
 #include "dispex/uv_map.h"
 #include "dispex/vector_space.h"
+#include "verify/edge_steps.h"
+#include "verify/verify_stats.h"
 
 namespace dispex {
 
 namespace {
 
-// Statistics of absolute values; sums in index order, so the result is deterministic.
-ErrorStats Summarise(std::vector<float>& values) {
-  ErrorStats s;
-  s.count = values.size();
-  if (values.empty()) return s;
-  double sum = 0, sum_sq = 0;
-  for (float v : values) {
-    sum += v;
-    sum_sq += double(v) * v;
-  }
-  s.mean = sum / double(values.size());
-  s.rms = std::sqrt(sum_sq / double(values.size()));
-  std::size_t k = static_cast<std::size_t>(std::ceil(0.99 * double(values.size()))) - 1;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-  s.p99 = values[k];
-  s.max = *std::max_element(values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-  return s;
-}
+using verify::FrameScratch;
+using verify::Summarise;
 
 // What the map holds (DisplacementMapSpace): nullopt for a scalar map.
 StatusOr<std::optional<VectorSpace>> MapSpace(const PtexFile& map) {
@@ -138,20 +125,6 @@ struct MapReader {
       span = std::max(span, std::hypot(c[2 * l] - c[2 * k], c[2 * l + 1] - c[2 * k + 1]));
     }
     return std::clamp(static_cast<int>(std::ceil(2 * span * uv->resolution())), 8, 64);
-  }
-};
-
-// Limit points with their frames, 3 floats per point in each array.
-struct FrameScratch {
-  std::vector<float> uv, p, nrm, du, dv;
-  void Resize(std::size_t points) {
-    for (auto* v : {&p, &nrm, &du, &dv}) v->resize(3 * points);
-  }
-  LimitEvaluator::Frames Frames() { return {p, nrm, du, dv}; }
-  SurfaceFrame At(std::size_t j) const {
-    return {{du[3 * j], du[3 * j + 1], du[3 * j + 2]},
-            {dv[3 * j], dv[3 * j + 1], dv[3 * j + 2]},
-            {nrm[3 * j], nrm[3 * j + 1], nrm[3 * j + 2]}};
   }
 };
 
@@ -459,155 +432,6 @@ StatusOr<VerifyReport> VerifyDisplacedMesh(const VerifyOptions& options) {
   return r;
 }
 
-// The map's face table for the sampler: resolutions from the map, adjacency and sub-face
-// flags from the base's limit surface (the map's own adjacency is not trusted).
-std::vector<PtexFaceInfo> MapFacesOnSurface(const LimitSurface& surface, const PtexFile& map) {
-  std::vector<PtexFaceInfo> faces = PtexFaceTable(surface);
-  for (std::size_t f = 0; f < faces.size(); ++f) {
-    const PtexFaceInfo& stored = map.face_info(PtexFaceId(static_cast<int>(f)));
-    faces[f].ulog2 = stored.ulog2;
-    faces[f].vlog2 = stored.vlog2;
-  }
-  return faces;
-}
-
-// Per field and face, the level-0 values whose steps at face edges are measured: the map's
-// one channel (one value for a constant face), or a vector map's D in object space as three
-// fields x, y, z. A tangent or parametric map's texels are converted with the frame at their
-// centres (constant faces expanded, as D turns over them); an object map's channels are D.
-Status EdgeFields(const LimitSurface& surface, const PtexFile& map,
-                  std::optional<VectorSpace> space, std::span<const PtexFaceInfo> faces,
-                  std::vector<std::vector<std::vector<float>>>& fields) {
-  const int channels = map.header().num_channels;
-  const bool convert = space && *space != VectorSpace::kObject;
-  fields.assign(space ? 3 : 1, std::vector<std::vector<float>>(faces.size()));
-  tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
-  tbb::enumerable_thread_specific<FrameScratch> scratch;
-  FirstError error;
-  tbb::parallel_for(std::size_t{0}, faces.size(), [&](std::size_t f) {
-    const PtexFaceId face(static_cast<std::int32_t>(f));
-    const bool hole = surface.is_hole(face);
-    std::vector<float> all;
-    if ((hole || !convert) &&
-        map.BlockInfo(face, 0).encoding == PtexBlockInfo::Encoding::kConstant) {
-      all.resize(static_cast<std::size_t>(channels));
-      map.ConstantValue(face, all.data());
-    } else {
-      Status read = map.ReadFace(face, 0, all);
-      if (!read.ok()) return error.Record(static_cast<int>(f), read);
-    }
-    for (float x : all) {
-      if (!std::isfinite(x)) {
-        return error.Record(static_cast<int>(f),
-                            Status::Error(fmt::format(
-                                "{}: face {} holds a value that is not finite", map.name(), f)));
-      }
-    }
-    const std::size_t texels = all.size() / static_cast<std::size_t>(channels);
-    for (std::size_t c = 0; c < fields.size(); ++c) fields[c][f].resize(texels);
-    if (convert && !hole) {
-      auto& evaluator = evaluators.local();
-      if (!evaluator) evaluator.emplace(surface);
-      FrameScratch& s = scratch.local();
-      s.Resize(texels);
-      Status st = evaluator->EvaluateGridFrames(face, faces[f].ures(), faces[f].vres(), s.Frames());
-      if (!st.ok()) return error.Record(static_cast<int>(f), st);
-      VectorsFromChannels(*space, s.du, s.dv, s.nrm, all, fields[0][f], fields[1][f], fields[2][f]);
-      return;
-    }
-    for (std::size_t c = 0; c < fields.size(); ++c) {
-      for (std::size_t i = 0; i < texels; ++i) {
-        fields[c][f][i] = all[i * static_cast<std::size_t>(channels) + c];
-      }
-    }
-  });
-  return error.failed() ? error.status() : Status::Ok();
-}
-
-// `faces` and `fields` as EdgeFields makes them.
-Status MeasureEdges(const Mesh& base, const LimitSurface& surface, const PtexFile& map,
-                    std::span<const PtexFaceInfo> faces,
-                    std::span<const std::vector<std::vector<float>>> fields,
-                    const VerifyOptions& options, VerifyReport& r) {
-  std::vector<std::uint8_t> holes(faces.size());
-  for (std::size_t f = 0; f < faces.size(); ++f) {
-    holes[f] = surface.is_hole(PtexFaceId(static_cast<std::int32_t>(f)));
-  }
-  std::vector<std::uint8_t> skip = holes, discontinuous(faces.size(), 0);
-  if (const PtexMetaItem* listed = map.FindMetaData("dispex:discontinuous_faces")) {
-    for (std::int32_t f : listed->AsInt32()) {
-      if (f < 0 || static_cast<std::size_t>(f) >= faces.size()) {
-        return Status::Error(
-            fmt::format("{}: dispex:discontinuous_faces names face {}, not one of "
-                        "its {} faces",
-                        map.name(), f, faces.size()));
-      }
-      if (!holes[static_cast<std::size_t>(f)]) discontinuous[static_cast<std::size_t>(f)] = 1;
-      skip[static_cast<std::size_t>(f)] = 1;
-    }
-  }
-  const std::vector<std::uint8_t> creases = SharpCreaseEdges(base, surface);
-  PtexEdgeSteps steps = MeasurePtexVectorEdgeSteps(faces, fields, creases, skip);
-  r.edges_object_space = fields.size() == 3;
-  r.measured_edges = true;
-  r.discontinuous_edges = CountEdgesTouching(faces, discontinuous, holes);
-  r.edges = steps.edges + r.discontinuous_edges;
-  r.crease_edges = steps.skipped_edges;
-  r.edge_per_face = Summarise(steps.per_face);
-  r.edge_across_faces = Summarise(steps.across_faces);
-  std::vector<VerifyReport::WorstEdge> worst;
-  for (const PtexEdgeStep& s : steps.edge_max) {
-    worst.push_back({s.face, s.edge, s.neighbour, s.t_per_face, s.per_face, "per-face"});
-    worst.push_back(
-        {s.face, s.edge, s.neighbour, s.t_across_faces, s.across_faces, "across-faces"});
-  }
-  std::stable_sort(worst.begin(), worst.end(),
-                   [](const auto& x, const auto& y) { return x.step > y.step; });
-  for (const auto& w : worst) {
-    if (r.worst_edges.size() == 10 || w.step == 0) break;
-    r.worst_edges.push_back(w);
-  }
-  const double tau = options.tolerance > 0 ? options.tolerance : r.map_tolerance;
-  if ((options.max_edge_step > 0 || options.max_edge_step_p99 > 0) && !(tau > 0)) {
-    return Status::Error(
-        fmt::format("{}: the edge-step bounds are in tolerances, and the map carries none (no "
-                    "dispex:statistics): give the tolerance",
-                    map.name()));
-  }
-  r.edge_tolerance = tau;
-  r.edge_max_limit = options.max_edge_step * tau;
-  r.edge_p99_limit = options.max_edge_step_p99 * tau;
-  return Status::Ok();
-}
-
-void EdgeThresholds(VerifyReport& r, const VerifyOptions& options) {
-  if (!r.passed) return;
-  const std::pair<const char*, const ErrorStats*> readers[] = {
-      {"per-face", &r.edge_per_face}, {"across-faces", &r.edge_across_faces}};
-  for (const auto& [reader, stats] : readers) {
-    if (r.edge_max_limit > 0 && stats->max > r.edge_max_limit) {
-      r.passed = false;
-      r.failure = fmt::format(
-          "edge steps ({} reader): max {:.4g} exceeds max_edge_step {} x tolerance {:.4g}", reader,
-          stats->max, options.max_edge_step, r.edge_tolerance);
-    } else if (r.edge_p99_limit > 0 && stats->p99 > r.edge_p99_limit) {
-      r.passed = false;
-      r.failure = fmt::format(
-          "edge steps ({} reader): p99 {:.4g} exceeds max_edge_step_p99 {} x tolerance {:.4g}",
-          reader, stats->p99, options.max_edge_step_p99, r.edge_tolerance);
-    }
-    if (!r.passed) {
-      for (const auto& w : r.worst_edges) {
-        if (std::string_view(w.reader) != reader) continue;
-        r.failure += fmt::format(" (worst: face {} edge {} at t {:.4g}, neighbour {}, step {:.4g})",
-                                 w.face, w.edge, w.t, w.neighbour, w.step);
-        break;
-      }
-      return;
-    }
-  }
-}
-
 // The map under test, open: its reader (MapReader) and what it points into, and what the map
 // records of the sculpt it was made from. Built in place: `reader` points into it.
 struct MapUnderTest {
@@ -615,8 +439,8 @@ struct MapUnderTest {
   std::optional<PtexFile> ptex;
   std::optional<UvMap> uv;
   std::optional<PtexUvCharts> charts;
-  std::vector<PtexFaceInfo> faces;                      // a Ptex map's (MapFacesOnSurface)
-  std::vector<std::vector<std::vector<float>>> fields;  // a Ptex map's (EdgeFields)
+  std::vector<PtexFaceInfo> faces;                      // a Ptex map's (MeasureEdgeSteps)
+  std::vector<std::vector<std::vector<float>>> fields;  // a Ptex map's (MeasureEdgeSteps)
   std::optional<PtexMapSampler> sampler;
   std::string sculpt_fingerprint;
   std::int64_t sculpt_vertices = 0;  // as the map records it (0: not recorded)
@@ -720,17 +544,8 @@ Status OpenPtexMap(const VerifyOptions& options, const LimitSurface& surface, Ma
   return Status::Ok();
 }
 
-// A Ptex map's steps at shared face edges (EdgeFields, MeasureEdges).
-Status MeasureEdgeSteps(const VerifyOptions& options, const Mesh& base, const LimitSurface& surface,
-                        MapUnderTest& m, VerifyReport& r) {
-  const PtexFile& map = *m.ptex;
-  m.faces = MapFacesOnSurface(surface, map);
-  DISPEX_RETURN_IF_ERROR(EdgeFields(surface, map, m.reader.space, m.faces, m.fields));
-  return MeasureEdges(base, surface, map, m.faces, m.fields, options, r);
-}
-
 // A scalar Ptex map compared with a truth is read across face edges (MapReader::TruthScalar),
-// from the texels EdgeFields read.
+// from the texels MeasureEdgeSteps read.
 void ReadAcrossFaces(const VerifyOptions& options, MapUnderTest& m) {
   if (!options.truth_path.empty() && !m.reader.space) {
     m.sampler.emplace(m.faces, m.fields[0]);
@@ -968,7 +783,7 @@ void ApplyBounds(const VerifyOptions& options, VerifyReport& r) {
     Threshold(r, "map->sculpt", r.map_to_sculpt, limit_abs, option);
     Threshold(r, "sculpt->map", r.sculpt_to_map, limit_abs, option);
   }
-  EdgeThresholds(r, options);
+  verify::EdgeThresholds(r, options);
   if (r.measured_truth) RmsThreshold(r, "truth", r.truth, options.max_rms);
   if (r.measured_distances) {
     RmsThreshold(r, "map->sculpt", r.map_to_sculpt, options.max_rms);
@@ -1000,7 +815,8 @@ StatusOr<VerifyReport> Verify(const VerifyOptions& options) {
     DISPEX_RETURN_IF_ERROR(OpenUvMap(options, base, surface, m, r));
   } else {
     DISPEX_RETURN_IF_ERROR(OpenPtexMap(options, surface, m, r));
-    DISPEX_RETURN_IF_ERROR(MeasureEdgeSteps(options, base, surface, m, r));
+    DISPEX_RETURN_IF_ERROR(verify::MeasureEdgeSteps(options, base, surface, *m.ptex, m.reader.space,
+                                                    m.faces, m.fields, r));
     ReadAcrossFaces(options, m);
   }
   if (!options.truth_path.empty()) DISPEX_RETURN_IF_ERROR(MeasureTruth(options, surface, m, r));
