@@ -61,9 +61,7 @@ def _mesh_or_path(value, argument):
                     f"mesh arrays")
 
 
-_MESH_KEYWORDS = {"crease_edges", "crease_sharpness", "corner_vertices", "corner_sharpness",
-                  "holes", "face_groups", "group_names", "boundary_interpolation",
-                  "crease_method", "triangle_subdivision", "uvs", "face_uv_indices", "name"}
+_MESH_KEYWORDS = set(_dispex._mesh_keywords())  # Mesh's keyword-only arguments
 
 
 def _check_progress(progress):

@@ -244,25 +244,28 @@ PyMesh MakeMesh(const py::handle& points, const py::handle& counts, const py::ha
   return PyMesh{std::make_shared<const Mesh>(std::move(mesh)), name};
 }
 
+// dispex.Mesh's arguments: the arrays it needs, and the keyword-only ones (dispex.extract checks
+// a dict of arrays against them too: dispex._dispex._mesh_keywords).
+const std::array<const char*, 3> kPositional = {"points", "face_vertex_counts",
+                                                "face_vertex_indices"};
+const std::array<const char*, 13> kKeywords = {"crease_edges",
+                                               "crease_sharpness",
+                                               "corner_vertices",
+                                               "corner_sharpness",
+                                               "holes",
+                                               "face_groups",
+                                               "group_names",
+                                               "boundary_interpolation",
+                                               "crease_method",
+                                               "uvs",
+                                               "face_uv_indices",
+                                               "triangle_subdivision",
+                                               "name"};
+
 // The arguments of dispex.Mesh(...), checked as the signature in its docstring says
 // (TypeError naming what is wrong), without pybind11's own argument types in the messages.
 // `_argument` (the name dispex.extract gives a dict of arrays in errors) is not documented.
 PyMesh MeshFromArguments(const py::args& args, const py::kwargs& kwargs) {
-  static const std::array<const char*, 3> kPositional = {"points", "face_vertex_counts",
-                                                         "face_vertex_indices"};
-  static const std::array<const char*, 13> kKeywords = {"crease_edges",
-                                                        "crease_sharpness",
-                                                        "corner_vertices",
-                                                        "corner_sharpness",
-                                                        "holes",
-                                                        "face_groups",
-                                                        "group_names",
-                                                        "boundary_interpolation",
-                                                        "crease_method",
-                                                        "uvs",
-                                                        "face_uv_indices",
-                                                        "triangle_subdivision",
-                                                        "name"};
   if (args.size() > kPositional.size()) {
     throw py::type_error(fmt::format(
         "Mesh: takes 3 positional arguments (points, face_vertex_counts, face_vertex_indices), "
@@ -463,6 +466,8 @@ void AddMesh(py::module_& module) {
                            m.mesh->num_faces());
       });
 
+  module.def("_mesh_keywords",
+             [] { return std::vector<std::string>(kKeywords.begin(), kKeywords.end()); });
   module.def(
       "read_mesh",
       [](const std::string& path) {

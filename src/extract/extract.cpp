@@ -329,10 +329,10 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   // A shard runs its faces' first pass only, no stage that crosses faces (the merge runs them).
   const std::vector<std::uint8_t> in_shard =
       ShardFaces(options, inputs, settings, face_keys, report);
-  PlanFaces(plan, inputs, face_keys.keys, &previous, in_shard);
+  std::vector<std::uint8_t> runs = PlanFaces(plan, inputs, face_keys.keys, &previous, in_shard);
   std::vector<std::uint8_t> reach;
   if (within_reach) {
-    reach = FacesWithinReach(inputs, face_keys.keys, previous, in_shard, shard ? 0 : kLocalRings);
+    reach = FacesWithinReach(inputs, std::move(runs), shard ? 0 : kLocalRings);
     // For a run that is not a shard, the whole sculpt when that is most of it.
     if (!shard && 2 * std::count(reach.begin(), reach.end(), 1) > plan.faces) {
       plan.tracer = ExtractPlan::Tracer::kWholeSculpt;

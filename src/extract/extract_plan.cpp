@@ -52,9 +52,11 @@ std::string ExtractPlanSummary(const ExtractPlan& plan) {
 
 namespace extract {
 
-void PlanFaces(ExtractPlan& plan, const ExtractInputs& inputs, std::span<const Hash128> keys,
-               const PreviousMap* previous, std::span<const std::uint8_t> in_shard) {
+std::vector<std::uint8_t> PlanFaces(ExtractPlan& plan, const ExtractInputs& inputs,
+                                    std::span<const Hash128> keys, const PreviousMap* previous,
+                                    std::span<const std::uint8_t> in_shard) {
   plan.faces_run = plan.faces_copied = plan.faces_elsewhere = plan.hole_faces = 0;
+  std::vector<std::uint8_t> runs(keys.size(), 0);
   for (std::size_t f = 0; f < keys.size(); ++f) {
     if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) {
       ++plan.hole_faces;
@@ -64,27 +66,20 @@ void PlanFaces(ExtractPlan& plan, const ExtractInputs& inputs, std::span<const H
       ++plan.faces_copied;
     } else {
       ++plan.faces_run;
+      runs[f] = 1;
     }
   }
+  return runs;
 }
 
 std::vector<std::uint8_t> FacesWithinReach(const ExtractInputs& inputs,
-                                           std::span<const Hash128> keys,
-                                           const PreviousMap& previous,
-                                           std::span<const std::uint8_t> in_shard, int rings) {
-  const auto n = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
-  std::vector<std::uint8_t> traced(n, 0);
+                                           std::vector<std::uint8_t> runs, int rings) {
   std::vector<int> ring;
-  for (std::size_t f = 0; f < n; ++f) {
-    if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
-    if (!in_shard.empty() && !in_shard[f]) continue;
-    if (!previous.usable() || !previous.Reusable(f, keys[f])) {
-      traced[f] = 1;
-      ring.push_back(static_cast<int>(f));
-    }
+  for (std::size_t f = 0; f < runs.size(); ++f) {
+    if (runs[f]) ring.push_back(static_cast<int>(f));
   }
-  AddRings(inputs.faces, rings, std::move(ring), traced);
-  return traced;
+  AddRings(inputs.faces, rings, std::move(ring), runs);
+  return runs;
 }
 
 nlohmann::json ExtractPlanJson(const ExtractPlan& plan) {
