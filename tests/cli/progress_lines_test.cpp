@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -17,6 +16,7 @@ namespace dispex {
 namespace {
 
 using testing::DataPath;
+using testing::MatchWhole;
 using testing::RunDispex;
 using testing::SculptOptions;
 using testing::TempDir;
@@ -53,14 +53,14 @@ TEST_F(ProgressLines, PipedLinesCountTheFacesToTheEnd) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::regex line_format(R"(progress extract (\d+)/(\d+))");
+  const std::string line_format = "progress extract ([0-9]+)/([0-9]+)";
   const std::vector<std::string> lines = Lines(r.err);
   ASSERT_FALSE(lines.empty()) << "no progress line";
   std::uint64_t last_done = 0, last_total = 0;
   for (const std::string& line : lines) {  // -q: nothing but the progress lines
-    std::smatch m;
-    ASSERT_TRUE(std::regex_match(line, m, line_format)) << "not a progress line: " << line;
-    const std::uint64_t done = std::stoull(m[1]), total = std::stoull(m[2]);
+    const auto m = MatchWhole(line, line_format);
+    ASSERT_TRUE(m) << "not a progress line: " << line;
+    const std::uint64_t done = std::stoull((*m)[1]), total = std::stoull((*m)[2]);
     EXPECT_EQ(total, kSpotPtexFaces) << line;
     EXPECT_LE(done, total) << line;
     EXPECT_GE(done, last_done) << line << ": done went back";

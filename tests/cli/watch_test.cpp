@@ -19,7 +19,6 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <stop_token>
@@ -35,6 +34,7 @@ namespace dispex {
 namespace {
 
 using testing::DataPath;
+using testing::MatchWhole;
 using testing::RunDispex;
 using testing::SculptOptions;
 using testing::Slurp;
@@ -134,17 +134,16 @@ class Watcher {
       buffer_.append(chunk, static_cast<std::size_t>(n));
     }
   }
-  // The next line, which must match `pattern`; its groups.
-  std::smatch Expect(const std::string& pattern, std::chrono::milliseconds timeout = 20s) {
+  // The next line, which must match `pattern` (POSIX extended); its groups, the whole line first.
+  std::vector<std::string> Expect(const std::string& pattern,
+                                  std::chrono::milliseconds timeout = 20s) {
     const std::optional<std::string> line = NextLine(timeout);
     EXPECT_TRUE(line.has_value()) << "no line matching " << pattern << "; stderr so far:\n" << all_;
-    std::smatch m;
-    if (line) {
-      last_ = *line;
-      EXPECT_TRUE(std::regex_match(last_, m, std::regex(pattern)))
-          << "expected " << pattern << "\n     got " << last_;
-    }
-    return m;
+    if (!line) return {};
+    last_ = *line;
+    std::optional<std::vector<std::string>> m = MatchWhole(last_, pattern);
+    EXPECT_TRUE(m) << "expected " << pattern << "\n     got " << last_;
+    return m.value_or(std::vector<std::string>{});
   }
   int Interrupt() {
     ::kill(pid_, SIGINT);
@@ -245,7 +244,7 @@ TEST(Watch, SavesAreExtractedAgainAndBrokenOnesLeaveTheMap) {
     }
   }
   ASSERT_TRUE(Slurp(sculpt_path) == sculpt_b);
-  auto m = w.Expect(R"(dispex: .*sculpt\.obj changed: (\d+) of 252 faces extracted again )"
+  auto m = w.Expect(R"(dispex: .*sculpt\.obj changed: ([0-9]+) of 252 faces extracted again )"
                     R"(\(sculpt\), .*map\.ptx written in .* s)");
   if (m.size() > 1) {
     EXPECT_GT(std::stoi(m[1]), 0);
@@ -262,7 +261,7 @@ TEST(Watch, SavesAreExtractedAgainAndBrokenOnesLeaveTheMap) {
     std::this_thread::sleep_for(std::chrono::milliseconds(kSettleMs / 5));
   }
   ASSERT_TRUE(Slurp(sculpt_path) == sculpt_c);
-  w.Expect(R"(dispex: .*sculpt\.obj changed: \d+ of 252 faces extracted again \(sculpt\), .*)");
+  w.Expect(R"(dispex: .*sculpt\.obj changed: [0-9]+ of 252 faces extracted again \(sculpt\), .*)");
   EXPECT_TRUE(Slurp(map_path) == map_c) << "the map is not the full extraction of the save";
 
   // A broken save (cut short, then a face of vertices that do not exist): one error line, the
@@ -274,13 +273,13 @@ TEST(Watch, SavesAreExtractedAgainAndBrokenOnesLeaveTheMap) {
   // A save by rename (a temporary file renamed onto the sculpt) is noticed.
   WriteFile(sculpt_path + ".tmp", sculpt_a);
   fs::rename(sculpt_path + ".tmp", sculpt_path);
-  w.Expect(R"(dispex: .*sculpt\.obj changed: \d+ of 252 faces extracted again \(sculpt\), .*)");
+  w.Expect(R"(dispex: .*sculpt\.obj changed: [0-9]+ of 252 faces extracted again \(sculpt\), .*)");
   EXPECT_TRUE(Slurp(map_path) == map_a) << "the map is not the full extraction of the save";
 
   // The base is watched too.
   WriteFile(base_path + ".tmp", moved_base);
   fs::rename(base_path + ".tmp", base_path);
-  w.Expect(R"(dispex: .*base\.obj changed: \d+ of 252 faces extracted again \(base\), .*)");
+  w.Expect(R"(dispex: .*base\.obj changed: [0-9]+ of 252 faces extracted again \(base\), .*)");
   EXPECT_TRUE(Slurp(map_path) == map_d) << "the map is not the full extraction of the save";
   // The report is rewritten each round.
   const nlohmann::json report = nlohmann::json::parse(Slurp(report_path));
@@ -318,7 +317,7 @@ TEST(Watch, InterruptedRoundLeavesTheMap) {
   // Rays at 128 samples a side: about a second on 2 cores.
   Watcher w({"extract", cage, make.output_path, "-o", map_path, "--watch", "--method", "rays",
              "--oversample", "128", "--progress-lines"});
-  const auto m = w.Expect(R"(progress extract (\d+)/252)");
+  const auto m = w.Expect(R"(progress extract ([0-9]+)/252)");
   ASSERT_EQ(m.size(), 2u);
   ASSERT_LT(std::stoi(m[1]), 200) << "the round was nearly done: no interruption to test";
   const auto sent = std::chrono::steady_clock::now();

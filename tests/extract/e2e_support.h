@@ -3,6 +3,7 @@
 #pragma once
 
 #include <gtest/gtest.h>
+#include <regex.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -215,6 +217,28 @@ inline CommandResult RunDispex(const std::string& args, const TempDir& dir,
   fs::remove(out);
   fs::remove(err);
   return r;
+}
+
+// Whether all of `line` matches the POSIX extended regular expression `pattern`; the groups
+// (whole match first) when it does. POSIX regex.h rather than std::regex: GCC 12 at -O1 under
+// AddressSanitizer warns (maybe-uninitialized) inside libstdc++'s regex compiler.
+inline std::optional<std::vector<std::string>> MatchWhole(const std::string& line,
+                                                          const std::string& pattern) {
+  regex_t re;
+  if (regcomp(&re, ("^(" + pattern + ")$").c_str(), REG_EXTENDED) != 0) {
+    ADD_FAILURE() << "bad pattern: " << pattern;
+    return std::nullopt;
+  }
+  std::array<regmatch_t, 10> groups{};
+  const bool matched = regexec(&re, line.c_str(), groups.size(), groups.data(), 0) == 0;
+  regfree(&re);
+  if (!matched) return std::nullopt;
+  std::vector<std::string> out;
+  // Group 1 is the whole-line wrapper added above; the pattern's own groups follow it.
+  for (std::size_t i = 1; i < groups.size() && groups[i].rm_so >= 0; ++i)
+    out.push_back(line.substr(static_cast<std::size_t>(groups[i].rm_so),
+                              static_cast<std::size_t>(groups[i].rm_eo - groups[i].rm_so)));
+  return out;
 }
 
 }  // namespace dispex::testing
