@@ -39,123 +39,148 @@ struct BatchArgs {
   bool quiet = false;
 };
 
-int RunBatch(BatchArgs& args) {
+// The manifest's assets, narrowed to --asset, and for --shard that asset's shard and part.
+StatusOr<std::vector<BatchAsset>> SelectAssets(const BatchArgs& args) {
   ExtractOptions defaults;
   defaults.threads = args.threads;
   defaults.incremental = args.incremental;
-  auto assets = ReadBatchManifest(args.manifest, defaults);
-  if (!assets.ok()) return ReportFailure(assets.status(), 2);
+  DISPEX_ASSIGN_OR_RETURN(std::vector<BatchAsset> assets,
+                          ReadBatchManifest(args.manifest, defaults));
   if (!args.asset.empty()) {
-    std::erase_if(*assets, [&](const BatchAsset& a) { return a.name != args.asset; });
-    if (assets->empty()) {
-      return ReportFailure(
-          Status::Error(fmt::format("--asset {}: no such asset in {}", args.asset, args.manifest)),
-          2);
+    std::erase_if(assets, [&](const BatchAsset& a) { return a.name != args.asset; });
+    if (assets.empty()) {
+      return Status::Error(
+          fmt::format("--asset {}: no such asset in {}", args.asset, args.manifest));
     }
   }
   if (!args.shard.empty()) {
     if (args.asset.empty() || args.parts_dir.empty()) {
-      return ReportFailure(Status::Error("--shard needs --asset and --parts-dir"), 2);
+      return Status::Error("--shard needs --asset and --parts-dir");
     }
-    ExtractOptions& o = assets->front().options;
+    ExtractOptions& o = assets.front().options;
     Status parsed = ParseShard(args.shard, o.shard_index, o.shard_count);
-    if (!parsed.ok()) return ReportFailure(parsed.WithPrefix("--shard"), 2);
+    if (!parsed.ok()) return parsed.WithPrefix("--shard");
     auto shard_sculpt = ParseShardSculpt(args.shard_sculpt);
-    if (!shard_sculpt.ok()) {
-      return ReportFailure(shard_sculpt.status().WithPrefix("--shard-sculpt"), 2);
-    }
+    if (!shard_sculpt.ok()) return shard_sculpt.status().WithPrefix("--shard-sculpt");
     o.shard_sculpt = *shard_sculpt;
     o.output_path = PartPath(args.parts_dir, args.asset, o.shard_index, o.shard_count);
   } else if (!args.parts_dir.empty()) {
-    return ReportFailure(Status::Error("--parts-dir needs --shard"), 2);
+    return Status::Error("--parts-dir needs --shard");
   }
   if (!args.view_dir.empty() && !args.shard.empty()) {
-    return ReportFailure(Status::Error("--view shows whole maps: not with --shard"), 2);
+    return Status::Error("--view shows whole maps: not with --shard");
   }
-  const Status outputs =
-      CheckOutputs({{"--report", args.report_path}, {"--view", args.view_dir, true}});
-  if (!outputs.ok()) return ReportFailure(outputs, 2);
-  InstallCancelSignalHandlers();
+  DISPEX_RETURN_IF_ERROR(
+      CheckOutputs({{"--report", args.report_path}, {"--view", args.view_dir, true}}));
+  return assets;
+}
+
+// What the batch has done so far: its report, failures and review pages.
+struct BatchRun {
   nlohmann::json report;
-  report["manifest"] = args.manifest;
-  report["assets"] = nlohmann::json::array();
   int failed = 0;
   std::vector<ViewIndexEntry> pages;
   int pages_failed = 0;
+};
+
+// The asset's review page (dispex view), its sculpt and its extraction's report in it.
+void WriteAssetPage(const BatchArgs& args, const BatchAsset& asset, const std::string& extract_json,
+                    const std::string& progress, nlohmann::json& entry, BatchRun& run) {
+  ViewPageOptions view;
+  view.base_path = asset.options.base_path;
+  view.map_path = asset.options.output_path;
+  view.sculpt_path = asset.options.sculpt_path;
+  view.extract_report_json = extract_json;
+  view.title = asset.name;
+  view.threads = args.threads;
+  const std::string page = asset.name + ".html";
+  const std::string path = (std::filesystem::path(args.view_dir) / page).string();
+  StatusOr<ViewPageReport> shown = WriteViewPage(view, path);
+  if (shown.ok()) {
+    entry["view"] = path;
+    run.pages.push_back({asset.name, page, "ok",
+                         fmt::format("{} map, {} Ptex faces, {:.1f} MB page", shown->map_kind,
+                                     shown->ptex_faces, double(shown->page_bytes) / 1e6)});
+    return;
+  }
+  ++run.pages_failed;
+  entry["view_error"] = shown.status().message();
+  run.pages.push_back({asset.name, "", "no page", shown.status().message()});
+  std::fprintf(stderr, "dispex: %s %s: page FAILED: %s\n", progress.c_str(), asset.name.c_str(),
+               shown.status().message().c_str());
+}
+
+// One asset extracted (its output folder made when missing, as a farm's merge job makes it),
+// its entry in the report, and its page with --view.
+void RunAsset(const BatchArgs& args, const BatchAsset& asset, const std::string& progress,
+              BatchRun& run) {
+  std::error_code ec;
+  std::filesystem::create_directories(
+      std::filesystem::path(asset.options.output_path).parent_path(), ec);
+  StatusOr<ExtractReport> r = Extract(asset.options);
+  nlohmann::json entry = {{"name", asset.name}, {"output", asset.options.output_path}};
+  if (r.ok()) {
+    entry["status"] = "ok";
+    const std::string extract_json = ExtractReportJson(*r);
+    entry["report"] = nlohmann::json::parse(extract_json);
+    if (!args.quiet) {
+      std::fprintf(stderr, "dispex: %s %s: %s, %.2fs, peak %.0f MB -> %s\n", progress.c_str(),
+                   asset.name.c_str(), r->unchanged ? "up to date" : "ok", r->t_total,
+                   double(r->peak_rss_bytes) / 1e6, asset.options.output_path.c_str());
+    }
+    if (!args.view_dir.empty()) WriteAssetPage(args, asset, extract_json, progress, entry, run);
+  } else {
+    ++run.failed;
+    const std::string message = WithFlagNames(r.status().message(), kBatchFlags);
+    entry["status"] = "failed";
+    entry["error"] = message;
+    std::fprintf(stderr, "dispex: %s %s: FAILED: %s\n", progress.c_str(), asset.name.c_str(),
+                 message.c_str());
+    run.pages.push_back({asset.name, "", "failed", message});
+  }
+  run.report["assets"].push_back(std::move(entry));
+}
+
+// The batch's index page, linking each asset's.
+Status WriteIndexPage(const BatchArgs& args, BatchRun& run) {
+  const std::string index = MakeViewIndex(
+      std::filesystem::path(args.manifest).filename().string() + " - dispex batch", run.pages);
+  const std::string path = (std::filesystem::path(args.view_dir) / "index.html").string();
+  Status written = WriteFileAtomically(path, index.data(), index.size());
+  if (!written.ok()) return written.WithPrefix("--view");
+  run.report["view_index"] = path;
+  if (!args.quiet) std::fprintf(stderr, "dispex: %s: %zu pages\n", path.c_str(), run.pages.size());
+  return Status::Ok();
+}
+
+int RunBatch(BatchArgs& args) {
+  auto assets = SelectAssets(args);
+  if (!assets.ok()) return ReportFailure(assets.status(), 2);
+  InstallCancelSignalHandlers();
+  BatchRun run;
+  run.report["manifest"] = args.manifest;
+  run.report["assets"] = nlohmann::json::array();
   const std::size_t n = assets->size();
   for (std::size_t k = 0; k < n && !CancelRequested(); ++k) {
-    const BatchAsset& asset = (*assets)[k];
-    // The output folder is the asset's own: made when missing, as a farm's merge job makes it.
-    std::error_code ec;
-    std::filesystem::create_directories(
-        std::filesystem::path(asset.options.output_path).parent_path(), ec);
-    StatusOr<ExtractReport> r = Extract(asset.options);
-    nlohmann::json entry = {{"name", asset.name}, {"output", asset.options.output_path}};
-    if (r.ok()) {
-      entry["status"] = "ok";
-      const std::string extract_json = ExtractReportJson(*r);
-      entry["report"] = nlohmann::json::parse(extract_json);
-      if (!args.quiet) {
-        std::fprintf(stderr, "dispex: [%zu/%zu] %s: %s, %.2fs, peak %.0f MB -> %s\n", k + 1, n,
-                     asset.name.c_str(), r->unchanged ? "up to date" : "ok", r->t_total,
-                     double(r->peak_rss_bytes) / 1e6, asset.options.output_path.c_str());
-      }
-      if (!args.view_dir.empty()) {
-        // The asset's review page (dispex view), its sculpt and its extraction's report in it.
-        ViewPageOptions view;
-        view.base_path = asset.options.base_path;
-        view.map_path = asset.options.output_path;
-        view.sculpt_path = asset.options.sculpt_path;
-        view.extract_report_json = extract_json;
-        view.title = asset.name;
-        view.threads = args.threads;
-        const std::string page = asset.name + ".html";
-        const std::string path = (std::filesystem::path(args.view_dir) / page).string();
-        StatusOr<ViewPageReport> shown = WriteViewPage(view, path);
-        if (shown.ok()) {
-          entry["view"] = path;
-          pages.push_back({asset.name, page, "ok",
-                           fmt::format("{} map, {} Ptex faces, {:.1f} MB page", shown->map_kind,
-                                       shown->ptex_faces, double(shown->page_bytes) / 1e6)});
-        } else {
-          ++pages_failed;
-          entry["view_error"] = shown.status().message();
-          pages.push_back({asset.name, "", "no page", shown.status().message()});
-          std::fprintf(stderr, "dispex: [%zu/%zu] %s: page FAILED: %s\n", k + 1, n,
-                       asset.name.c_str(), shown.status().message().c_str());
-        }
-      }
-    } else {
-      ++failed;
-      const std::string message = WithFlagNames(r.status().message(), kBatchFlags);
-      entry["status"] = "failed";
-      entry["error"] = message;
-      std::fprintf(stderr, "dispex: [%zu/%zu] %s: FAILED: %s\n", k + 1, n, asset.name.c_str(),
-                   message.c_str());
-      pages.push_back({asset.name, "", "failed", message});
-    }
-    report["assets"].push_back(std::move(entry));
+    RunAsset(args, (*assets)[k], fmt::format("[{}/{}]", k + 1, n), run);
   }
-  report["failed"] = failed;
-  if (!args.view_dir.empty()) report["pages_failed"] = pages_failed;
+  run.report["failed"] = run.failed;
   if (!args.view_dir.empty()) {
-    const std::string index = MakeViewIndex(
-        std::filesystem::path(args.manifest).filename().string() + " - dispex batch", pages);
-    const std::string path = (std::filesystem::path(args.view_dir) / "index.html").string();
-    Status written = WriteFileAtomically(path, index.data(), index.size());
-    if (!written.ok()) return ReportFailure(written.WithPrefix("--view"));
-    report["view_index"] = path;
-    if (!args.quiet) std::fprintf(stderr, "dispex: %s: %zu pages\n", path.c_str(), pages.size());
+    run.report["pages_failed"] = run.pages_failed;
+    const Status index = WriteIndexPage(args, run);
+    if (!index.ok()) return ReportFailure(index);
   }
   if (!args.report_path.empty()) {
-    const std::string text = report.dump(2) + "\n";
+    const std::string text = run.report.dump(2) + "\n";
     Status written = WriteFileAtomically(args.report_path, text.data(), text.size());
     if (!written.ok()) return ReportFailure(written.WithPrefix("--report"));
   }
   if (const int sig = CancelSignal()) return ReportFailure(Status::Error("cancelled"), 128 + sig);
-  if (failed > 0) std::fprintf(stderr, "dispex: %d of %zu assets failed\n", failed, n);
-  if (pages_failed > 0) std::fprintf(stderr, "dispex: %d review pages failed\n", pages_failed);
-  if (failed > 0 || pages_failed > 0) return 1;
+  if (run.failed > 0) std::fprintf(stderr, "dispex: %d of %zu assets failed\n", run.failed, n);
+  if (run.pages_failed > 0) {
+    std::fprintf(stderr, "dispex: %d review pages failed\n", run.pages_failed);
+  }
+  if (run.failed > 0 || run.pages_failed > 0) return 1;
   if (!args.quiet && n > 1) std::fprintf(stderr, "dispex: all %zu assets done\n", n);
   return 0;
 }

@@ -214,108 +214,138 @@ std::optional<ChunkCopy> CopyChunk(int fd, const char* file_begin, const Chunk& 
   return ChunkCopy{buffer.data(), {begin, begin + (chunk.end - chunk.begin)}};
 }
 
-// `bytes` is the mapping of the open file `mapped_fd`, or a buffer in memory when it is -1: a
-// mapping's chunks are counted and parsed from copies read from `mapped_fd` (CopyChunk).
-StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
-                              const ReadOptions& options, int mapped_fd) {
-  const bool mapped = mapped_fd >= 0;
-  const std::size_t chunk_bytes =
-      options.chunk_bytes > 0 ? options.chunk_bytes : kDefaultChunkBytes;
-  const std::vector<Chunk> chunks = CutIntoChunks(bytes, chunk_bytes);
-  const std::size_t n = chunks.size();
-  const char* file_begin = bytes.data();
+// Both passes read a mapped file's chunks as copies, each with the two bytes before it that a
+// continued newline looks back at, into a buffer of its thread's (CopyChunk): the buffers'
+// pages are first touched once and reused chunk after chunk, where the mapping's pages were each
+// first touched by a pass (docs/BENCHMARKS.md, "Memory"). The file is the one mapped
+// (MappedFile::fd), not whatever its path names now. A chunk that cannot be copied is read
+// through the mapping, its pages mapped in one call and dropped after it. A buffer in memory
+// (no file descriptor) is read in place.
+class ChunkReader {
+ public:
+  ChunkReader(std::string_view bytes, const std::vector<Chunk>& chunks, int mapped_fd)
+      : file_begin_(bytes.data()), chunks_(chunks), mapped_fd_(mapped_fd) {}
 
-  std::vector<ChunkCounts> counts(n);
-  std::vector<mesh::ChunkOutput> outputs(n);
-  Mesh mesh;
-  mesh.source = name;
-  std::vector<mesh::ChunkInput> inputs(n);
-  std::atomic<bool> out_of_memory{false};
-
-  // Both passes read a mapped file's chunks as copies, each with the two bytes before it that a
-  // continued newline looks back at, into a buffer of its thread's (CopyChunk): the buffers'
-  // pages are first touched once and reused chunk after chunk, where the mapping's pages were each
-  // first touched by a pass (docs/BENCHMARKS.md, "Memory"). The file is the one mapped
-  // (MappedFile::fd), not whatever its path names now. A chunk that cannot be copied is read
-  // through the mapping, its pages mapped in one call and dropped after it.
-  // with_bytes(i, use) calls use(look_back_start, chunk) on chunk i's bytes.
-  tbb::enumerable_thread_specific<std::vector<char>> copies;
-  auto with_bytes = [&](std::size_t i, auto&& use) {
-    const Chunk& chunk = chunks[i];
+  // Calls use(look_back_start, chunk) on chunk i's bytes.
+  template <class Use>
+  void WithBytes(std::size_t i, Use&& use) {
+    const Chunk& chunk = chunks_[i];
+    const bool mapped = mapped_fd_ >= 0;
     if (mapped) {
       if (const std::optional<ChunkCopy> copy =
-              CopyChunk(mapped_fd, file_begin, chunk, copies.local())) {
+              CopyChunk(mapped_fd_, file_begin_, chunk, copies_.local())) {
         use(copy->file_begin, copy->chunk);
         return;
       }
       PopulateMappedPages(chunk.begin, static_cast<std::size_t>(chunk.end - chunk.begin));
     }
-    use(file_begin, chunk);
+    use(file_begin_, chunk);
     if (mapped) ReleaseMappedPages(chunk.begin, chunk.end);
-  };
-  RunWithThreads(options.threads, [&] {
+  }
+
+ private:
+  const char* file_begin_;
+  const std::vector<Chunk>& chunks_;
+  int mapped_fd_;
+  tbb::enumerable_thread_specific<std::vector<char>> copies_;
+};
+
+// The counting pass (step 2), in parallel.
+std::vector<ChunkCounts> CountChunks(ChunkReader& reader, std::size_t n, int threads) {
+  std::vector<ChunkCounts> counts(n);
+  RunWithThreads(threads, [&] {
     tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      with_bytes(i, [&](const char* look_back, const Chunk& chunk) {
+      reader.WithBytes(i, [&](const char* look_back, const Chunk& chunk) {
         counts[i] = CountChunk(look_back, chunk);
       });
     });
   });
+  return counts;
+}
 
-  std::int64_t lines = 0, vertices = 0, texcoords = 0, faces = 0, corners_counted = 0;
+// The file's totals from the counting pass.
+struct FileCounts {
+  std::int64_t lines = 0, vertices = 0, texcoords = 0, faces = 0, corners = 0;
   // Whether every face line's corners were counted: they are then parsed in place.
   bool in_place = true;
-  std::vector<std::int64_t> corner_base(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    corner_base[i] = corners_counted;
-    corners_counted += counts[i].corners;
-    in_place = in_place && counts[i].plain;
-    inputs[i].first_line = lines + 1;
-    inputs[i].vertex_base = vertices;
-    inputs[i].texcoord_base = texcoords;
-    inputs[i].face_base = faces;
-    lines += counts[i].lines;
-    vertices += counts[i].vertices;
-    texcoords += counts[i].texcoords;
-    faces += counts[i].faces;
+};
+
+// Prefix sums of the counts: each chunk's first line number and its vertex, texture
+// coordinate and face bases in `inputs`, its first corner in `corner_base`.
+FileCounts SumCounts(const std::vector<ChunkCounts>& counts, std::vector<mesh::ChunkInput>& inputs,
+                     std::vector<std::int64_t>& corner_base) {
+  FileCounts total;
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    corner_base[i] = total.corners;
+    total.corners += counts[i].corners;
+    total.in_place = total.in_place && counts[i].plain;
+    inputs[i].first_line = total.lines + 1;
+    inputs[i].vertex_base = total.vertices;
+    inputs[i].texcoord_base = total.texcoords;
+    inputs[i].face_base = total.faces;
+    total.lines += counts[i].lines;
+    total.vertices += counts[i].vertices;
+    total.texcoords += counts[i].texcoords;
+    total.faces += counts[i].faces;
   }
-  // Vertex ids are int32 (OpenSubdiv, Embree) and so are face ids.
-  if (vertices > std::numeric_limits<std::int32_t>::max()) {
+  total.in_place = total.in_place && total.corners <= std::numeric_limits<std::uint32_t>::max();
+  return total;
+}
+
+// Vertex ids are int32 (OpenSubdiv, Embree) and so are face ids.
+Status CheckCounts(const FileCounts& total, const std::string& name) {
+  if (total.vertices > std::numeric_limits<std::int32_t>::max()) {
     return Status::Error(
-        fmt::format("{}: {} vertices: more than the 2^31-1 supported", name, vertices));
+        fmt::format("{}: {} vertices: more than the 2^31-1 supported", name, total.vertices));
   }
-  if (faces > std::numeric_limits<std::int32_t>::max()) {
-    return Status::Error(fmt::format("{}: {} faces: more than the 2^31-1 supported", name, faces));
-  }
-  if (texcoords > std::numeric_limits<std::int32_t>::max()) {
+  if (total.faces > std::numeric_limits<std::int32_t>::max()) {
     return Status::Error(
-        fmt::format("{}: {} texture coordinates: more than the 2^31-1 supported", name, texcoords));
+        fmt::format("{}: {} faces: more than the 2^31-1 supported", name, total.faces));
   }
-  in_place = in_place && corners_counted <= std::numeric_limits<std::uint32_t>::max();
+  if (total.texcoords > std::numeric_limits<std::int32_t>::max()) {
+    return Status::Error(fmt::format("{}: {} texture coordinates: more than the 2^31-1 supported",
+                                     name, total.texcoords));
+  }
+  return Status::Ok();
+}
+
+// Sizes the final arrays (their pages first touched in parallel) and points each chunk's input
+// at its part of them.
+void AllocateArrays(const FileCounts& total, const std::vector<ChunkCounts>& counts,
+                    const std::vector<std::int64_t>& corner_base, int threads, Mesh& mesh,
+                    std::vector<mesh::ChunkInput>& inputs) {
   // Embree reads 16 bytes at the last vertex: keep one spare element of capacity.
-  RunWithThreads(options.threads, [&] {
-    ReserveTouched(mesh.positions, static_cast<std::size_t>(vertices) + 1);
-    AssignTouched(mesh.face_offsets, static_cast<std::size_t>(faces) + 1, 0u);
-    AssignTouched(mesh.uvs, 2 * static_cast<std::size_t>(texcoords), 0.0f);
-    if (in_place) AssignTouched(mesh.face_indices, static_cast<std::size_t>(corners_counted), 0);
+  RunWithThreads(threads, [&] {
+    ReserveTouched(mesh.positions, static_cast<std::size_t>(total.vertices) + 1);
+    AssignTouched(mesh.face_offsets, static_cast<std::size_t>(total.faces) + 1, 0u);
+    AssignTouched(mesh.uvs, 2 * static_cast<std::size_t>(total.texcoords), 0.0f);
+    if (total.in_place) {
+      AssignTouched(mesh.face_indices, static_cast<std::size_t>(total.corners), 0);
+    }
   });
-  mesh.positions.resize(static_cast<std::size_t>(vertices));
-  for (std::size_t i = 0; i < n; ++i) {
+  mesh.positions.resize(static_cast<std::size_t>(total.vertices));
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
     mesh::ChunkInput& in = inputs[i];
-    in.num_vertices = vertices;
-    in.num_texcoords = texcoords;
-    in.num_faces = faces;
+    in.num_vertices = total.vertices;
+    in.num_texcoords = total.texcoords;
+    in.num_faces = total.faces;
     in.positions = mesh.positions.data();
     in.uvs = mesh.uvs.data();
     in.face_sizes = mesh.face_offsets.data() + 1;
-    if (in_place) {
+    if (total.in_place) {
       in.indices = mesh.face_indices.data() + corner_base[i];
       in.corners = counts[i].corners;
     }
   }
+}
 
-  RunWithThreads(options.threads, [&] {
-    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      with_bytes(i, [&](const char* look_back, const Chunk& chunk) {
+// The parsing pass (step 3), in parallel; false when a chunk ran out of memory.
+bool ParseChunks(ChunkReader& reader, std::vector<mesh::ChunkInput>& inputs,
+                 std::vector<mesh::ChunkOutput>& outputs, int threads) {
+  std::atomic<bool> out_of_memory{false};
+  RunWithThreads(threads, [&] {
+    tbb::parallel_for(std::size_t{0}, inputs.size(), [&](std::size_t i) {
+      reader.WithBytes(i, [&](const char* look_back, const Chunk& chunk) {
         mesh::ChunkInput& in = inputs[i];
         in.file_begin = look_back;
         in.begin = chunk.begin;
@@ -324,64 +354,84 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
       });
     });
   });
-  if (out_of_memory.load()) return Status::Error(name + ": out of memory while reading");
+  return !out_of_memory.load();
+}
 
+// What the parsing pass read, over all chunks.
+struct ParsedCounts {
   std::uint64_t corners = 0;
-  std::int64_t faces_without_uvs = 0, first_face_without_uvs = -1, faces_before = 0;
-  for (std::size_t i = 0; i < n; ++i) {
+  std::int64_t faces_without_uvs = 0, first_face_without_uvs = -1;
+};
+
+// The first error of the earliest chunk, else the corners and the faces without UVs; fails for
+// a file without faces or with more corners than 32-bit offsets hold.
+StatusOr<ParsedCounts> CheckOutputs(const std::vector<mesh::ChunkOutput>& outputs,
+                                    const std::vector<ChunkCounts>& counts, const FileCounts& total,
+                                    const std::string& name) {
+  ParsedCounts parsed;
+  std::int64_t faces_before = 0;
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
     const mesh::ChunkOutput& out = outputs[i];
     if (out.error) return LineError(name, out.error->line, out.error->message);
     DISPEX_CHECK_EQ(out.vertices, counts[i].vertices);
     DISPEX_CHECK_EQ(out.texcoords, counts[i].texcoords);
     DISPEX_CHECK_EQ(out.faces, counts[i].faces);
     // In place, a chunk parsed without error read the corners counted (CountFaceCorners).
-    if (in_place) DISPEX_CHECK_EQ(out.corners, counts[i].corners);
-    corners += in_place ? static_cast<std::uint64_t>(out.corners) : out.indices.size();
-    faces_without_uvs += out.faces - out.faces_with_uvs;
-    if (first_face_without_uvs < 0 && out.first_face_without_uvs >= 0) {
-      first_face_without_uvs = faces_before + out.first_face_without_uvs;
+    if (total.in_place) DISPEX_CHECK_EQ(out.corners, counts[i].corners);
+    parsed.corners += total.in_place ? static_cast<std::uint64_t>(out.corners) : out.indices.size();
+    parsed.faces_without_uvs += out.faces - out.faces_with_uvs;
+    if (parsed.first_face_without_uvs < 0 && out.first_face_without_uvs >= 0) {
+      parsed.first_face_without_uvs = faces_before + out.first_face_without_uvs;
     }
     faces_before += out.faces;
   }
-  if (faces == 0) {
+  if (total.faces == 0) {
     return Status::Error(
-        fmt::format("{}: no faces ({} vertices): not a polygon mesh", name, vertices));
+        fmt::format("{}: no faces ({} vertices): not a polygon mesh", name, total.vertices));
   }
-  if (corners > std::numeric_limits<std::uint32_t>::max()) {
+  if (parsed.corners > std::numeric_limits<std::uint32_t>::max()) {
     return Status::Error(
-        fmt::format("{}: {} face corners: more than the 2^32-1 supported", name, corners));
+        fmt::format("{}: {} face corners: more than the 2^32-1 supported", name, parsed.corners));
   }
+  return parsed;
+}
 
-  // Face sizes -> offsets.
+void FaceSizesToOffsets(Mesh& mesh) {
   std::uint32_t offset = 0;
   for (std::size_t f = 1; f < mesh.face_offsets.size(); ++f) {
     offset += mesh.face_offsets[f];
     mesh.face_offsets[f] = offset;
   }
-  if (!in_place) {
-    RunWithThreads(options.threads, [&] {
-      AppendInOrder(outputs, &mesh::ChunkOutput::indices, corners, mesh.face_indices);
+}
+
+// The face indices not parsed in place, and the UV indices when every face had them (see
+// Mesh::faces_without_uvs), appended in file order; the UVs dropped otherwise.
+void MergeIndices(std::vector<mesh::ChunkOutput>& outputs, const FileCounts& total,
+                  const ParsedCounts& parsed, int threads, Mesh& mesh) {
+  if (!total.in_place) {
+    RunWithThreads(threads, [&] {
+      AppendInOrder(outputs, &mesh::ChunkOutput::indices, parsed.corners, mesh.face_indices);
     });
   }
-  // UVs: all faces or none (see Mesh::faces_without_uvs).
-  if (faces_without_uvs == 0 && texcoords > 0) {
-    RunWithThreads(options.threads, [&] {
-      AppendInOrder(outputs, &mesh::ChunkOutput::uv_indices, corners, mesh.face_uv_indices);
+  if (parsed.faces_without_uvs == 0 && total.texcoords > 0) {
+    RunWithThreads(threads, [&] {
+      AppendInOrder(outputs, &mesh::ChunkOutput::uv_indices, parsed.corners, mesh.face_uv_indices);
     });
     DISPEX_CHECK_EQ(mesh.face_uv_indices.size(), mesh.face_indices.size());
-  } else {
-    for (auto& out : outputs) out.uv_indices.Release();
-    std::vector<float>().swap(mesh.uvs);
-    if (faces_without_uvs < faces) {
-      mesh.faces_without_uvs = static_cast<std::size_t>(faces_without_uvs);
-      mesh.first_face_without_uvs = static_cast<std::size_t>(first_face_without_uvs);
-    }
+    return;
   }
+  for (auto& out : outputs) out.uv_indices.Release();
+  std::vector<float>().swap(mesh.uvs);
+  if (parsed.faces_without_uvs < total.faces) {
+    mesh.faces_without_uvs = static_cast<std::size_t>(parsed.faces_without_uvs);
+    mesh.first_face_without_uvs = static_cast<std::size_t>(parsed.first_face_without_uvs);
+  }
+}
 
-  MergeGroups(outputs, mesh);
-
-  for (auto& out : outputs) {
-    SubdivTags& tags = mesh.tags;
+// The chunks' tags in file order; a setting from the file is the last chunk's that has one.
+void MergeTags(const std::vector<mesh::ChunkOutput>& outputs, Mesh& mesh) {
+  SubdivTags& tags = mesh.tags;
+  for (const auto& out : outputs) {
     tags.creases.insert(tags.creases.end(), out.tags.creases.begin(), out.tags.creases.end());
     tags.corners.insert(tags.corners.end(), out.tags.corners.begin(), out.tags.corners.end());
     tags.holes.insert(tags.holes.end(), out.tags.holes.begin(), out.tags.holes.end());
@@ -400,6 +450,37 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
     tags.ignored_tag_names.insert(tags.ignored_tag_names.end(), out.tags.ignored_tag_names.begin(),
                                   out.tags.ignored_tag_names.end());
   }
+}
+
+// `bytes` is the mapping of the open file `mapped_fd`, or a buffer in memory when it is -1: a
+// mapping's chunks are counted and parsed from copies read from `mapped_fd` (ChunkReader).
+// The steps are those of the comment at the top of this file.
+StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
+                              const ReadOptions& options, int mapped_fd) {
+  const std::size_t chunk_bytes =
+      options.chunk_bytes > 0 ? options.chunk_bytes : kDefaultChunkBytes;
+  const std::vector<Chunk> chunks = CutIntoChunks(bytes, chunk_bytes);
+  const std::size_t n = chunks.size();
+  ChunkReader reader(bytes, chunks, mapped_fd);
+  const std::vector<ChunkCounts> counts = CountChunks(reader, n, options.threads);
+
+  std::vector<mesh::ChunkInput> inputs(n);
+  std::vector<std::int64_t> corner_base(n);
+  const FileCounts total = SumCounts(counts, inputs, corner_base);
+  DISPEX_RETURN_IF_ERROR(CheckCounts(total, name));
+  Mesh mesh;
+  mesh.source = name;
+  AllocateArrays(total, counts, corner_base, options.threads, mesh, inputs);
+
+  std::vector<mesh::ChunkOutput> outputs(n);
+  if (!ParseChunks(reader, inputs, outputs, options.threads)) {
+    return Status::Error(name + ": out of memory while reading");
+  }
+  DISPEX_ASSIGN_OR_RETURN(const ParsedCounts parsed, CheckOutputs(outputs, counts, total, name));
+  FaceSizesToOffsets(mesh);
+  MergeIndices(outputs, total, parsed, options.threads, mesh);
+  MergeGroups(outputs, mesh);
+  MergeTags(outputs, mesh);
   return mesh;
 }
 

@@ -117,8 +117,19 @@ class ElementSplit {
   }
 
  private:
-  // owner_: the element's one shape (>= 0), kUnused, or EncodeShared(s) for the s-th shared one.
+  // The steps of Build, in order.
+  Status FindLowestShapes(const Mesh& mesh, std::span<const std::int32_t> indices,
+                          std::size_t num_elements, std::string_view what);
+  std::size_t EncodeOwners(const Mesh& mesh, std::span<const std::int32_t> indices,
+                           bool& any_shared);
+  void ListSharedShapes(const Mesh& mesh, std::span<const std::int32_t> indices,
+                        std::size_t num_shared);
+  void NumberInShapes(std::size_t num_elements, std::size_t num_shapes);
+
+  // owner_: the element's one shape (>= 0), kUnused, or EncodeShared(s) for the s-th shared one;
+  // kUnseen while FindLowestShapes runs, for an element no face has used yet.
   static constexpr std::int32_t kUnused = -1;
+  static constexpr std::int32_t kUnseen = std::numeric_limits<std::int32_t>::max();
   static std::int32_t EncodeShared(std::size_t s) { return -2 - static_cast<std::int32_t>(s); }
   static std::size_t SharedIndex(std::int32_t owner) {
     return static_cast<std::size_t>(-2 - owner);
@@ -158,12 +169,22 @@ StatusOr<ElementSplit> ElementSplit::Build(const Mesh& mesh, std::span<const std
                                            std::size_t num_elements, std::size_t num_shapes,
                                            std::string_view what) {
   ElementSplit split;
-  constexpr std::int32_t kNone = std::numeric_limits<std::int32_t>::max();
-  std::vector<std::int32_t>& owner = split.owner_;
-  owner.assign(num_elements, kNone);
-  const auto n = static_cast<std::int64_t>(num_elements);
+  DISPEX_RETURN_IF_ERROR(split.FindLowestShapes(mesh, indices, num_elements, what));
+  bool any_shared = false;
+  const std::size_t num_shared = split.EncodeOwners(mesh, indices, any_shared);
+  if (num_shared > 0) split.ListSharedShapes(mesh, indices, num_shared);
+  split.NumberInShapes(num_elements, num_shapes);
+  DISPEX_CHECK(!any_shared || split.first_shared_ >= 0);
+  return split;
+}
 
-  // Each element's lowest shape.
+// Each element's lowest shape, in owner_ (kUnseen for an element no face uses); fails for the
+// lowest face with an index out of range.
+Status ElementSplit::FindLowestShapes(const Mesh& mesh, std::span<const std::int32_t> indices,
+                                      std::size_t num_elements, std::string_view what) {
+  std::vector<std::int32_t>& owner = owner_;
+  owner.assign(num_elements, kUnseen);
+  const auto n = static_cast<std::int64_t>(num_elements);
   FirstError error;
   ParallelForFaces(mesh, [&](std::size_t f, std::size_t begin, std::size_t end, std::int32_t g) {
     for (std::size_t c = begin; c < end; ++c) {
@@ -180,113 +201,122 @@ StatusOr<ElementSplit> ElementSplit::Build(const Mesh& mesh, std::span<const std
       }
     }
   });
-  if (error.failed()) return error.status();
+  return error.failed() ? error.status() : Status::Ok();
+}
 
-  // Elements that a face of a higher shape uses too.
+// Marks the elements that a face of a higher shape uses too, and encodes owner_: kUnused, the
+// one shape, or the shared element's index. Returns the number of shared elements; sets
+// `any_shared` when a face found one.
+std::size_t ElementSplit::EncodeOwners(const Mesh& mesh, std::span<const std::int32_t> indices,
+                                       bool& any_shared) {
+  std::vector<std::int32_t>& owner = owner_;
+  const std::size_t num_elements = owner.size();
   std::vector<std::uint8_t> shared(num_elements, 0);
-  std::atomic<bool> any_shared{false};
+  std::atomic<bool> found{false};
   ParallelForFaces(mesh, [&](std::size_t, std::size_t begin, std::size_t end, std::int32_t g) {
     for (std::size_t c = begin; c < end; ++c) {
       const auto v = static_cast<std::size_t>(indices[c]);
       if (owner[v] != g) {
         std::atomic_ref<std::uint8_t>(shared[v]).store(1, std::memory_order_relaxed);
-        any_shared.store(true, std::memory_order_relaxed);
+        found.store(true, std::memory_order_relaxed);
       }
     }
   });
-
   std::size_t num_shared = 0;
   for (std::size_t v = 0; v < num_elements; ++v) {
-    if (owner[v] == kNone) {
+    if (owner[v] == kUnseen) {
       owner[v] = kUnused;
     } else if (shared[v] != 0) {
-      if (split.first_shared_ < 0) split.first_shared_ = static_cast<std::int32_t>(v);
+      if (first_shared_ < 0) first_shared_ = static_cast<std::int32_t>(v);
       owner[v] = EncodeShared(num_shared++);
     }
   }
-  std::vector<std::uint8_t>().swap(shared);
+  any_shared = found.load();
+  return num_shared;
+}
 
-  // The shapes of each shared element: its corners sorted by element, then deduplicated.
-  if (num_shared > 0) {
-    std::vector<std::size_t>& start = split.shared_start_;
-    start.assign(num_shared + 1, 0);
-    ParallelForFaces(mesh, [&](std::size_t, std::size_t begin, std::size_t end, std::int32_t) {
-      for (std::size_t c = begin; c < end; ++c) {
-        const std::int32_t o = owner[static_cast<std::size_t>(indices[c])];
-        if (o <= -2) {
-          std::atomic_ref<std::size_t>(start[SharedIndex(o) + 1])
-              .fetch_add(1, std::memory_order_relaxed);
-        }
+// The shapes of each shared element: its corners sorted by element, then deduplicated.
+void ElementSplit::ListSharedShapes(const Mesh& mesh, std::span<const std::int32_t> indices,
+                                    std::size_t num_shared) {
+  const std::vector<std::int32_t>& owner = owner_;
+  std::vector<std::size_t>& start = shared_start_;
+  start.assign(num_shared + 1, 0);
+  ParallelForFaces(mesh, [&](std::size_t, std::size_t begin, std::size_t end, std::int32_t) {
+    for (std::size_t c = begin; c < end; ++c) {
+      const std::int32_t o = owner[static_cast<std::size_t>(indices[c])];
+      if (o <= -2) {
+        std::atomic_ref<std::size_t>(start[SharedIndex(o) + 1])
+            .fetch_add(1, std::memory_order_relaxed);
       }
-    });
-    for (std::size_t s = 0; s < num_shared; ++s) start[s + 1] += start[s];
-    std::vector<std::size_t> cursor(start.begin(), start.end() - 1);
-    std::vector<std::int32_t> shapes(start.back());
-    ParallelForFaces(mesh, [&](std::size_t, std::size_t begin, std::size_t end, std::int32_t g) {
-      for (std::size_t c = begin; c < end; ++c) {
-        const std::int32_t o = owner[static_cast<std::size_t>(indices[c])];
-        if (o <= -2) {
-          shapes[std::atomic_ref<std::size_t>(cursor[SharedIndex(o)])
-                     .fetch_add(1, std::memory_order_relaxed)] = g;
-        }
-      }
-    });
-    std::vector<std::size_t>().swap(cursor);
-    std::vector<std::size_t> unique(num_shared);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, num_shared),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t s = r.begin(); s < r.end(); ++s) {
-                          const auto first = shapes.begin() + static_cast<std::ptrdiff_t>(start[s]);
-                          const auto last =
-                              shapes.begin() + static_cast<std::ptrdiff_t>(start[s + 1]);
-                          std::sort(first, last);
-                          unique[s] = static_cast<std::size_t>(std::unique(first, last) - first);
-                        }
-                      });
-    // Compacted in place: each list moves towards the front.
-    std::size_t out = 0;
-    for (std::size_t s = 0; s < num_shared; ++s) {
-      const std::size_t in = start[s];
-      start[s] = out;
-      for (std::size_t k = 0; k < unique[s]; ++k) shapes[out++] = shapes[in + k];
     }
-    start[num_shared] = out;
-    shapes.resize(out);
-    shapes.shrink_to_fit();
-    split.shared_shape_ = std::move(shapes);
-    split.shared_id_.resize(out);
+  });
+  for (std::size_t s = 0; s < num_shared; ++s) start[s + 1] += start[s];
+  std::vector<std::size_t> cursor(start.begin(), start.end() - 1);
+  std::vector<std::int32_t> shapes(start.back());
+  ParallelForFaces(mesh, [&](std::size_t, std::size_t begin, std::size_t end, std::int32_t g) {
+    for (std::size_t c = begin; c < end; ++c) {
+      const std::int32_t o = owner[static_cast<std::size_t>(indices[c])];
+      if (o <= -2) {
+        shapes[std::atomic_ref<std::size_t>(cursor[SharedIndex(o)])
+                   .fetch_add(1, std::memory_order_relaxed)] = g;
+      }
+    }
+  });
+  std::vector<std::size_t>().swap(cursor);
+  std::vector<std::size_t> unique(num_shared);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, num_shared),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t s = r.begin(); s < r.end(); ++s) {
+                        const auto first = shapes.begin() + static_cast<std::ptrdiff_t>(start[s]);
+                        const auto last =
+                            shapes.begin() + static_cast<std::ptrdiff_t>(start[s + 1]);
+                        std::sort(first, last);
+                        unique[s] = static_cast<std::size_t>(std::unique(first, last) - first);
+                      }
+                    });
+  // Compacted in place: each list moves towards the front.
+  std::size_t out = 0;
+  for (std::size_t s = 0; s < num_shared; ++s) {
+    const std::size_t in = start[s];
+    start[s] = out;
+    for (std::size_t k = 0; k < unique[s]; ++k) shapes[out++] = shapes[in + k];
   }
+  start[num_shared] = out;
+  shapes.resize(out);
+  shapes.shrink_to_fit();
+  shared_shape_ = std::move(shapes);
+  shared_id_.resize(out);
+}
 
-  // Ids in each shape, in ascending order of the parent's ids.
-  std::vector<std::size_t>& shape_start = split.shape_start_;
+// Ids in each shape, in ascending order of the parent's ids.
+void ElementSplit::NumberInShapes(std::size_t num_elements, std::size_t num_shapes) {
+  std::vector<std::size_t>& shape_start = shape_start_;
   shape_start.assign(num_shapes + 1, 0);
-  split.local_.resize(num_elements);  // ForEachShape reads it
+  local_.resize(num_elements);  // ForEachShape reads it
   for (std::size_t v = 0; v < num_elements; ++v) {
-    split.ForEachShape(static_cast<std::int32_t>(v), [&](std::int32_t g, std::int32_t) {
+    ForEachShape(static_cast<std::int32_t>(v), [&](std::int32_t g, std::int32_t) {
       ++shape_start[static_cast<std::size_t>(g) + 1];
     });
   }
   for (std::size_t g = 0; g < num_shapes; ++g) shape_start[g + 1] += shape_start[g];
-  split.elements_.resize(shape_start.back());
+  elements_.resize(shape_start.back());
   std::vector<std::size_t> next(num_shapes, 0);
   for (std::size_t v = 0; v < num_elements; ++v) {
-    const std::int32_t o = owner[v];
+    const std::int32_t o = owner_[v];
     auto number = [&](std::int32_t g) {
       const std::size_t id = next[static_cast<std::size_t>(g)]++;
-      split.elements_[shape_start[static_cast<std::size_t>(g)] + id] = static_cast<std::int32_t>(v);
+      elements_[shape_start[static_cast<std::size_t>(g)] + id] = static_cast<std::int32_t>(v);
       return static_cast<std::int32_t>(id);
     };
     if (o >= 0) {
-      split.local_[v] = number(o);
+      local_[v] = number(o);
     } else if (o != kUnused) {
       const std::size_t s = SharedIndex(o);
-      for (std::size_t e = split.shared_start_[s]; e < split.shared_start_[s + 1]; ++e) {
-        split.shared_id_[e] = number(split.shared_shape_[e]);
+      for (std::size_t e = shared_start_[s]; e < shared_start_[s + 1]; ++e) {
+        shared_id_[e] = number(shared_shape_[e]);
       }
     }
   }
-  DISPEX_CHECK(!any_shared.load() || split.first_shared_ >= 0);
-  return split;
 }
 
 // The faces of each shape in file order: faces[start[g] .. start[g + 1]).

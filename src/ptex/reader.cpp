@@ -28,6 +28,143 @@ std::string Num(std::uint64_t v) {
   return std::to_string(v);
 }
 
+// The fields of the 64-byte header after the magic and the version (docs/ptex.md, "Header").
+struct MainHeader {
+  std::uint32_t mesh_type = 0, data_type = 0;
+  std::int32_t alpha = 0;
+  std::uint16_t nchannels = 0, nlevels = 0;
+  std::uint32_t nfaces = 0, ext_size = 0, face_info_zip = 0, const_zip = 0, level_info_size = 0,
+                minor = 0;
+  std::uint64_t level_data_size = 0;
+  std::uint32_t meta_zip = 0, meta_mem = 0;
+};
+
+MainHeader LoadMainHeader(const std::uint8_t* h) {
+  MainHeader m;
+  m.mesh_type = Load<std::uint32_t>(h + 8);
+  m.data_type = Load<std::uint32_t>(h + 12);
+  m.alpha = Load<std::int32_t>(h + 16);
+  m.nchannels = Load<std::uint16_t>(h + 20);
+  m.nlevels = Load<std::uint16_t>(h + 22);
+  m.nfaces = Load<std::uint32_t>(h + 24);
+  m.ext_size = Load<std::uint32_t>(h + 28);
+  m.face_info_zip = Load<std::uint32_t>(h + 32);
+  m.const_zip = Load<std::uint32_t>(h + 36);
+  m.level_info_size = Load<std::uint32_t>(h + 40);
+  m.minor = Load<std::uint32_t>(h + 44);
+  m.level_data_size = Load<std::uint64_t>(h + 48);
+  m.meta_zip = Load<std::uint32_t>(h + 56);
+  m.meta_mem = Load<std::uint32_t>(h + 60);
+  return m;
+}
+
+// Why the header's fields do not describe a Ptex file dispex reads ("" when they do).
+std::string MainHeaderProblem(const MainHeader& m) {
+  if (m.mesh_type > 1) return "header: mesh type " + Num(m.mesh_type) + " is not 0 or 1";
+  if (m.data_type > 3) return "header: data type " + Num(m.data_type) + " is not 0..3";
+  if (m.nchannels == 0) return "header: 0 channels";
+  if (m.alpha < -1 || m.alpha >= m.nchannels) {
+    return "header: alpha channel " + std::to_string(m.alpha) + " is not -1 or below " +
+           Num(m.nchannels) + " channels";
+  }
+  if (m.nfaces == 0) return "header: the file has no faces";
+  if (m.nfaces > kMaxFaces) {
+    return "header: " + Num(m.nfaces) + " faces exceed the limit of " + Num(kMaxFaces);
+  }
+  if (m.nlevels == 0 || m.nlevels > kMaxLevels) {
+    return "header: level count " + Num(m.nlevels) + " is not in 1.." + Num(kMaxLevels);
+  }
+  if (m.level_info_size != kLevelInfoSize * m.nlevels) {
+    return "header: level info size " + Num(m.level_info_size) + " is not 16 x " + Num(m.nlevels) +
+           " levels";
+  }
+  if (m.ext_size > kMaxExtHeaderSize) {
+    return "header: extended header size " + Num(m.ext_size) + " is not plausible";
+  }
+  if ((m.meta_zip == 0) != (m.meta_mem == 0)) {
+    return "header: meta data sizes " + Num(m.meta_zip) + " (compressed) and " + Num(m.meta_mem) +
+           " (inflated) disagree";
+  }
+  return "";
+}
+
+void SetHeaderInfo(const MainHeader& m, std::uint64_t file_size, PtexHeaderInfo& header) {
+  header.mesh_type = static_cast<PtexMeshType>(m.mesh_type);
+  header.data_type = static_cast<PtexDataType>(m.data_type);
+  header.num_channels = m.nchannels;
+  header.alpha_channel = m.alpha;
+  header.num_faces = static_cast<int>(m.nfaces);
+  header.num_levels = m.nlevels;
+  header.minor_version = static_cast<int>(m.minor);
+  header.file_size = file_size;
+}
+
+// The extended header's fields (docs/ptex.md, "Extended header").
+struct ExtHeader {
+  std::uint16_t ubord = 0, vbord = 0, edge_filter = 0;
+  std::uint32_t lmd_header_zip = 0, lmd_header_mem = 0;
+  std::uint64_t lmd_data_size = 0, edit_size = 0, edit_pos = 0;
+};
+
+// min(40, ext_size) bytes at `x` are read, the rest are zero.
+ExtHeader LoadExtHeader(const std::uint8_t* x, std::uint32_t ext_size) {
+  std::uint8_t ext[kExtHeaderSize] = {};
+  std::memcpy(ext, x, std::min<std::size_t>(kExtHeaderSize, ext_size));
+  ExtHeader e;
+  e.ubord = Load<std::uint16_t>(ext);
+  e.vbord = Load<std::uint16_t>(ext + 4);
+  e.edge_filter = Load<std::uint16_t>(ext + 6);
+  e.lmd_header_zip = Load<std::uint32_t>(ext + 8);
+  e.lmd_header_mem = Load<std::uint32_t>(ext + 12);
+  e.lmd_data_size = Load<std::uint64_t>(ext + 16);
+  e.edit_size = Load<std::uint64_t>(ext + 24);
+  e.edit_pos = Load<std::uint64_t>(ext + 32);
+  return e;
+}
+
+std::string ExtHeaderProblem(const ExtHeader& e) {
+  if (e.ubord > 2 || e.vbord > 2) {
+    return "extended header: border modes (" + Num(e.ubord) + ", " + Num(e.vbord) +
+           ") are not 0..2";
+  }
+  if (e.edge_filter > 1) {
+    return "extended header: edge filter mode " + Num(e.edge_filter) + " is not 0 or 1";
+  }
+  if ((e.lmd_header_zip == 0) != (e.lmd_header_mem == 0)) {
+    return "extended header: large meta data header sizes disagree";
+  }
+  return "";
+}
+
+// Where the sections start, one after the other from the end of the extended header.
+struct SectionPositions {
+  std::uint64_t face_info = 0, const_data = 0, level_info = 0, level_data = 0, meta = 0;
+};
+
+SectionPositions PositionsOf(const MainHeader& m) {
+  SectionPositions at;
+  at.face_info = kHeaderSize + m.ext_size;
+  at.const_data = at.face_info + m.face_info_zip;
+  at.level_info = at.const_data + m.const_zip;
+  at.level_data = at.level_info + m.level_info_size;
+  at.meta = at.level_data + m.level_data_size;
+  return at;
+}
+
+// Whether the sections up to the level data lie within the file ("" when they do).
+std::string SectionsProblem(const MainHeader& m, const SectionPositions& at, std::uint64_t size) {
+  if (at.level_data > size) {
+    return "face info, constant data and level info (" + Num(at.level_data - at.face_info) +
+           " bytes from offset " + Num(at.face_info) + ") run past the end of the file (" +
+           Num(size) + " bytes)";
+  }
+  if (m.level_data_size > size - at.level_data) {
+    return "header: level data of " + Num(m.level_data_size) + " bytes at offset " +
+           Num(at.level_data) + " runs past the end of the file (" + Num(size) + " bytes)";
+  }
+  return "";
+}
+
 }  // namespace
 
 PtexFile::Impl::~Impl() {
@@ -130,120 +267,43 @@ Status PtexFile::Impl::ParseHeaders(Layout& layout) {
   if (size < kHeaderSize) {
     return Fail("file of " + Num(size) + " bytes is shorter than the 64-byte Ptex header");
   }
-  const std::uint8_t* h = data;
-  if (Load<std::uint32_t>(h) != kMagic) return Fail("not a Ptex file (no 'Ptex' magic)");
-  const std::uint32_t version = Load<std::uint32_t>(h + 4);
+  if (Load<std::uint32_t>(data) != kMagic) return Fail("not a Ptex file (no 'Ptex' magic)");
+  const std::uint32_t version = Load<std::uint32_t>(data + 4);
   if (version != kMajorVersion) {
     return Fail("header: unsupported Ptex major version " + Num(version) + " (expected 1)");
   }
-  const std::uint32_t mesh_type = Load<std::uint32_t>(h + 8);
-  const std::uint32_t data_type = Load<std::uint32_t>(h + 12);
-  const std::int32_t alpha = Load<std::int32_t>(h + 16);
-  const std::uint16_t nchannels = Load<std::uint16_t>(h + 20);
-  const std::uint16_t nlevels = Load<std::uint16_t>(h + 22);
-  const std::uint32_t nfaces = Load<std::uint32_t>(h + 24);
-  const std::uint32_t ext_size = Load<std::uint32_t>(h + 28);
-  const std::uint32_t face_info_zip = Load<std::uint32_t>(h + 32);
-  const std::uint32_t const_zip = Load<std::uint32_t>(h + 36);
-  const std::uint32_t level_info_size = Load<std::uint32_t>(h + 40);
-  const std::uint32_t minor = Load<std::uint32_t>(h + 44);
-  const std::uint64_t level_data_size = Load<std::uint64_t>(h + 48);
-  const std::uint32_t meta_zip = Load<std::uint32_t>(h + 56);
-  const std::uint32_t meta_mem = Load<std::uint32_t>(h + 60);
+  const MainHeader m = LoadMainHeader(data);
+  if (std::string why = MainHeaderProblem(m); !why.empty()) return Fail(why);
+  SetHeaderInfo(m, size, header);
 
-  if (mesh_type > 1) return Fail("header: mesh type " + Num(mesh_type) + " is not 0 or 1");
-  if (data_type > 3) return Fail("header: data type " + Num(data_type) + " is not 0..3");
-  if (nchannels == 0) return Fail("header: 0 channels");
-  if (alpha < -1 || alpha >= nchannels) {
-    return Fail("header: alpha channel " + std::to_string(alpha) + " is not -1 or below " +
-                Num(nchannels) + " channels");
+  if (kHeaderSize + std::uint64_t{m.ext_size} > size) {
+    return Fail("extended header of " + Num(m.ext_size) + " bytes runs past the end of the file");
   }
-  if (nfaces == 0) return Fail("header: the file has no faces");
-  if (nfaces > kMaxFaces)
-    return Fail("header: " + Num(nfaces) + " faces exceed the limit of " + Num(kMaxFaces));
-  if (nlevels == 0 || nlevels > kMaxLevels) {
-    return Fail("header: level count " + Num(nlevels) + " is not in 1.." + Num(kMaxLevels));
-  }
-  if (level_info_size != kLevelInfoSize * nlevels) {
-    return Fail("header: level info size " + Num(level_info_size) + " is not 16 x " + Num(nlevels) +
-                " levels");
-  }
-  if (ext_size > kMaxExtHeaderSize) {
-    return Fail("header: extended header size " + Num(ext_size) + " is not plausible");
-  }
-  if ((meta_zip == 0) != (meta_mem == 0)) {
-    return Fail("header: meta data sizes " + Num(meta_zip) + " (compressed) and " + Num(meta_mem) +
-                " (inflated) disagree");
-  }
-  header.mesh_type = static_cast<PtexMeshType>(mesh_type);
-  header.data_type = static_cast<PtexDataType>(data_type);
-  header.num_channels = nchannels;
-  header.alpha_channel = alpha;
-  header.num_faces = static_cast<int>(nfaces);
-  header.num_levels = nlevels;
-  header.minor_version = static_cast<int>(minor);
-  header.file_size = size;
-  const std::uint64_t pixel = static_cast<std::uint64_t>(header.pixel_size());
+  const ExtHeader x = LoadExtHeader(data + kHeaderSize, m.ext_size);
+  if (std::string why = ExtHeaderProblem(x); !why.empty()) return Fail(why);
+  header.u_border = static_cast<PtexBorderMode>(x.ubord);
+  header.v_border = static_cast<PtexBorderMode>(x.vbord);
+  header.edge_filter = static_cast<PtexEdgeFilterMode>(x.edge_filter);
 
-  // Extended header: min(40, ext_size) bytes are read, the rest are zero.
-  if (kHeaderSize + std::uint64_t{ext_size} > size) {
-    return Fail("extended header of " + Num(ext_size) + " bytes runs past the end of the file");
-  }
-  std::uint8_t ext[kExtHeaderSize] = {};
-  std::memcpy(ext, data + kHeaderSize, std::min<std::size_t>(kExtHeaderSize, ext_size));
-  const std::uint16_t ubord = Load<std::uint16_t>(ext), vbord = Load<std::uint16_t>(ext + 4);
-  const std::uint16_t edge_filter = Load<std::uint16_t>(ext + 6);
-  const std::uint32_t lmd_header_zip = Load<std::uint32_t>(ext + 8);
-  const std::uint32_t lmd_header_mem = Load<std::uint32_t>(ext + 12);
-  const std::uint64_t lmd_data_size = Load<std::uint64_t>(ext + 16);
-  const std::uint64_t edit_size = Load<std::uint64_t>(ext + 24);
-  const std::uint64_t edit_pos = Load<std::uint64_t>(ext + 32);
-  if (ubord > 2 || vbord > 2) {
-    return Fail("extended header: border modes (" + Num(ubord) + ", " + Num(vbord) +
-                ") are not 0..2");
-  }
-  if (edge_filter > 1)
-    return Fail("extended header: edge filter mode " + Num(edge_filter) + " is not 0 or 1");
-  if ((lmd_header_zip == 0) != (lmd_header_mem == 0)) {
-    return Fail("extended header: large meta data header sizes disagree");
-  }
-  header.u_border = static_cast<PtexBorderMode>(ubord);
-  header.v_border = static_cast<PtexBorderMode>(vbord);
-  header.edge_filter = static_cast<PtexEdgeFilterMode>(edge_filter);
-
-  // Section offsets, each checked to lie within the file.
-  std::uint64_t pos = kHeaderSize + ext_size;
-  const std::uint64_t face_info_pos = pos;
-  const std::uint64_t const_pos = face_info_pos + face_info_zip;
-  const std::uint64_t level_info_pos = const_pos + const_zip;
-  const std::uint64_t level_data_pos = level_info_pos + level_info_size;
-  if (level_data_pos > size) {
-    return Fail("face info, constant data and level info (" + Num(level_data_pos - face_info_pos) +
-                " bytes from offset " + Num(face_info_pos) + ") run past the end of the file (" +
-                Num(size) + " bytes)");
-  }
-  if (level_data_size > size - level_data_pos) {
-    return Fail("header: level data of " + Num(level_data_size) + " bytes at offset " +
-                Num(level_data_pos) + " runs past the end of the file (" + Num(size) + " bytes)");
-  }
-  const std::uint64_t meta_pos = level_data_pos + level_data_size;
-  layout.nfaces = nfaces;
-  layout.pixel = pixel;
-  layout.face_info_pos = face_info_pos;
-  layout.face_info_zip = face_info_zip;
-  layout.const_pos = const_pos;
-  layout.const_zip = const_zip;
-  layout.level_info_pos = level_info_pos;
-  layout.level_data_pos = level_data_pos;
-  layout.level_data_size = level_data_size;
-  layout.meta_pos = meta_pos;
-  layout.meta_zip = meta_zip;
-  layout.meta_mem = meta_mem;
-  layout.lmd_header_zip = lmd_header_zip;
-  layout.lmd_header_mem = lmd_header_mem;
-  layout.lmd_data_size = lmd_data_size;
-  layout.edit_size = edit_size;
-  layout.edit_pos = edit_pos;
+  const SectionPositions at = PositionsOf(m);
+  if (std::string why = SectionsProblem(m, at, size); !why.empty()) return Fail(why);
+  layout.nfaces = m.nfaces;
+  layout.pixel = static_cast<std::uint64_t>(header.pixel_size());
+  layout.face_info_pos = at.face_info;
+  layout.face_info_zip = m.face_info_zip;
+  layout.const_pos = at.const_data;
+  layout.const_zip = m.const_zip;
+  layout.level_info_pos = at.level_info;
+  layout.level_data_pos = at.level_data;
+  layout.level_data_size = m.level_data_size;
+  layout.meta_pos = at.meta;
+  layout.meta_zip = m.meta_zip;
+  layout.meta_mem = m.meta_mem;
+  layout.lmd_header_zip = x.lmd_header_zip;
+  layout.lmd_header_mem = x.lmd_header_mem;
+  layout.lmd_data_size = x.lmd_data_size;
+  layout.edit_size = x.edit_size;
+  layout.edit_pos = x.edit_pos;
   return Status::Ok();
 }
 

@@ -17,6 +17,7 @@
 #include <atomic>
 #include <cstring>
 #include <mutex>
+#include <span>
 
 #include "core/atomic_output.h"
 #include "core/check.h"
@@ -81,6 +82,34 @@ class BufferedOutput {
   std::vector<std::uint8_t> buffer_;
 };
 
+// The compressed sections of the file and their sizes, in file order (WriteFile's steps).
+struct FileSections {
+  std::vector<std::int32_t> order;           // the reduction order of the faces
+  std::vector<std::uint32_t> level_entries;  // per level: its faces
+  std::vector<std::uint8_t> face_info_zip, const_zip;
+  std::vector<std::vector<std::uint8_t>> level_header_zip;  // per level
+  std::vector<std::uint64_t> level_size;                    // per level: headers and blocks
+  std::uint64_t level_data_total = 0;
+  // Meta data: small items in one block, large ones after the barrier.
+  std::vector<std::uint8_t> small_raw, small_zip, lmd_header_raw, lmd_header_zip;
+  std::vector<std::vector<std::uint8_t>> lmd_values;
+  std::uint64_t lmd_data_size = 0;
+  std::uint64_t file_size = 0;
+
+  std::size_t num_levels() const { return level_entries.size(); }
+  // The size of the file they make up.
+  std::uint64_t Total() const {
+    return kHeaderSize + kExtHeaderSize + face_info_zip.size() + const_zip.size() +
+           kLevelInfoSize * num_levels() + level_data_total + small_zip.size() + kBarrierSize +
+           lmd_header_zip.size() + lmd_data_size;
+  }
+  // Whether a section the header gives a 32-bit size exceeds it.
+  bool OverSectionLimit() const {
+    return face_info_zip.size() > 0xffffffffull || const_zip.size() > 0xffffffffull ||
+           small_raw.size() > 0xffffffffull || lmd_header_raw.size() > 0xffffffffull;
+  }
+};
+
 }  // namespace
 
 struct PtexWriter::Impl {
@@ -118,6 +147,13 @@ struct PtexWriter::Impl {
                                std::vector<std::uint8_t>& out) const;
   Status AddMeta(const std::string& key, PtexMetaType type, const void* data, std::size_t bytes);
   Status WriteFile();
+  // WriteFile's steps, in order.
+  std::vector<PtexFaceInfo> CloseUnsetFaces();
+  std::vector<std::uint32_t> LevelEntries(std::span<const std::int32_t> order) const;
+  void CompressLevels(const std::vector<PtexFaceInfo>& infos, FileSections& sections) const;
+  void CompressMetaData(FileSections& sections) const;
+  std::vector<std::uint8_t> EncodeHeaders(const FileSections& sections) const;
+  Status WriteSections(const FileSections& sections);
 };
 
 // ---- Construction -------------------------------------------------------------------------
@@ -499,8 +535,21 @@ Status PtexWriter::Finish() {
 }
 
 Status PtexWriter::Impl::WriteFile() {
+  const std::vector<PtexFaceInfo> infos = CloseUnsetFaces();
+  FileSections sections;
+  CompressLevels(infos, sections);
+  CompressMetaData(sections);
+  if (sections.OverSectionLimit()) {
+    return Status::Error(path + ": a section exceeds the format's 4 GiB section limit");
+  }
+  sections.file_size = sections.Total();
+  return WriteSections(sections);
+}
+
+// Faces never set become constant zero, 1x1, with no neighbours (as the reference writer).
+// Returns every face's info.
+std::vector<PtexFaceInfo> PtexWriter::Impl::CloseUnsetFaces() {
   const std::size_t n = faces.size();
-  // Faces never set: constant zero, 1x1, no neighbours (as the reference writer).
   for (std::size_t f = 0; f < n; ++f) {
     const std::uint8_t st = state[f].load(std::memory_order_acquire);
     DISPEX_CHECK_NE(st, std::uint8_t{kBusy});  // contract: no SetFace in flight
@@ -512,10 +561,14 @@ Status PtexWriter::Impl::WriteFile() {
   }
   std::vector<PtexFaceInfo> infos(n);
   for (std::size_t f = 0; f < n; ++f) infos[f] = faces[f].info;
+  return infos;
+}
 
-  // Levels: level L >= 1 holds the faces with at least L stored reductions, which are a
-  // prefix of the reduction order.
-  const std::vector<std::int32_t> order = ReductionOrder(infos);
+// The faces of each level: level L >= 1 holds the faces with at least L stored reductions,
+// which are a prefix of the reduction order.
+std::vector<std::uint32_t> PtexWriter::Impl::LevelEntries(
+    std::span<const std::int32_t> order) const {
+  const std::size_t n = faces.size();
   std::vector<std::uint32_t> level_entries(1, static_cast<std::uint32_t>(n));
   for (std::size_t r = 0; r < n; ++r) {
     const std::size_t reductions = faces[std::size_t(order[r])].headers.size() - 1;
@@ -525,68 +578,60 @@ Status PtexWriter::Impl::WriteFile() {
       level_entries[l] = static_cast<std::uint32_t>(r + 1);
     }
   }
-  const std::size_t nlevels = level_entries.size();
+  return level_entries;
+}
 
-  // Offsets of each stored level inside a face's block buffer.
-  auto block_offset = [&](const Face& face, std::size_t level_index) {
-    std::size_t off = 0;
-    for (std::size_t l = 0; l < level_index; ++l) off += BlockSizeOf(face.headers[l]);
-    return off;
-  };
-
-  // Compressed sections, in file order.
+// The face info and constant data compressed, and each level's face data headers; the
+// levels' sizes.
+void PtexWriter::Impl::CompressLevels(const std::vector<PtexFaceInfo>& infos,
+                                      FileSections& x) const {
+  const std::size_t n = faces.size();
+  x.order = ReductionOrder(infos);
+  x.level_entries = LevelEntries(x.order);
+  const std::size_t nlevels = x.num_levels();
   std::vector<std::uint8_t> face_info_raw(n * kFaceInfoSize);
   for (std::size_t f = 0; f < n; ++f) EncodeFaceInfo(infos[f], &face_info_raw[f * kFaceInfoSize]);
-  std::vector<std::uint8_t> face_info_zip, const_zip;
-  CompressAppend(face_info_raw, options.compressor, level, face_info_zip);
-  CompressAppend(const_data, options.compressor, level, const_zip);
+  CompressAppend(face_info_raw, options.compressor, level, x.face_info_zip);
+  CompressAppend(const_data, options.compressor, level, x.const_zip);
 
-  std::vector<std::vector<std::uint8_t>> level_header_zip(nlevels);
-  std::vector<std::uint64_t> level_size(nlevels);
-  std::uint64_t level_data_total = 0;
+  x.level_header_zip.resize(nlevels);
+  x.level_size.resize(nlevels);
   for (std::size_t l = 0; l < nlevels; ++l) {
     std::vector<std::uint8_t> raw;
-    raw.reserve(level_entries[l] * 4);
+    raw.reserve(x.level_entries[l] * 4);
     std::uint64_t blocks = 0;
-    for (std::size_t r = 0; r < level_entries[l]; ++r) {
-      const Face& face = faces[l == 0 ? r : std::size_t(order[r])];
+    for (std::size_t r = 0; r < x.level_entries[l]; ++r) {
+      const Face& face = faces[l == 0 ? r : std::size_t(x.order[r])];
       Append<std::uint32_t>(raw, face.headers[l]);
       blocks += BlockSizeOf(face.headers[l]);
     }
-    CompressAppend(raw, options.compressor, level, level_header_zip[l]);
-    level_size[l] = level_header_zip[l].size() + blocks;
-    level_data_total += level_size[l];
+    CompressAppend(raw, options.compressor, level, x.level_header_zip[l]);
+    x.level_size[l] = x.level_header_zip[l].size() + blocks;
+    x.level_data_total += x.level_size[l];
   }
+}
 
-  // Meta data: small items in one block, large ones after the barrier.
-  std::vector<std::uint8_t> small_raw, small_zip, lmd_header_raw, lmd_header_zip;
-  std::vector<std::vector<std::uint8_t>> lmd_values;
+// Meta data: small items in one block, large ones after the barrier.
+void PtexWriter::Impl::CompressMetaData(FileSections& x) const {
   for (const PtexMetaItem& item : meta) {
-    if (!item.large) AppendMetaRecord(item, -1, small_raw);
+    if (!item.large) AppendMetaRecord(item, -1, x.small_raw);
   }
   for (const PtexMetaItem& item : meta) {
     if (!item.large) continue;
-    lmd_values.emplace_back();
+    x.lmd_values.emplace_back();
     const std::size_t zipsize =
-        CompressAppend(item.bytes, options.compressor, level, lmd_values.back());
-    AppendMetaRecord(item, static_cast<std::int64_t>(zipsize), lmd_header_raw);
+        CompressAppend(item.bytes, options.compressor, level, x.lmd_values.back());
+    AppendMetaRecord(item, static_cast<std::int64_t>(zipsize), x.lmd_header_raw);
   }
-  if (!small_raw.empty()) CompressAppend(small_raw, options.compressor, level, small_zip);
-  if (!lmd_header_raw.empty()) {
-    CompressAppend(lmd_header_raw, options.compressor, level, lmd_header_zip);
+  if (!x.small_raw.empty()) CompressAppend(x.small_raw, options.compressor, level, x.small_zip);
+  if (!x.lmd_header_raw.empty()) {
+    CompressAppend(x.lmd_header_raw, options.compressor, level, x.lmd_header_zip);
   }
-  std::uint64_t lmd_data_size = 0;
-  for (const auto& v : lmd_values) lmd_data_size += v.size();
+  for (const auto& v : x.lmd_values) x.lmd_data_size += v.size();
+}
 
-  const std::uint64_t file_size = kHeaderSize + kExtHeaderSize + face_info_zip.size() +
-                                  const_zip.size() + kLevelInfoSize * nlevels + level_data_total +
-                                  small_zip.size() + kBarrierSize + lmd_header_zip.size() +
-                                  lmd_data_size;
-  if (face_info_zip.size() > 0xffffffffull || const_zip.size() > 0xffffffffull ||
-      small_raw.size() > 0xffffffffull || lmd_header_raw.size() > 0xffffffffull) {
-    return Status::Error(path + ": a section exceeds the format's 4 GiB section limit");
-  }
-
+// The header and the extended header.
+std::vector<std::uint8_t> PtexWriter::Impl::EncodeHeaders(const FileSections& x) const {
   std::vector<std::uint8_t> header(kHeaderSize + kExtHeaderSize, 0);
   std::uint8_t* h = header.data();
   Store<std::uint32_t>(h + 0, kMagic);
@@ -595,53 +640,64 @@ Status PtexWriter::Impl::WriteFile() {
   Store<std::uint32_t>(h + 12, static_cast<std::uint32_t>(options.data_type));
   Store<std::int32_t>(h + 16, options.alpha_channel);
   Store<std::uint16_t>(h + 20, static_cast<std::uint16_t>(options.num_channels));
-  Store<std::uint16_t>(h + 22, static_cast<std::uint16_t>(nlevels));
-  Store<std::uint32_t>(h + 24, static_cast<std::uint32_t>(n));
+  Store<std::uint16_t>(h + 22, static_cast<std::uint16_t>(x.num_levels()));
+  Store<std::uint32_t>(h + 24, static_cast<std::uint32_t>(faces.size()));
   Store<std::uint32_t>(h + 28, static_cast<std::uint32_t>(kExtHeaderSize));
-  Store<std::uint32_t>(h + 32, static_cast<std::uint32_t>(face_info_zip.size()));
-  Store<std::uint32_t>(h + 36, static_cast<std::uint32_t>(const_zip.size()));
-  Store<std::uint32_t>(h + 40, static_cast<std::uint32_t>(kLevelInfoSize * nlevels));
+  Store<std::uint32_t>(h + 32, static_cast<std::uint32_t>(x.face_info_zip.size()));
+  Store<std::uint32_t>(h + 36, static_cast<std::uint32_t>(x.const_zip.size()));
+  Store<std::uint32_t>(h + 40, static_cast<std::uint32_t>(kLevelInfoSize * x.num_levels()));
   Store<std::uint32_t>(h + 44, kMinorVersion);
-  Store<std::uint64_t>(h + 48, level_data_total);
-  Store<std::uint32_t>(h + 56, static_cast<std::uint32_t>(small_zip.size()));
-  Store<std::uint32_t>(h + 60, static_cast<std::uint32_t>(small_raw.size()));
-  std::uint8_t* x = h + kHeaderSize;
-  Store<std::uint16_t>(x + 0, static_cast<std::uint16_t>(options.u_border));
-  Store<std::uint16_t>(x + 4, static_cast<std::uint16_t>(options.v_border));
-  Store<std::uint16_t>(x + 6, static_cast<std::uint16_t>(options.edge_filter));
-  Store<std::uint32_t>(x + 8, static_cast<std::uint32_t>(lmd_header_zip.size()));
-  Store<std::uint32_t>(x + 12, static_cast<std::uint32_t>(lmd_header_raw.size()));
-  Store<std::uint64_t>(x + 16, lmd_data_size);
-  Store<std::uint64_t>(x + 24, 0);          // editdatasize
-  Store<std::uint64_t>(x + 32, file_size);  // editdatapos: where edits would be appended
+  Store<std::uint64_t>(h + 48, x.level_data_total);
+  Store<std::uint32_t>(h + 56, static_cast<std::uint32_t>(x.small_zip.size()));
+  Store<std::uint32_t>(h + 60, static_cast<std::uint32_t>(x.small_raw.size()));
+  std::uint8_t* e = h + kHeaderSize;
+  Store<std::uint16_t>(e + 0, static_cast<std::uint16_t>(options.u_border));
+  Store<std::uint16_t>(e + 4, static_cast<std::uint16_t>(options.v_border));
+  Store<std::uint16_t>(e + 6, static_cast<std::uint16_t>(options.edge_filter));
+  Store<std::uint32_t>(e + 8, static_cast<std::uint32_t>(x.lmd_header_zip.size()));
+  Store<std::uint32_t>(e + 12, static_cast<std::uint32_t>(x.lmd_header_raw.size()));
+  Store<std::uint64_t>(e + 16, x.lmd_data_size);
+  Store<std::uint64_t>(e + 24, 0);            // editdatasize
+  Store<std::uint64_t>(e + 32, x.file_size);  // editdatapos: where edits would be appended
+  return header;
+}
 
+// The file, section by section, in order; it must come out file_size bytes long.
+Status PtexWriter::Impl::WriteSections(const FileSections& x) {
+  const std::size_t nlevels = x.num_levels();
+  // Offsets of each stored level inside a face's block buffer.
+  auto block_offset = [&](const Face& face, std::size_t level_index) {
+    std::size_t off = 0;
+    for (std::size_t l = 0; l < level_index; ++l) off += BlockSizeOf(face.headers[l]);
+    return off;
+  };
   BufferedOutput out(output);
-  DISPEX_RETURN_IF_ERROR(out.Write(header));
-  DISPEX_RETURN_IF_ERROR(out.Write(face_info_zip));
-  DISPEX_RETURN_IF_ERROR(out.Write(const_zip));
+  DISPEX_RETURN_IF_ERROR(out.Write(EncodeHeaders(x)));
+  DISPEX_RETURN_IF_ERROR(out.Write(x.face_info_zip));
+  DISPEX_RETURN_IF_ERROR(out.Write(x.const_zip));
   for (std::size_t l = 0; l < nlevels; ++l) {
     std::uint8_t info[kLevelInfoSize];
-    Store<std::uint64_t>(info, level_size[l]);
-    Store<std::uint32_t>(info + 8, static_cast<std::uint32_t>(level_header_zip[l].size()));
-    Store<std::uint32_t>(info + 12, level_entries[l]);
+    Store<std::uint64_t>(info, x.level_size[l]);
+    Store<std::uint32_t>(info + 8, static_cast<std::uint32_t>(x.level_header_zip[l].size()));
+    Store<std::uint32_t>(info + 12, x.level_entries[l]);
     DISPEX_RETURN_IF_ERROR(out.Write(info, sizeof(info)));
   }
   for (std::size_t l = 0; l < nlevels; ++l) {
-    DISPEX_RETURN_IF_ERROR(out.Write(level_header_zip[l]));
-    for (std::size_t r = 0; r < level_entries[l]; ++r) {
-      const Face& face = faces[l == 0 ? r : std::size_t(order[r])];
+    DISPEX_RETURN_IF_ERROR(out.Write(x.level_header_zip[l]));
+    for (std::size_t r = 0; r < x.level_entries[l]; ++r) {
+      const Face& face = faces[l == 0 ? r : std::size_t(x.order[r])];
       const std::uint32_t size = BlockSizeOf(face.headers[l]);
       if (size == 0) continue;
       DISPEX_RETURN_IF_ERROR(out.Write(face.blocks.data() + block_offset(face, l), size));
     }
   }
-  DISPEX_RETURN_IF_ERROR(out.Write(small_zip));
+  DISPEX_RETURN_IF_ERROR(out.Write(x.small_zip));
   const std::uint8_t barrier[kBarrierSize] = {};
   DISPEX_RETURN_IF_ERROR(out.Write(barrier, sizeof(barrier)));
-  DISPEX_RETURN_IF_ERROR(out.Write(lmd_header_zip));
-  for (const auto& v : lmd_values) DISPEX_RETURN_IF_ERROR(out.Write(v));
+  DISPEX_RETURN_IF_ERROR(out.Write(x.lmd_header_zip));
+  for (const auto& v : x.lmd_values) DISPEX_RETURN_IF_ERROR(out.Write(v));
   DISPEX_RETURN_IF_ERROR(out.Flush());
-  DISPEX_CHECK_EQ(out.written(), file_size);
+  DISPEX_CHECK_EQ(out.written(), x.file_size);
   return Status::Ok();
 }
 

@@ -4,10 +4,10 @@
 // of the cage: a cage edge (quads cover it whole, n-gon sub-faces one half each) or, inside an
 // n-gon, a spoke from an edge midpoint to the face centre. Every point a face puts on a line
 // is named exactly, by the line and a reduced fraction along it (or, at a line's ends, by the
-// cage vertex, edge midpoint or face centre there), so the faces around a point find the same
-// name and share one vertex: position and normal from the lowest-numbered face, displacement
-// averaged over all of them (or, with per-face displacement, one copy of the vertex per face,
-// each displaced by its own face's value, as a renderer that reads each face on its own
+// cage vertex, edge midpoint or face centre there; tessellation_lines.h), so the faces around a
+// point find the same name and share one vertex: position and normal from the lowest-numbered face,
+// displacement averaged over all of them (or, with per-face displacement, one copy of the vertex
+// per face, each displaced by its own face's value, as a renderer that reads each face on its own
 // displaces it). A vector map's displacement is a vector in object space, each face's from its
 // own frame and channels at its own (u, v), so the faces around a point average (or keep)
 // vectors as a scalar map's average heights. Along a line the points of all its faces are merged,
@@ -33,158 +33,14 @@
 
 #include "core/check.h"
 #include "core/first_error.h"
+#include "render/tessellation_lines.h"
+#include "render/vertex_normals.h"
 
 namespace dispex::render {
 
 namespace {
 
-constexpr std::int32_t kBaseEdge = 0, kSpoke = 1;
-enum : std::int32_t { kVertexPoint = 0, kEdgePoint = 1, kSpokePoint = 2, kCentrePoint = 3 };
-
-// A line of the cage: a base edge (a < b, its vertices) or a spoke (a = base face, b = corner
-// q: from the midpoint of the face's edge q to its centre). Parameters along a line run 0..2.
-struct LineKey {
-  std::int32_t kind = 0, a = 0, b = 0;
-  auto operator<=>(const LineKey&) const = default;
-};
-
-// One side of one Ptex face on its line: from parameter p0 (the side's start, in the face's
-// counter-clockwise order) to p1, cut into `segs` equal segments.
-struct SideEntry {
-  LineKey line;
-  std::int32_t p0 = 0, p1 = 0;
-  std::int32_t segs = 0;
-  std::int32_t face = -1, side = 0;
-};
-
-// An exact parameter num / den on a line, reduced (0 / 1 for zero).
-struct Frac {
-  std::int32_t num = 0, den = 1;
-};
-bool FracLess(Frac x, Frac y) {
-  return std::int64_t(x.num) * y.den < std::int64_t(y.num) * x.den;
-}
-Frac Reduce(std::int32_t num, std::int32_t den) {
-  const std::int32_t g = std::gcd(num, den);
-  return {num / g, den / g};
-}
-
-struct PointKey {
-  std::int32_t kind = 0, a = 0, b = 0, num = 0, den = 0;
-  auto operator<=>(const PointKey&) const = default;
-};
-
-// One face's view of one shared point, from one of its sides.
-struct Record {
-  PointKey key;
-  std::int32_t face = 0;
-  float u = 0, v = 0;
-  std::int64_t line_point = 0;  // the point's index in the flat array of line points
-  std::int32_t side = 0;        // the side of `face` whose line holds the point
-};
-// A total order. The side comes last: records equal up to it differ in nothing the mean
-// displacement reads.
-bool RecordLess(const Record& x, const Record& y) {
-  if (x.key != y.key) return x.key < y.key;
-  if (x.face != y.face) return x.face < y.face;
-  if (x.u != y.u) return x.u < y.u;
-  if (x.v != y.v) return x.v < y.v;
-  if (x.line_point != y.line_point) return x.line_point < y.line_point;
-  return x.side < y.side;
-}
-
-void SideUv(int side, double s, float& u, float& v) {
-  switch (side) {
-    case 0:
-      u = static_cast<float>(s), v = 0;
-      return;
-    case 1:
-      u = 1, v = static_cast<float>(s);
-      return;
-    case 2:
-      u = static_cast<float>(1.0 - s), v = 1;
-      return;
-    default:
-      u = 0, v = static_cast<float>(1.0 - s);
-      return;
-  }
-}
-
-PointKey KeyOf(const Mesh& cage, const LineKey& line, Frac t) {
-  if (line.kind == kBaseEdge) {
-    if (t.num == 0) return {kVertexPoint, line.a, 0, 0, 0};
-    if (t.num == 2 * t.den) return {kVertexPoint, line.b, 0, 0, 0};
-    return {kEdgePoint, line.a, line.b, t.num, t.den};
-  }
-  if (t.num == 0) {  // the midpoint of the face's edge q
-    const auto verts = cage.face(static_cast<std::size_t>(line.a));
-    const int n = static_cast<int>(verts.size());
-    const std::int32_t va = verts[static_cast<std::size_t>(line.b)];
-    const std::int32_t vb = verts[static_cast<std::size_t>((line.b + 1) % n)];
-    return {kEdgePoint, std::min(va, vb), std::max(va, vb), 1, 1};
-  }
-  if (t.num == 2 * t.den) return {kCentrePoint, line.a, 0, 0, 0};
-  return {kSpokePoint, line.a, line.b, t.num, t.den};
-}
-
-LineKey EdgeLine(std::int32_t va, std::int32_t vb) {
-  return {kBaseEdge, std::min(va, vb), std::max(va, vb)};
-}
-
-// The four sides of Ptex face f (see the conventions in include/dispex/subdiv.h: a quad's
-// corners are its vertices 0..3; sub-face q of an n-gon runs from vertex q (0,0) to the
-// midpoint of edge q (1,0), the centre (1,1) and the midpoint of edge q-1 (0,1)).
-void FaceSides(const Mesh& cage, const LimitSurface& surface, int f, int kx, int ky,
-               SideEntry out[4]) {
-  const BaseFaceId base = surface.base_face(PtexFaceId(f));
-  const auto verts = cage.face(static_cast<std::size_t>(base.value));
-  const int n = static_cast<int>(verts.size());
-  for (int s = 0; s < 4; ++s) {
-    out[s].face = f;
-    out[s].side = s;
-    out[s].segs = (s % 2 == 0) ? kx : ky;
-  }
-  if (n == 4) {
-    for (int s = 0; s < 4; ++s) {
-      const std::int32_t va = verts[static_cast<std::size_t>(s)];
-      const std::int32_t vb = verts[static_cast<std::size_t>((s + 1) % 4)];
-      out[s].line = EdgeLine(va, vb);
-      out[s].p0 = va < vb ? 0 : 2;
-      out[s].p1 = 2 - out[s].p0;
-    }
-    return;
-  }
-  const int q = surface.sub_face(PtexFaceId(f));
-  const std::int32_t vq = verts[static_cast<std::size_t>(q)];
-  const std::int32_t vnext = verts[static_cast<std::size_t>((q + 1) % n)];
-  const std::int32_t vprev = verts[static_cast<std::size_t>((q + n - 1) % n)];
-  out[0].line = EdgeLine(vq, vnext);  // vertex q to the midpoint of edge q
-  out[0].p0 = vq < vnext ? 0 : 2;
-  out[0].p1 = 1;
-  out[1].line = {kSpoke, base.value, q};  // midpoint of edge q to the centre
-  out[1].p0 = 0;
-  out[1].p1 = 2;
-  out[2].line = {kSpoke, base.value, (q + n - 1) % n};  // centre to the midpoint of edge q-1
-  out[2].p0 = 2;
-  out[2].p1 = 0;
-  out[3].line = EdgeLine(vprev, vq);  // midpoint of edge q-1 to vertex q
-  out[3].p0 = 1;
-  out[3].p1 = vprev < vq ? 2 : 0;
-}
-
-Frac PointOnSide(const SideEntry& e, int i) {
-  return Reduce(e.p0 * e.segs + (e.p1 - e.p0) * i, e.segs);
-}
-
-bool Covers(const SideEntry& e, Frac t) {
-  const std::int64_t lo = std::min(e.p0, e.p1), hi = std::max(e.p0, e.p1);
-  return std::int64_t(t.num) >= lo * t.den && std::int64_t(t.num) <= hi * t.den;
-}
-
-double SigmaOf(const SideEntry& e, Frac t) {
-  return double(std::int64_t(t.num) - std::int64_t(e.p0) * t.den) /
-         double(std::int64_t(t.den) * (e.p1 - e.p0));
-}
+using namespace lines;
 
 Float3 Sub(const Float3& a, const Float3& b) {
   return {a.x - b.x, a.y - b.y, a.z - b.z};
@@ -199,41 +55,6 @@ Status MapValueError(const PtexFile& map, int face) {
   if (!read.ok()) return read;
   return Status::Error(
       fmt::format("{}: face {} holds a value that is not finite", map.name(), face));
-}
-
-// Vertex normals: for each vertex the sum of its faces' (area-weighted) normals, in face
-// order, normalised; `fallback` (or +z) where the sum vanishes.
-void VertexNormals(std::size_t num_vertices, std::span<const std::uint32_t> face_offsets,
-                   std::span<const std::int32_t> face_indices, std::span<const Float3> face_normals,
-                   std::span<const Float3> fallback, std::vector<Float3>& normals) {
-  const std::size_t num_faces = face_offsets.size() - 1;
-  std::vector<std::uint32_t> start(num_vertices + 1, 0);
-  for (std::int32_t v : face_indices) ++start[static_cast<std::size_t>(v) + 1];
-  std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-  std::vector<std::uint32_t> faces_of(face_indices.size());
-  for (std::size_t f = 0; f < num_faces; ++f) {
-    for (std::uint32_t k = face_offsets[f]; k < face_offsets[f + 1]; ++k) {
-      faces_of[fill[static_cast<std::size_t>(face_indices[k])]++] = static_cast<std::uint32_t>(f);
-    }
-  }
-  normals.resize(num_vertices);
-  tbb::parallel_for(std::size_t{0}, num_vertices, [&](std::size_t v) {
-    double x = 0, y = 0, z = 0;
-    std::uint32_t previous = std::numeric_limits<std::uint32_t>::max();
-    for (std::uint32_t k = start[v]; k < start[v + 1]; ++k) {
-      if (faces_of[k] == previous) continue;  // a face listing the vertex twice counts once
-      previous = faces_of[k];
-      const Float3& n = face_normals[faces_of[k]];
-      x += n.x, y += n.y, z += n.z;
-    }
-    const double len = std::sqrt(x * x + y * y + z * z);
-    if (len > 0 && std::isfinite(len)) {
-      normals[v] = {float(x / len), float(y / len), float(z / len)};
-    } else {
-      normals[v] = v < fallback.size() ? fallback[v] : Float3{0, 0, 1};
-    }
-  });
 }
 
 // TessellateLimitSurface's state, built by its steps in the order Run calls them. Each step
@@ -882,51 +703,6 @@ StatusOr<ShadedMesh> TessellateLimitSurface(const Mesh& cage, const LimitSurface
                                             BoundaryDisplacement boundary,
                                             std::optional<VectorSpace> vector_space) {
   return Tessellation(cage, surface, density, map, channel, boundary, vector_space).Run();
-}
-
-ShadedMesh ShadePolygonMesh(const Mesh& mesh) {
-  ShadedMesh out;
-  const std::size_t num_faces = mesh.num_faces();
-  // Newell normals of the polygons (twice the area times the unit normal for planar ones).
-  std::vector<Float3> face_normals(num_faces);
-  std::vector<std::uint32_t> triangle_start(num_faces + 1, 0);
-  for (std::size_t f = 0; f < num_faces; ++f) {
-    triangle_start[f + 1] = triangle_start[f] + static_cast<std::uint32_t>(mesh.face_size(f) - 2);
-  }
-  tbb::parallel_for(std::size_t{0}, num_faces, [&](std::size_t f) {
-    const auto verts = mesh.face(f);
-    double x = 0, y = 0, z = 0;
-    for (std::size_t k = 0; k < verts.size(); ++k) {
-      const Float3& p = mesh.positions[static_cast<std::size_t>(verts[k])];
-      const Float3& q = mesh.positions[static_cast<std::size_t>(verts[(k + 1) % verts.size()])];
-      x += (double(p.y) - q.y) * (double(p.z) + q.z);
-      y += (double(p.z) - q.z) * (double(p.x) + q.x);
-      z += (double(p.x) - q.x) * (double(p.y) + q.y);
-    }
-    face_normals[f] = {float(x), float(y), float(z)};
-  });
-  VertexNormals(mesh.num_vertices(), mesh.face_offsets, mesh.face_indices, face_normals, {},
-                out.normals);
-
-  Mesh& tri = out.mesh;
-  tri.source = mesh.source;
-  tri.positions.reserve(mesh.positions.size() + 1);  // Embree reads 16 bytes at the last one
-  tri.positions.assign(mesh.positions.begin(), mesh.positions.end());
-  const std::size_t num_triangles = triangle_start[num_faces];
-  tri.face_offsets.resize(num_triangles + 1);
-  tri.face_indices.resize(3 * num_triangles);
-  tbb::parallel_for(std::size_t{0}, num_faces, [&](std::size_t f) {
-    const auto verts = mesh.face(f);
-    for (std::size_t k = 1; k + 1 < verts.size(); ++k) {
-      const std::size_t t = triangle_start[f] + k - 1;
-      tri.face_offsets[t] = static_cast<std::uint32_t>(3 * t);
-      tri.face_indices[3 * t] = verts[0];
-      tri.face_indices[3 * t + 1] = verts[k];
-      tri.face_indices[3 * t + 2] = verts[k + 1];
-    }
-  });
-  tri.face_offsets[num_triangles] = static_cast<std::uint32_t>(3 * num_triangles);
-  return out;
 }
 
 }  // namespace dispex::render

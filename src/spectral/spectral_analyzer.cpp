@@ -20,9 +20,11 @@
 #include <cstring>
 #include <limits>
 #include <tuple>
+#include <utility>
 
 #include "core/check.h"
 #include "dispex/spectral.h"
+#include "spectral/acceptance.h"
 #include "spectral/aligned_buffer.h"
 #include "spectral/bilinear_readback.h"
 #include "spectral/block_shape.h"
@@ -35,6 +37,7 @@
 
 namespace dispex {
 
+using spectral::Acceptance;
 using spectral::BlockShape;
 using spectral::ShapeOfLog2;
 
@@ -64,6 +67,33 @@ struct SpectralAnalyzer::Impl {
   // Resamples the loaded block (whose REDFT10 is in `coefficients` unless `res` equals `shape`
   // or is 1 x 1) to `res`, into texels[slot]; returns the texels.
   float* ResampleLoaded(const BlockShape& shape, const BlockShape& res, float mean, int slot);
+
+  // Analyze's steps, in order (see the top of this file).
+  //
+  // A resolution 2^kx x 2^ky, its texels in texels[slot], and their errors: read back at the
+  // samples, and on the edges (0 when not measured).
+  struct Candidate {
+    int kx = 0, ky = 0, slot = 0;
+    double error = 0, edge = 0;
+  };
+  // The per-face reader's largest error on the edges, when they are measured.
+  double EdgeError(const float* t, const BlockShape& res, const BlockShape& shape,
+                   const Acceptance& accept) const {
+    return accept.measure_edges() ? spectral::MaxEdgeReadError(t, res, samples.data(), shape) : 0.0;
+  }
+  // 1. The face as the samples' mean, when that is within the tolerances.
+  bool AcceptConstant(const BlockShape& shape, const Summary& summary,
+                      const SpectralOptions& options, const Acceptance& accept, SpectralFace& face);
+  // 2. The rule's resolution (the truncation bound's, the nonzero rule's or the fixed one),
+  // into face.stats, raised to the floor.
+  std::pair<int, int> RuleResolution(const BlockShape& shape, const SpectralOptions& options,
+                                     SpectralFaceStats& stats);
+  // 3. Resamples to `res` into texels[slot], the edge texels pinned when accept.pin.
+  const float* ResampleInto(const BlockShape& shape, const BlockShape& res, float mean, int slot,
+                            const Acceptance& accept);
+  // 4. With verify: u or v doubled, whichever scores lower (ties go to u), until accepted.
+  void StepUp(const BlockShape& shape, float mean, const Acceptance& accept, Candidate& at,
+              SpectralFaceStats& stats);
 };
 
 StatusOr<SpectralAnalyzer::Impl::Summary> SpectralAnalyzer::Impl::Load(std::span<const float> in,
@@ -124,6 +154,95 @@ SpectralAnalyzer::~SpectralAnalyzer() = default;
 SpectralAnalyzer::SpectralAnalyzer(SpectralAnalyzer&&) noexcept = default;
 SpectralAnalyzer& SpectralAnalyzer::operator=(SpectralAnalyzer&&) noexcept = default;
 
+bool SpectralAnalyzer::Impl::AcceptConstant(const BlockShape& shape, const Summary& summary,
+                                            const SpectralOptions& options,
+                                            const Acceptance& accept, SpectralFace& face) {
+  if (!spectral::ConstantAllowed(options) || !(summary.max_deviation <= accept.tolerance)) {
+    return false;
+  }
+  float* texel = texels[0].Reserve(1);
+  texel[0] = summary.mean;
+  const double edge = EdgeError(texel, ShapeOfLog2(0, 0), shape, accept);
+  if (!accept.Accepted(summary.max_deviation, edge)) return false;
+  face.constant = true;
+  face.constant_value = summary.mean;
+  face.texels = std::span<const float>(texel, 1);
+  face.stats.texels_after = 1;
+  face.stats.bound = summary.max_deviation;
+  face.stats.measured_error = summary.max_deviation;
+  face.stats.edge_error = edge;
+  face.stats.constant = true;
+  return true;
+}
+
+std::pair<int, int> SpectralAnalyzer::Impl::RuleResolution(const BlockShape& shape,
+                                                           const SpectralOptions& options,
+                                                           SpectralFaceStats& stats) {
+  dct.Forward(shape.lx, shape.ly, samples.data(), coefficients.Reserve(shape.count()));
+  bounds.Build(coefficients.data(), shape);
+  int kx = 0;
+  int ky = 0;
+  switch (options.rule) {
+    case ResolutionRule::kErrorBound:
+      std::tie(kx, ky) = bounds.Smallest(options.tolerance);
+      break;
+    case ResolutionRule::kNonzero:
+      std::tie(kx, ky) =
+          spectral::NonzeroRuleResolution(coefficients.data(), shape, options.nonzero_threshold);
+      break;
+    case ResolutionRule::kFixed:
+      kx = options.fixed_ulog2;
+      ky = options.fixed_vlog2;
+      break;
+  }
+  stats.bound_ulog2 = kx;
+  stats.bound_vlog2 = ky;
+  spectral::RaiseToFloor(options, shape, kx, ky);
+  return {kx, ky};
+}
+
+const float* SpectralAnalyzer::Impl::ResampleInto(const BlockShape& shape, const BlockShape& res,
+                                                  float mean, int slot, const Acceptance& accept) {
+  float* t = ResampleLoaded(shape, res, mean, slot);
+  if (accept.pin) spectral::PinEdgeTexels(t, res, samples.data(), shape);
+  return t;
+}
+
+void SpectralAnalyzer::Impl::StepUp(const BlockShape& shape, float mean, const Acceptance& accept,
+                                    Candidate& at, SpectralFaceStats& stats) {
+  const bool early_stop = accept.verify && !accept.measure_edges();
+  while (!accept.Accepted(at.error, at.edge)) {
+    // Candidates: u doubled into one free slot, v doubled into the other. The v candidate's
+    // measurement may stop once it exceeds the u candidate's (it has lost: ties go to u).
+    const bool can_u = at.kx < shape.lx;
+    const bool can_v = at.ky < shape.ly;
+    if (!can_u && !can_v) {
+      // The full resolution reads back exactly; only the edge criterion can still fail, where
+      // the samples themselves are too coarse for it.
+      DISPEX_CHECK(at.error <= accept.tolerance);
+      stats.edge_limited = true;
+      break;
+    }
+    Candidate u{at.kx + 1, at.ky, (at.slot + 1) % 3, kInfinity, kInfinity};
+    Candidate v{at.kx, at.ky + 1, (at.slot + 2) % 3, kInfinity, kInfinity};
+    if (can_u) {
+      const BlockShape res = ShapeOfLog2(u.kx, u.ky);
+      const float* t = ResampleInto(shape, res, mean, u.slot, accept);
+      u.error = spectral::MaxReadBackError(t, res, samples.data(), shape, kInfinity);
+      u.edge = EdgeError(t, res, shape, accept);
+    }
+    if (can_v) {
+      const BlockShape res = ShapeOfLog2(v.kx, v.ky);
+      const float* t = ResampleInto(shape, res, mean, v.slot, accept);
+      v.error = spectral::MaxReadBackError(t, res, samples.data(), shape,
+                                           early_stop ? u.error : kInfinity);
+      v.edge = EdgeError(t, res, shape, accept);
+    }
+    at = can_u && accept.Score(u.error, u.edge) <= accept.Score(v.error, v.edge) ? u : v;
+    ++stats.step_ups;
+  }
+}
+
 StatusOr<SpectralFace> SpectralAnalyzer::Analyze(std::span<const float> samples, int nx, int ny,
                                                  const SpectralOptions& options) {
   DISPEX_RETURN_IF_ERROR(ValidateSpectralOptions(options));
@@ -134,130 +253,28 @@ StatusOr<SpectralFace> SpectralAnalyzer::Analyze(std::span<const float> samples,
 
   SpectralFace face;
   face.stats.texels_before = static_cast<std::int64_t>(shape.count());
-  const double tolerance = options.tolerance;
-  const bool verify = options.rule == ResolutionRule::kErrorBound && options.verify;
-  // With an edge tolerance, a resolution is accepted when both the read-back error and the
-  // per-face reader's error on the face's edges are within theirs; candidates compete on the
-  // larger of the two ratios.
-  const double edge_tolerance = verify ? options.edge_tolerance : 0.0;
-  auto edge_error = [&](const float* texels, const BlockShape& res) {
-    return edge_tolerance > 0 ? spectral::MaxEdgeReadError(texels, res, m.samples.data(), shape)
-                              : 0.0;
-  };
-  auto score = [&](double error, double edge) {
-    return edge_tolerance > 0 ? std::max(error / tolerance, edge / edge_tolerance) : error;
-  };
-  auto accepted = [&](double error, double edge) {
-    return error <= tolerance && (edge_tolerance <= 0 || edge <= edge_tolerance);
-  };
-  const bool has_floor = options.min_ulog2 > 0 || options.min_vlog2 > 0;
-  if (options.rule == ResolutionRule::kErrorBound && summary.max_deviation <= tolerance &&
-      !has_floor) {
-    float* texel = m.texels[0].Reserve(1);
-    texel[0] = summary.mean;
-    const double edge = edge_error(texel, ShapeOfLog2(0, 0));
-    if (accepted(summary.max_deviation, edge)) {
-      face.constant = true;
-      face.constant_value = summary.mean;
-      face.texels = std::span<const float>(texel, 1);
-      face.stats.texels_after = 1;
-      face.stats.bound = summary.max_deviation;
-      face.stats.measured_error = summary.max_deviation;
-      face.stats.edge_error = edge;
-      face.stats.constant = true;
-      return face;
-    }
-  }
+  const Acceptance accept(options);
+  if (m.AcceptConstant(shape, summary, options, accept, face)) return face;
 
-  m.dct.Forward(shape.lx, shape.ly, m.samples.data(), m.coefficients.Reserve(shape.count()));
-  m.bounds.Build(m.coefficients.data(), shape);
-  int kx = 0;
-  int ky = 0;
-  switch (options.rule) {
-    case ResolutionRule::kErrorBound:
-      std::tie(kx, ky) = m.bounds.Smallest(tolerance);
-      break;
-    case ResolutionRule::kNonzero:
-      std::tie(kx, ky) =
-          spectral::NonzeroRuleResolution(m.coefficients.data(), shape, options.nonzero_threshold);
-      break;
-    case ResolutionRule::kFixed:
-      kx = options.fixed_ulog2;
-      ky = options.fixed_vlog2;
-      break;
-  }
-  face.stats.bound_ulog2 = kx;
-  face.stats.bound_vlog2 = ky;
-  if (options.rule == ResolutionRule::kErrorBound) {
-    kx = std::max(kx, std::min(options.min_ulog2, shape.lx));
-    ky = std::max(ky, std::min(options.min_vlog2, shape.ly));
-  }
+  Impl::Candidate at;
+  std::tie(at.kx, at.ky) = m.RuleResolution(shape, options, face.stats);
+  const BlockShape first = ShapeOfLog2(at.kx, at.ky);
+  const float* texels = m.ResampleInto(shape, first, summary.mean, at.slot, accept);
+  at.error = spectral::MaxReadBackError(texels, first, m.samples.data(), shape,
+                                        accept.verify ? accept.tolerance : kInfinity);
+  at.edge = m.EdgeError(texels, first, shape, accept);
+  if (accept.verify) m.StepUp(shape, summary.mean, accept, at, face.stats);
 
-  const bool pin = verify && options.pin_edges;
-  auto resample = [&](const BlockShape& res, int into) -> const float* {
-    float* t = m.ResampleLoaded(shape, res, summary.mean, into);
-    if (pin) spectral::PinEdgeTexels(t, res, m.samples.data(), shape);
-    return t;
-  };
-  int slot = 0;
-  const float* texels = resample(ShapeOfLog2(kx, ky), slot);
-  const bool early_stop = verify && edge_tolerance <= 0;
-  double error = spectral::MaxReadBackError(texels, ShapeOfLog2(kx, ky), m.samples.data(), shape,
-                                            verify ? tolerance : kInfinity);
-  double edge = edge_error(texels, ShapeOfLog2(kx, ky));
-  while (verify && !accepted(error, edge)) {
-    // Candidates: u doubled into one free slot, v doubled into the other. The v candidate's
-    // measurement may stop once it exceeds the u candidate's (it has lost: ties go to u).
-    const bool can_u = kx < shape.lx;
-    const bool can_v = ky < shape.ly;
-    if (!can_u && !can_v) {
-      // The full resolution reads back exactly; only the edge criterion can still fail, where
-      // the samples themselves are too coarse for it.
-      DISPEX_CHECK(error <= tolerance);
-      face.stats.edge_limited = true;
-      break;
-    }
-    const int slot_u = (slot + 1) % 3;
-    const int slot_v = (slot + 2) % 3;
-    double error_u = kInfinity, edge_u = kInfinity;
-    double error_v = kInfinity, edge_v = kInfinity;
-    if (can_u) {
-      const BlockShape res = ShapeOfLog2(kx + 1, ky);
-      const float* t = resample(res, slot_u);
-      error_u = spectral::MaxReadBackError(t, res, m.samples.data(), shape, kInfinity);
-      edge_u = edge_error(t, res);
-    }
-    if (can_v) {
-      const BlockShape res = ShapeOfLog2(kx, ky + 1);
-      const float* t = resample(res, slot_v);
-      error_v = spectral::MaxReadBackError(t, res, m.samples.data(), shape,
-                                           early_stop ? error_u : kInfinity);
-      edge_v = edge_error(t, res);
-    }
-    if (can_u && score(error_u, edge_u) <= score(error_v, edge_v)) {
-      ++kx;
-      slot = slot_u;
-      error = error_u;
-      edge = edge_u;
-    } else {
-      ++ky;
-      slot = slot_v;
-      error = error_v;
-      edge = edge_v;
-    }
-    ++face.stats.step_ups;
-  }
-
-  const BlockShape res = ShapeOfLog2(kx, ky);
-  face.ulog2 = kx;
-  face.vlog2 = ky;
-  face.texels = std::span<const float>(m.texels[slot].data(), res.count());
+  const BlockShape res = ShapeOfLog2(at.kx, at.ky);
+  face.ulog2 = at.kx;
+  face.vlog2 = at.ky;
+  face.texels = std::span<const float>(m.texels[at.slot].data(), res.count());
   face.constant = res.count() == 1;
   face.constant_value = face.constant ? face.texels[0] : 0.0f;
   face.stats.texels_after = static_cast<std::int64_t>(res.count());
-  face.stats.bound = m.bounds.Bound(kx, ky);
-  face.stats.measured_error = error;
-  face.stats.edge_error = edge;
+  face.stats.bound = m.bounds.Bound(at.kx, at.ky);
+  face.stats.measured_error = at.error;
+  face.stats.edge_error = at.edge;
   face.stats.constant = face.constant;
   return face;
 }

@@ -8,9 +8,11 @@
 #include <cmath>
 #include <limits>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "dispex/spectral.h"
+#include "spectral/acceptance.h"
 #include "spectral/aligned_buffer.h"
 #include "spectral/bilinear_readback.h"
 #include "spectral/block_shape.h"
@@ -22,6 +24,7 @@
 
 namespace dispex {
 
+using spectral::Acceptance;
 using spectral::BlockShape;
 using spectral::ShapeOfLog2;
 
@@ -133,7 +136,103 @@ struct SpectralVectorAnalyzer::Impl {
     }
     return Measured{std::sqrt(worst), EdgeError(shape, res)};
   }
+
+  // Analyze's steps, in order (SpectralAnalyzer's: see spectral_analyzer.cpp).
+  //
+  // A resolution 2^kx x 2^ky, its texels in interleaved[slot], and their errors.
+  struct Candidate {
+    int kx = 0, ky = 0, slot = 0;
+    Measured measured;
+  };
+  // 1. The face as the samples' mean, when that is within the tolerances.
+  bool AcceptConstant(const BlockShape& shape, const SpectralOptions& options,
+                      const Acceptance& accept, SpectralVectorFace& face);
+  // 2. The rule's resolution (on the vector bound, the largest of the channels' nonzero rules,
+  // or the fixed one), into face.stats, raised to the floor.
+  std::pair<int, int> RuleResolution(const BlockShape& shape, const SpectralOptions& options,
+                                     SpectralFaceStats& stats);
+  // 3. With verify: u or v doubled, whichever scores lower (ties go to u), until accepted; the
+  // full resolution holds the samples themselves, so the loop ends.
+  void StepUp(const BlockShape& shape, const Acceptance& accept, Candidate& at,
+              SpectralFaceStats& stats);
 };
+
+bool SpectralVectorAnalyzer::Impl::AcceptConstant(const BlockShape& shape,
+                                                  const SpectralOptions& options,
+                                                  const Acceptance& accept,
+                                                  SpectralVectorFace& face) {
+  if (!spectral::ConstantAllowed(options)) return false;
+  const double deviation = MaxDeviationFromMean(shape);
+  if (!(deviation <= accept.tolerance)) return false;
+  for (int c = 0; c < kChannels; ++c) texels[c].Reserve(1)[0] = mean[c];
+  const Measured constant{deviation, EdgeError(shape, ShapeOfLog2(0, 0))};
+  if (!accept.Accepted(constant.error, constant.edge)) return false;
+  float* texel = interleaved[0].Reserve(kChannels);
+  std::copy(mean.begin(), mean.end(), texel);
+  face.constant = true;
+  face.constant_value = mean;
+  face.texels = std::span<const float>(texel, kChannels);
+  face.stats.texels_after = 1;
+  face.stats.bound = deviation;
+  face.stats.measured_error = deviation;
+  face.stats.edge_error = constant.edge;
+  face.stats.constant = true;
+  return true;
+}
+
+std::pair<int, int> SpectralVectorAnalyzer::Impl::RuleResolution(const BlockShape& shape,
+                                                                 const SpectralOptions& options,
+                                                                 SpectralFaceStats& stats) {
+  for (int c = 0; c < kChannels; ++c) {
+    dct.Forward(shape.lx, shape.ly, samples[c].data(), coefficients[c].Reserve(shape.count()));
+    bounds[c].Build(coefficients[c].data(), shape);
+  }
+  int kx = 0;
+  int ky = 0;
+  switch (options.rule) {
+    case ResolutionRule::kErrorBound:
+      std::tie(kx, ky) = Smallest(shape, options.tolerance);
+      break;
+    case ResolutionRule::kNonzero:
+      for (int c = 0; c < kChannels; ++c) {
+        const auto [cx, cy] = spectral::NonzeroRuleResolution(coefficients[c].data(), shape,
+                                                              options.nonzero_threshold);
+        kx = std::max(kx, cx);
+        ky = std::max(ky, cy);
+      }
+      break;
+    case ResolutionRule::kFixed:
+      kx = options.fixed_ulog2;
+      ky = options.fixed_vlog2;
+      break;
+  }
+  stats.bound_ulog2 = kx;
+  stats.bound_vlog2 = ky;
+  spectral::RaiseToFloor(options, shape, kx, ky);
+  return {kx, ky};
+}
+
+void SpectralVectorAnalyzer::Impl::StepUp(const BlockShape& shape, const Acceptance& accept,
+                                          Candidate& at, SpectralFaceStats& stats) {
+  while (!accept.Accepted(at.measured.error, at.measured.edge)) {
+    const bool can_u = at.kx < shape.lx;
+    const bool can_v = at.ky < shape.ly;
+    if (!can_u && !can_v) {
+      // Only the edge criterion can still fail, where the samples are too coarse for it.
+      stats.edge_limited = measure_edges;
+      break;
+    }
+    const Measured none{kInfinity, kInfinity};
+    Candidate u{at.kx + 1, at.ky, (at.slot + 1) % 3, none};
+    Candidate v{at.kx, at.ky + 1, (at.slot + 2) % 3, none};
+    if (can_u) u.measured = ResampleAndMeasure(shape, ShapeOfLog2(u.kx, u.ky), u.slot);
+    if (can_v) v.measured = ResampleAndMeasure(shape, ShapeOfLog2(v.kx, v.ky), v.slot);
+    const bool take_u = can_u && accept.Score(u.measured.error, u.measured.edge) <=
+                                     accept.Score(v.measured.error, v.measured.edge);
+    at = take_u ? u : v;
+    ++stats.step_ups;
+  }
+}
 
 SpectralVectorAnalyzer::SpectralVectorAnalyzer() : impl_(std::make_unique<Impl>()) {}
 SpectralVectorAnalyzer::~SpectralVectorAnalyzer() = default;
@@ -157,113 +256,26 @@ StatusOr<SpectralVectorFace> SpectralVectorAnalyzer::Analyze(std::span<const flo
 
   SpectralVectorFace face;
   face.stats.texels_before = static_cast<std::int64_t>(shape.count());
-  const double tolerance = options.tolerance;
-  const bool verify = options.rule == ResolutionRule::kErrorBound && options.verify;
-  // As SpectralAnalyzer: with an edge tolerance a resolution is accepted when both errors are
-  // within theirs, and candidates compete on the larger of the two ratios.
-  const double edge_tolerance = verify ? options.edge_tolerance : 0.0;
-  m.measure_edges = edge_tolerance > 0;
-  m.pin = verify && options.pin_edges;
-  auto score = [&](const Measured& e) {
-    return m.measure_edges ? std::max(e.error / tolerance, e.edge / edge_tolerance) : e.error;
-  };
-  auto accepted = [&](const Measured& e) {
-    return e.error <= tolerance && (!m.measure_edges || e.edge <= edge_tolerance);
-  };
-  const bool has_floor = options.min_ulog2 > 0 || options.min_vlog2 > 0;
-  if (options.rule == ResolutionRule::kErrorBound && !has_floor) {
-    const double deviation = m.MaxDeviationFromMean(shape);
-    if (deviation <= tolerance) {
-      for (int c = 0; c < kChannels; ++c) m.texels[c].Reserve(1)[0] = m.mean[c];
-      const Measured constant{deviation, m.EdgeError(shape, ShapeOfLog2(0, 0))};
-      if (accepted(constant)) {
-        float* texel = m.interleaved[0].Reserve(kChannels);
-        std::copy(m.mean.begin(), m.mean.end(), texel);
-        face.constant = true;
-        face.constant_value = m.mean;
-        face.texels = std::span<const float>(texel, kChannels);
-        face.stats.texels_after = 1;
-        face.stats.bound = deviation;
-        face.stats.measured_error = deviation;
-        face.stats.edge_error = constant.edge;
-        face.stats.constant = true;
-        return face;
-      }
-    }
-  }
+  const Acceptance accept(options);
+  m.measure_edges = accept.measure_edges();
+  m.pin = accept.pin;
+  if (m.AcceptConstant(shape, options, accept, face)) return face;
 
-  for (int c = 0; c < kChannels; ++c) {
-    m.dct.Forward(shape.lx, shape.ly, m.samples[c].data(),
-                  m.coefficients[c].Reserve(shape.count()));
-    m.bounds[c].Build(m.coefficients[c].data(), shape);
-  }
-  int kx = 0;
-  int ky = 0;
-  switch (options.rule) {
-    case ResolutionRule::kErrorBound:
-      std::tie(kx, ky) = m.Smallest(shape, tolerance);
-      break;
-    case ResolutionRule::kNonzero:
-      for (int c = 0; c < kChannels; ++c) {
-        const auto [cx, cy] = spectral::NonzeroRuleResolution(m.coefficients[c].data(), shape,
-                                                              options.nonzero_threshold);
-        kx = std::max(kx, cx);
-        ky = std::max(ky, cy);
-      }
-      break;
-    case ResolutionRule::kFixed:
-      kx = options.fixed_ulog2;
-      ky = options.fixed_vlog2;
-      break;
-  }
-  face.stats.bound_ulog2 = kx;
-  face.stats.bound_vlog2 = ky;
-  if (options.rule == ResolutionRule::kErrorBound) {
-    kx = std::max(kx, std::min(options.min_ulog2, shape.lx));
-    ky = std::max(ky, std::min(options.min_vlog2, shape.ly));
-  }
+  Impl::Candidate at;
+  std::tie(at.kx, at.ky) = m.RuleResolution(shape, options, face.stats);
+  at.measured = m.ResampleAndMeasure(shape, ShapeOfLog2(at.kx, at.ky), at.slot);
+  if (accept.verify) m.StepUp(shape, accept, at, face.stats);
 
-  int slot = 0;
-  Measured measured = m.ResampleAndMeasure(shape, ShapeOfLog2(kx, ky), slot);
-  while (verify && !accepted(measured)) {
-    // Double u or v, whichever scores lower (ties go to u); the full resolution holds the
-    // samples themselves, so the loop ends.
-    const bool can_u = kx < shape.lx;
-    const bool can_v = ky < shape.ly;
-    if (!can_u && !can_v) {
-      // Only the edge criterion can still fail, where the samples are too coarse for it.
-      face.stats.edge_limited = m.measure_edges;
-      break;
-    }
-    const int slot_u = (slot + 1) % 3;
-    const int slot_v = (slot + 2) % 3;
-    const Measured none{kInfinity, kInfinity};
-    const Measured at_u =
-        can_u ? m.ResampleAndMeasure(shape, ShapeOfLog2(kx + 1, ky), slot_u) : none;
-    const Measured at_v =
-        can_v ? m.ResampleAndMeasure(shape, ShapeOfLog2(kx, ky + 1), slot_v) : none;
-    if (can_u && score(at_u) <= score(at_v)) {
-      ++kx;
-      slot = slot_u;
-      measured = at_u;
-    } else {
-      ++ky;
-      slot = slot_v;
-      measured = at_v;
-    }
-    ++face.stats.step_ups;
-  }
-
-  const BlockShape res = ShapeOfLog2(kx, ky);
-  face.ulog2 = kx;
-  face.vlog2 = ky;
-  face.texels = std::span<const float>(m.interleaved[slot].data(), kChannels * res.count());
+  const BlockShape res = ShapeOfLog2(at.kx, at.ky);
+  face.ulog2 = at.kx;
+  face.vlog2 = at.ky;
+  face.texels = std::span<const float>(m.interleaved[at.slot].data(), kChannels * res.count());
   face.constant = res.count() == 1;
   if (face.constant) std::copy_n(face.texels.begin(), kChannels, face.constant_value.begin());
   face.stats.texels_after = static_cast<std::int64_t>(res.count());
-  face.stats.bound = m.Bound(kx, ky);
-  face.stats.measured_error = measured.error;
-  face.stats.edge_error = measured.edge;
+  face.stats.bound = m.Bound(at.kx, at.ky);
+  face.stats.measured_error = at.measured.error;
+  face.stats.edge_error = at.measured.edge;
   face.stats.constant = face.constant;
   return face;
 }

@@ -135,6 +135,123 @@ bool ValidSharpness(float s) {
   return std::isfinite(s) && s >= 0.0f;
 }
 
+Status Fail(const std::string& where, const std::string& what) {
+  return Status::Error(where + ": " + what);
+}
+
+// The face arrays' extent, the sizes OpenSubdiv's int indices hold, and finite positions.
+Status CheckArrays(const Mesh& cage, const std::string& where) {
+  if (cage.face_offsets.size() < 2) return Fail(where, "the cage has no faces");
+  if (cage.face_offsets.front() != 0 || cage.face_offsets.back() != cage.face_indices.size()) {
+    return Fail(
+        where,
+        fmt::format("face offsets do not span the {} face indices (first {}, last {})",
+                    cage.face_indices.size(), cage.face_offsets.front(), cage.face_offsets.back()));
+  }
+  constexpr std::size_t kMaxIndex = std::numeric_limits<std::int32_t>::max();
+  if (cage.num_faces() > kMaxIndex || cage.num_vertices() > kMaxIndex ||
+      cage.face_indices.size() > kMaxIndex) {
+    return Fail(where, fmt::format("too large for OpenSubdiv ({} vertices, {} faces)",
+                                   cage.num_vertices(), cage.num_faces()));
+  }
+  if (cage.num_vertices() == 0) return Fail(where, "the cage has no vertices");
+  for (std::size_t v = 0; v < cage.num_vertices(); ++v) {
+    const Float3& p = cage.positions[v];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      return Fail(
+          where, fmt::format("vertex {} has a non-finite position ({}, {}, {})", v, p.x, p.y, p.z));
+    }
+  }
+  return Status::Ok();
+}
+
+// Every face: its size, its vertex indices in range, no vertex twice.
+Status CheckFaces(const Mesh& cage, const std::string& where) {
+  const std::int64_t num_vertices = static_cast<std::int64_t>(cage.num_vertices());
+  std::vector<std::int32_t> sorted;  // scratch for repeated-vertex checks of large faces
+  for (std::size_t f = 0; f < cage.num_faces(); ++f) {
+    if (cage.face_offsets[f + 1] < cage.face_offsets[f]) {
+      return Fail(where, fmt::format("face {}: face offsets decrease", f));
+    }
+    const int n = cage.face_size(f);
+    if (n < 3) {
+      return Fail(where, fmt::format("face {} has {} vertices; a face needs at least 3", f, n));
+    }
+    if (n > Far::VALENCE_LIMIT) {
+      return Fail(where, fmt::format("face {} has {} vertices; OpenSubdiv allows at most {}", f, n,
+                                     Far::VALENCE_LIMIT));
+    }
+    std::span<const std::int32_t> face = cage.face(f);
+    for (int k = 0; k < n; ++k) {
+      if (face[k] < 0 || face[k] >= num_vertices) {
+        return Fail(where, fmt::format("face {}: vertex index {} out of range ({} vertices)", f,
+                                       face[k], num_vertices));
+      }
+    }
+    if (n <= 16) {
+      for (int a = 0; a < n; ++a) {
+        for (int b = a + 1; b < n; ++b) {
+          if (face[a] == face[b]) {
+            return Fail(where,
+                        fmt::format("face {} repeats vertex {} (a degenerate face)", f, face[a]));
+          }
+        }
+      }
+    } else {
+      sorted.assign(face.begin(), face.end());
+      std::sort(sorted.begin(), sorted.end());
+      auto it = std::adjacent_find(sorted.begin(), sorted.end());
+      if (it != sorted.end()) {
+        return Fail(where, fmt::format("face {} repeats vertex {} (a degenerate face)", f, *it));
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+// Crease, corner and hole tags: their vertices and faces in range, their sharpness valid.
+Status CheckTags(const Mesh& cage, const std::string& where) {
+  const std::int64_t num_vertices = static_cast<std::int64_t>(cage.num_vertices());
+  const SubdivTags& tags = cage.tags;
+  for (std::size_t i = 0; i < tags.creases.size(); ++i) {
+    const auto& c = tags.creases[i];
+    if (c.v0.value < 0 || c.v0.value >= num_vertices || c.v1.value < 0 ||
+        c.v1.value >= num_vertices) {
+      return Fail(where, fmt::format("crease tag {}: vertex {}-{} out of range ({} vertices)", i,
+                                     c.v0.value, c.v1.value, num_vertices));
+    }
+    if (c.v0 == c.v1) {
+      return Fail(where, fmt::format("crease tag {}: vertices {}-{} do not make an edge", i,
+                                     c.v0.value, c.v1.value));
+    }
+    if (!ValidSharpness(c.sharpness)) {
+      return Fail(where, fmt::format("crease tag {} (vertices {}-{}): sharpness {} is not a finite "
+                                     "value >= 0",
+                                     i, c.v0.value, c.v1.value, c.sharpness));
+    }
+  }
+  for (std::size_t i = 0; i < tags.corners.size(); ++i) {
+    const auto& c = tags.corners[i];
+    if (c.vertex.value < 0 || c.vertex.value >= num_vertices) {
+      return Fail(where, fmt::format("corner tag {}: vertex {} out of range ({} vertices)", i,
+                                     c.vertex.value, num_vertices));
+    }
+    if (!ValidSharpness(c.sharpness)) {
+      return Fail(where, fmt::format("corner tag {} (vertex {}): sharpness {} is not a finite "
+                                     "value >= 0",
+                                     i, c.vertex.value, c.sharpness));
+    }
+  }
+  const std::int64_t num_faces = static_cast<std::int64_t>(cage.num_faces());
+  for (std::size_t i = 0; i < tags.holes.size(); ++i) {
+    if (tags.holes[i].value < 0 || tags.holes[i].value >= num_faces) {
+      return Fail(where, fmt::format("hole tag {}: face {} out of range ({} faces)", i,
+                                     tags.holes[i].value, num_faces));
+    }
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 float MaxSemiSharpness(const SubdivTags& tags) {
@@ -150,108 +267,9 @@ float MaxSemiSharpness(const SubdivTags& tags) {
 
 Status ValidateCage(const Mesh& cage) {
   const std::string where = Where(cage);
-  auto fail = [&](const std::string& what) { return Status::Error(where + ": " + what); };
-
-  if (cage.face_offsets.size() < 2) return fail("the cage has no faces");
-  if (cage.face_offsets.front() != 0 || cage.face_offsets.back() != cage.face_indices.size()) {
-    return fail(fmt::format("face offsets do not span the {} face indices (first {}, last {})",
-                            cage.face_indices.size(), cage.face_offsets.front(),
-                            cage.face_offsets.back()));
-  }
-  constexpr std::size_t kMaxIndex = std::numeric_limits<std::int32_t>::max();
-  if (cage.num_faces() > kMaxIndex || cage.num_vertices() > kMaxIndex ||
-      cage.face_indices.size() > kMaxIndex) {
-    return fail(fmt::format("too large for OpenSubdiv ({} vertices, {} faces)", cage.num_vertices(),
-                            cage.num_faces()));
-  }
-  if (cage.num_vertices() == 0) return fail("the cage has no vertices");
-  for (std::size_t v = 0; v < cage.num_vertices(); ++v) {
-    const Float3& p = cage.positions[v];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      return fail(
-          fmt::format("vertex {} has a non-finite position ({}, {}, {})", v, p.x, p.y, p.z));
-    }
-  }
-
-  const std::int64_t num_vertices = static_cast<std::int64_t>(cage.num_vertices());
-  std::vector<std::int32_t> sorted;  // scratch for repeated-vertex checks of large faces
-  for (std::size_t f = 0; f < cage.num_faces(); ++f) {
-    if (cage.face_offsets[f + 1] < cage.face_offsets[f]) {
-      return fail(fmt::format("face {}: face offsets decrease", f));
-    }
-    const int n = cage.face_size(f);
-    if (n < 3) {
-      return fail(fmt::format("face {} has {} vertices; a face needs at least 3", f, n));
-    }
-    if (n > Far::VALENCE_LIMIT) {
-      return fail(fmt::format("face {} has {} vertices; OpenSubdiv allows at most {}", f, n,
-                              Far::VALENCE_LIMIT));
-    }
-    std::span<const std::int32_t> face = cage.face(f);
-    for (int k = 0; k < n; ++k) {
-      if (face[k] < 0 || face[k] >= num_vertices) {
-        return fail(fmt::format("face {}: vertex index {} out of range ({} vertices)", f, face[k],
-                                num_vertices));
-      }
-    }
-    if (n <= 16) {
-      for (int a = 0; a < n; ++a) {
-        for (int b = a + 1; b < n; ++b) {
-          if (face[a] == face[b]) {
-            return fail(fmt::format("face {} repeats vertex {} (a degenerate face)", f, face[a]));
-          }
-        }
-      }
-    } else {
-      sorted.assign(face.begin(), face.end());
-      std::sort(sorted.begin(), sorted.end());
-      auto it = std::adjacent_find(sorted.begin(), sorted.end());
-      if (it != sorted.end()) {
-        return fail(fmt::format("face {} repeats vertex {} (a degenerate face)", f, *it));
-      }
-    }
-  }
-
-  const SubdivTags& tags = cage.tags;
-  for (std::size_t i = 0; i < tags.creases.size(); ++i) {
-    const auto& c = tags.creases[i];
-    if (c.v0.value < 0 || c.v0.value >= num_vertices || c.v1.value < 0 ||
-        c.v1.value >= num_vertices) {
-      return fail(fmt::format("crease tag {}: vertex {}-{} out of range ({} vertices)", i,
-                              c.v0.value, c.v1.value, num_vertices));
-    }
-    if (c.v0 == c.v1) {
-      return fail(fmt::format("crease tag {}: vertices {}-{} do not make an edge", i, c.v0.value,
-                              c.v1.value));
-    }
-    if (!ValidSharpness(c.sharpness)) {
-      return fail(
-          fmt::format("crease tag {} (vertices {}-{}): sharpness {} is not a finite "
-                      "value >= 0",
-                      i, c.v0.value, c.v1.value, c.sharpness));
-    }
-  }
-  for (std::size_t i = 0; i < tags.corners.size(); ++i) {
-    const auto& c = tags.corners[i];
-    if (c.vertex.value < 0 || c.vertex.value >= num_vertices) {
-      return fail(fmt::format("corner tag {}: vertex {} out of range ({} vertices)", i,
-                              c.vertex.value, num_vertices));
-    }
-    if (!ValidSharpness(c.sharpness)) {
-      return fail(
-          fmt::format("corner tag {} (vertex {}): sharpness {} is not a finite value "
-                      ">= 0",
-                      i, c.vertex.value, c.sharpness));
-    }
-  }
-  const std::int64_t num_faces = static_cast<std::int64_t>(cage.num_faces());
-  for (std::size_t i = 0; i < tags.holes.size(); ++i) {
-    if (tags.holes[i].value < 0 || tags.holes[i].value >= num_faces) {
-      return fail(fmt::format("hole tag {}: face {} out of range ({} faces)", i,
-                              tags.holes[i].value, num_faces));
-    }
-  }
-  return Status::Ok();
+  DISPEX_RETURN_IF_ERROR(CheckArrays(cage, where));
+  DISPEX_RETURN_IF_ERROR(CheckFaces(cage, where));
+  return CheckTags(cage, where);
 }
 
 StatusOr<std::unique_ptr<Far::TopologyRefiner>> BuildTopologyRefiner(const Mesh& cage) {

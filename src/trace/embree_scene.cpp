@@ -32,6 +32,103 @@ RTCBuildQuality ToRtc(BuildQuality quality) {
   return RTC_BUILD_QUALITY_MEDIUM;
 }
 
+#if defined(__SANITIZE_THREAD__)
+// Under ThreadSanitizer: builds and releases of scenes one at a time across threads. Embree's
+// allocator hands memory a build on one thread freed to a build on another (two shapes
+// extracted side by side), through locks in libembree3 that ThreadSanitizer cannot see.
+std::mutex& EmbreeMemoryLock() {
+  static std::mutex lock;
+  return lock;
+}
+#endif
+
+// A new scene with the options' flags and build quality (nullptr when Embree fails).
+RTCScene NewScene(RTCDevice device, const TracerOptions& options) {
+  RTCScene scene = rtcNewScene(device);
+  if (scene == nullptr) return nullptr;
+  // The context filter is used only by the rare re-cast past a surface before a ray's
+  // window (batch_kernels.h, CastInWindow); Embree requires the flag to call it.
+  int flags = RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION;
+  if (options.robust) flags |= RTC_SCENE_FLAG_ROBUST;
+  if (options.compact) flags |= RTC_SCENE_FLAG_COMPACT;
+  rtcSetSceneFlags(scene, static_cast<RTCSceneFlags>(flags));
+  rtcSetSceneBuildQuality(scene, ToRtc(options.quality));
+  return scene;
+}
+
+// The vertices Embree reads, which may read 16 bytes at the last one: the mesh's own vector
+// when its capacity covers that, else one padded copy in `copy`.
+const Float3* PaddedPositions(const Mesh& mesh, std::vector<Float3>& copy, TracerStats& stats) {
+  const std::size_t num_vertices = mesh.num_vertices();
+  if (mesh.positions.capacity() >= num_vertices + 1) {
+    stats.shared_vertices = true;
+    return mesh.positions.data();
+  }
+  copy.reserve(num_vertices + 1);
+  copy.assign(mesh.positions.begin(), mesh.positions.end());
+  stats.copied_bytes += copy.capacity() * sizeof(Float3);
+  return copy.data();
+}
+
+// A mixed mesh's quads (their 4 indices each) and its other faces fanned from their first
+// vertex into triangles, with the sculpt face of each.
+void SplitMixedFaces(const Mesh& mesh, const SculptCounts& counts,
+                     std::vector<std::int32_t>& quad_indices, std::vector<std::int32_t>& quad_faces,
+                     std::vector<std::int32_t>& triangle_indices,
+                     std::vector<std::int32_t>& triangle_faces) {
+  quad_indices.reserve(4 * counts.quads);
+  quad_faces.reserve(counts.quads);
+  triangle_indices.reserve(3 * counts.triangles);
+  triangle_faces.reserve(counts.triangles);
+  for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+    const auto face = mesh.face(f);
+    const auto face_id = static_cast<std::int32_t>(f);
+    if (face.size() == 4) {
+      quad_indices.insert(quad_indices.end(), face.begin(), face.end());
+      quad_faces.push_back(face_id);
+      continue;
+    }
+    for (std::size_t k = 1; k + 1 < face.size(); ++k) {
+      triangle_indices.insert(triangle_indices.end(), {face[0], face[k], face[k + 1]});
+      triangle_faces.push_back(face_id);
+    }
+  }
+}
+
+// Builds the scene's BVH.
+void CommitScene(RTCScene scene) {
+#if defined(__SANITIZE_THREAD__)
+  // libembree3 is not instrumented: the TBB tasks of its BVH build read a task_group_context
+  // on this thread's stack, and ThreadSanitizer cannot see that they finished before the frame
+  // is reused (scripts/tsan-extract.sh). Under TSan the build runs on this thread alone, and
+  // one build at a time (EmbreeMemoryLock).
+  const std::lock_guard<std::mutex> lock(EmbreeMemoryLock());
+  tbb::task_arena(1).execute([&] { rtcCommitScene(scene); });
+#else
+  rtcCommitScene(scene);
+#endif
+}
+
+// The largest absolute finite coordinate of the scene's bounds (0 when none is finite).
+float BoundsScale(RTCScene scene) {
+  RTCBounds bounds;
+  rtcGetSceneBounds(scene, &bounds);
+  float scale = 0;
+  for (const float c : {bounds.lower_x, bounds.lower_y, bounds.lower_z, bounds.upper_x,
+                        bounds.upper_y, bounds.upper_z}) {
+    if (std::isfinite(c)) scale = std::max(scale, std::fabs(c));
+  }
+  return scale;
+}
+
+// What the stats call the backend: the device, the build and the guard's settings.
+std::string BackendName(const EmbreeDevice& device, const TracerOptions& options) {
+  return fmt::format("{}, {} build{}{}{}{}", device.Describe(), BuildQualityName(options.quality),
+                     options.robust ? ", robust" : "", options.compact ? ", compact" : "",
+                     options.retry_misses ? ", retry misses" : "",
+                     options.verify_hits ? ", verify hits" : "");
+}
+
 }  // namespace
 
 StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Mesh& mesh,
@@ -56,18 +153,6 @@ StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Mesh& mesh,
   }
   return scene;
 }
-
-#if defined(__SANITIZE_THREAD__)
-namespace {
-// Under ThreadSanitizer: builds and releases of scenes one at a time across threads. Embree's
-// allocator hands memory a build on one thread freed to a build on another (two shapes
-// extracted side by side), through locks in libembree3 that ThreadSanitizer cannot see.
-std::mutex& EmbreeMemoryLock() {
-  static std::mutex lock;
-  return lock;
-}
-}  // namespace
-#endif
 
 EmbreeScene::~EmbreeScene() {
 #if defined(__SANITIZE_THREAD__)
@@ -101,61 +186,22 @@ Status EmbreeScene::Setup(const Mesh& mesh, const TracerOptions& options) {
   const auto setup_start = Clock::now();
   SculptCounts counts;
   DISPEX_RETURN_IF_ERROR(CheckSculpt(mesh, &counts));
-
-  scene_ = rtcNewScene(device_->get());
+  scene_ = NewScene(device_->get(), options);
   if (scene_ == nullptr) return device_->TakeError();
-  // The context filter is used only by the rare re-cast past a surface before a ray's
-  // window (batch_kernels.h, CastInWindow); Embree requires the flag to call it.
-  int flags = RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION;
-  if (options.robust) flags |= RTC_SCENE_FLAG_ROBUST;
-  if (options.compact) flags |= RTC_SCENE_FLAG_COMPACT;
-  rtcSetSceneFlags(scene_, static_cast<RTCSceneFlags>(flags));
-  const RTCBuildQuality quality = ToRtc(options.quality);
-  rtcSetSceneBuildQuality(scene_, quality);
+  positions_ = PaddedPositions(mesh, vertex_copy_, stats_);
 
-  // Embree may read 16 bytes at the last vertex: share the mesh's vector when its capacity
-  // covers that, else make one padded copy.
-  const std::size_t num_vertices = mesh.num_vertices();
-  if (mesh.positions.capacity() >= num_vertices + 1) {
-    positions_ = mesh.positions.data();
-    stats_.shared_vertices = true;
-  } else {
-    vertex_copy_.reserve(num_vertices + 1);
-    vertex_copy_.assign(mesh.positions.begin(), mesh.positions.end());
-    positions_ = vertex_copy_.data();
-    stats_.copied_bytes += vertex_copy_.capacity() * sizeof(Float3);
-  }
-
+  // All quads or all triangles: Embree reads the mesh's own indices.
   const std::size_t num_faces = mesh.num_faces();
-  const bool all_quads = counts.quads == num_faces;
-  const bool all_triangles = counts.triangle_faces == num_faces;
   const std::int32_t* quad_indices = nullptr;
   const std::int32_t* triangle_indices = nullptr;
-  if (all_quads) {
+  if (counts.quads == num_faces) {
     quad_indices = mesh.face_indices.data();
     stats_.shared_indices = true;
-  } else if (all_triangles) {
+  } else if (counts.triangle_faces == num_faces) {
     triangle_indices = mesh.face_indices.data();
     stats_.shared_indices = true;
   } else {
-    // Mixed: quads keep their 4 indices, other faces are fanned from their first vertex.
-    quad_indices_.reserve(4 * counts.quads);
-    quad_faces_.reserve(counts.quads);
-    triangle_indices_.reserve(3 * counts.triangles);
-    triangle_faces_.reserve(counts.triangles);
-    for (std::size_t f = 0; f < num_faces; ++f) {
-      const auto face = mesh.face(f);
-      const auto face_id = static_cast<std::int32_t>(f);
-      if (face.size() == 4) {
-        quad_indices_.insert(quad_indices_.end(), face.begin(), face.end());
-        quad_faces_.push_back(face_id);
-        continue;
-      }
-      for (std::size_t k = 1; k + 1 < face.size(); ++k) {
-        triangle_indices_.insert(triangle_indices_.end(), {face[0], face[k], face[k + 1]});
-        triangle_faces_.push_back(face_id);
-      }
-    }
+    SplitMixedFaces(mesh, counts, quad_indices_, quad_faces_, triangle_indices_, triangle_faces_);
     quad_indices = quad_indices_.data();
     triangle_indices = triangle_indices_.data();
     stats_.copied_bytes += (quad_indices_.capacity() + quad_faces_.capacity() +
@@ -163,6 +209,8 @@ Status EmbreeScene::Setup(const Mesh& mesh, const TracerOptions& options) {
                            sizeof(std::int32_t);
   }
 
+  const std::size_t num_vertices = mesh.num_vertices();
+  const RTCBuildQuality quality = ToRtc(options.quality);
   if (counts.quads > 0) {
     DISPEX_RETURN_IF_ERROR(AddGeometry(kQuadGeometry, RTC_GEOMETRY_TYPE_QUAD, quad_indices,
                                        counts.quads, num_vertices, quality));
@@ -182,41 +230,21 @@ Status EmbreeScene::Setup(const Mesh& mesh, const TracerOptions& options) {
   stats_.setup_seconds = Seconds(setup_start);
 
   const auto build_start = Clock::now();
-#if defined(__SANITIZE_THREAD__)
-  // libembree3 is not instrumented: the TBB tasks of its BVH build read a task_group_context
-  // on this thread's stack, and ThreadSanitizer cannot see that they finished before the frame
-  // is reused (scripts/tsan-extract.sh). Under TSan the build runs on this thread alone, and
-  // one build at a time (EmbreeMemoryLock).
-  {
-    const std::lock_guard<std::mutex> lock(EmbreeMemoryLock());
-    tbb::task_arena(1).execute([&] { rtcCommitScene(scene_); });
-  }
-#else
-  rtcCommitScene(scene_);
-#endif
+  CommitScene(scene_);
   stats_.build_seconds = Seconds(build_start);
   DISPEX_RETURN_IF_ERROR(device_->TakeError());
 
-  RTCBounds bounds;
-  rtcGetSceneBounds(scene_, &bounds);
-  for (const float c : {bounds.lower_x, bounds.lower_y, bounds.lower_z, bounds.upper_x,
-                        bounds.upper_y, bounds.upper_z}) {
-    if (std::isfinite(c)) scale_ = std::max(scale_, std::fabs(c));
-  }
+  scale_ = BoundsScale(scene_);
   if (options.scale > 0) scale_ = options.scale;
-  stats_.scale = scale_;
   retry_misses_ = options.retry_misses;
   verify_hits_ = options.verify_hits;
-
+  stats_.scale = scale_;
   stats_.faces = num_faces;
   stats_.quads = counts.quads;
   stats_.triangles = counts.triangles;
   stats_.backend_bytes = device_->bytes();
   stats_.backend_peak_bytes = device_->peak_bytes();
-  stats_.backend = fmt::format(
-      "{}, {} build{}{}{}{}", device_->Describe(), BuildQualityName(options.quality),
-      options.robust ? ", robust" : "", options.compact ? ", compact" : "",
-      options.retry_misses ? ", retry misses" : "", options.verify_hits ? ", verify hits" : "");
+  stats_.backend = BackendName(*device_, options);
   return Status::Ok();
 }
 

@@ -58,15 +58,93 @@ struct KeyHash {
   }
 };
 
+using Key = std::array<std::int64_t, 4>;
+
 // `n` cells per side of a quad Ptex face, n / 2 on n-gon sub-faces, so that both sides of a
 // base edge have n cells. A vertex on the base is named by where it lies: a cage vertex, step
 // j of a base edge (from its lower vertex), step r of the spoke from edge k's midpoint to
 // the centre of an n-gon, the centre, or a Ptex face's interior grid point. Jitter is a
 // function of that name, so every Ptex face touching a vertex puts it at the same place.
-StatusOr<SculptLayoutMesh> BuildJittered(const Mesh& cage, const LimitSurface& surface, int n,
-                                         std::uint32_t seed) {
-  const int faces = surface.num_ptex_faces();
-  for (int f = 0; f < faces; ++f) {
+class JitteredNames {
+ public:
+  JitteredNames(const Mesh& cage, const LimitSurface& surface, int n, std::uint32_t seed)
+      : cage_(cage), surface_(surface), n_(n), half_(n / 2), seed_(seed) {}
+
+  // A point of base edge (a, b) at step p of n from a: its name and its place in [0, 1] from a.
+  double EdgePoint(std::int32_t a, std::int32_t b, int p, Key& key) const {
+    const std::int32_t lo = std::min(a, b), hi = std::max(a, b);
+    const int j = a < b ? p : n_ - p;
+    double q;
+    if (j == 0 || j == n_) {
+      key = {0, j == 0 ? lo : hi, 0, 0};
+      q = j == 0 ? 0 : 1;
+    } else {
+      key = {1, lo, hi, j};
+      q = (j + (2 * j == n_ ? 0.0
+                            : kJitter * Jitter(seed_, std::uint64_t(lo), std::uint64_t(hi),
+                                               std::uint64_t(j)))) /
+          n_;
+    }
+    return a < b ? q : 1 - q;
+  }
+
+  // Step r of `half` on spoke k of base face `face` (r = 0: edge k's midpoint).
+  double SpokePoint(BaseFaceId face, std::span<const std::int32_t> fv, int k, int r,
+                    Key& key) const {
+    if (r == 0) {
+      EdgePoint(fv[k], fv[(k + 1) % fv.size()], half_, key);
+      return 0.0;
+    }
+    if (r == half_) {
+      key = {2, face.value, 0, 0};
+      return 1.0;
+    }
+    key = {3, face.value, k, r};
+    return (r + kJitter * Jitter(seed_, std::uint64_t(face.value) + (1ull << 40), std::uint64_t(k),
+                                 std::uint64_t(r))) /
+           half_;
+  }
+
+  // Slot (i, j) of Ptex face f on edge e at step t (counter-clockwise): its name and (u, v).
+  void BoundaryPoint(int f, int e, int t, Key& key, float* uv) const {
+    PtexFaceId face(f);
+    BaseFaceId base = surface_.base_face(face);
+    auto fv = cage_.face(std::size_t(base.value));
+    const int size = static_cast<int>(fv.size());
+    double s;
+    if (size == 4) {
+      s = EdgePoint(fv[e], fv[(e + 1) % 4], t, key);
+    } else {
+      const int k = surface_.sub_face(face);
+      switch (e) {
+        case 0:
+          s = 2 * EdgePoint(fv[k], fv[(k + 1) % size], t, key);
+          break;
+        case 1:
+          s = SpokePoint(base, fv, k, t, key);
+          break;
+        case 2:
+          s = 1 - SpokePoint(base, fv, (k + size - 1) % size, half_ - t, key);
+          break;
+        default:
+          s = 2 * EdgePoint(fv[(k + size - 1) % size], fv[k], half_ + t, key) - 1;
+          break;
+      }
+    }
+    const double p[4][2] = {{s, 0}, {1, s}, {1 - s, 1}, {0, 1 - s}};
+    uv[0] = static_cast<float>(std::clamp(p[e][0], 0.0, 1.0));
+    uv[1] = static_cast<float>(std::clamp(p[e][1], 0.0, 1.0));
+  }
+
+ private:
+  const Mesh& cage_;
+  const LimitSurface& surface_;
+  const int n_, half_;
+  const std::uint32_t seed_;
+};
+
+Status CheckDensity(const LimitSurface& surface, int n) {
+  for (int f = 0; f < surface.num_ptex_faces(); ++f) {
     BaseFaceId base = surface.base_face(PtexFaceId(f));
     if (surface.base_face_size(base) != 4 && n % 2 != 0) {
       return Status::Error(
@@ -75,102 +153,54 @@ StatusOr<SculptLayoutMesh> BuildJittered(const Mesh& cage, const LimitSurface& s
                       n));
     }
   }
-  const int half = n / 2;
-  using Key = std::array<std::int64_t, 4>;
-  // A point of base edge (a, b) at step p of n from a: its name and its place in [0, 1] from a.
-  auto edge_point = [&](std::int32_t a, std::int32_t b, int p, Key& key) {
-    const std::int32_t lo = std::min(a, b), hi = std::max(a, b);
-    const int j = a < b ? p : n - p;
-    double q;
-    if (j == 0 || j == n) {
-      key = {0, j == 0 ? lo : hi, 0, 0};
-      q = j == 0 ? 0 : 1;
-    } else {
-      key = {1, lo, hi, j};
-      q = (j + (2 * j == n ? 0.0
-                           : kJitter * Jitter(seed, std::uint64_t(lo), std::uint64_t(hi),
-                                              std::uint64_t(j)))) /
-          n;
-    }
-    return a < b ? q : 1 - q;
-  };
-  // Step r of `half` on spoke k of base face `face` (r = 0: edge k's midpoint).
-  auto spoke_point = [&](BaseFaceId face, std::span<const std::int32_t> fv, int k, int r,
-                         Key& key) {
-    if (r == 0) {
-      edge_point(fv[k], fv[(k + 1) % fv.size()], half, key);
-      return 0.0;
-    }
-    if (r == half) {
-      key = {2, face.value, 0, 0};
-      return 1.0;
-    }
-    key = {3, face.value, k, r};
-    return (r + kJitter * Jitter(seed, std::uint64_t(face.value) + (1ull << 40), std::uint64_t(k),
-                                 std::uint64_t(r))) /
-           half;
-  };
-  // Slot (i, j) of Ptex face f on edge e at step t (counter-clockwise): its name and (u, v).
-  auto boundary = [&](int f, int e, int t, Key& key, float* uv) {
-    PtexFaceId face(f);
-    BaseFaceId base = surface.base_face(face);
-    auto fv = cage.face(std::size_t(base.value));
-    const int size = static_cast<int>(fv.size());
-    double s;
-    if (size == 4) {
-      s = edge_point(fv[e], fv[(e + 1) % 4], t, key);
-    } else {
-      const int k = surface.sub_face(face);
-      switch (e) {
-        case 0:
-          s = 2 * edge_point(fv[k], fv[(k + 1) % size], t, key);
-          break;
-        case 1:
-          s = spoke_point(base, fv, k, t, key);
-          break;
-        case 2:
-          s = 1 - spoke_point(base, fv, (k + size - 1) % size, half - t, key);
-          break;
-        default:
-          s = 2 * edge_point(fv[(k + size - 1) % size], fv[k], half + t, key) - 1;
-          break;
-      }
-    }
-    const double p[4][2] = {{s, 0}, {1, s}, {1 - s, 1}, {0, 1 - s}};
-    uv[0] = static_cast<float>(std::clamp(p[e][0], 0.0, 1.0));
-    uv[1] = static_cast<float>(std::clamp(p[e][1], 0.0, 1.0));
-  };
-  std::vector<std::size_t> first_slot(std::size_t(faces) + 1, 0);
-  std::vector<int> cells(std::size_t(faces), 0);
+  return Status::Ok();
+}
+
+// The grid points of every Ptex face, (cells + 1)^2 slots each (none for holes).
+struct SlotGrid {
+  std::vector<std::size_t> first_slot;  // per Ptex face, and the total at the end
+  std::vector<int> cells;               // per Ptex face, per side
+  std::size_t size() const { return first_slot.back(); }
+  std::size_t operator()(int f, int i, int j) const {
+    return first_slot[f] + std::size_t(j) * std::size_t(cells[f] + 1) + std::size_t(i);
+  }
+};
+
+StatusOr<SlotGrid> PlanSlots(const LimitSurface& surface, int n) {
+  const int faces = surface.num_ptex_faces();
+  SlotGrid grid;
+  grid.first_slot.assign(std::size_t(faces) + 1, 0);
+  grid.cells.assign(std::size_t(faces), 0);
   for (int f = 0; f < faces; ++f) {
     const bool quad = surface.base_face_size(surface.base_face(PtexFaceId(f))) == 4;
-    cells[f] = surface.is_hole(PtexFaceId(f)) ? 0 : quad ? n : half;
-    const std::size_t side = std::size_t(cells[f]) + 1;
-    first_slot[f + 1] = first_slot[f] + (cells[f] ? side * side : 0);
+    grid.cells[f] = surface.is_hole(PtexFaceId(f)) ? 0 : quad ? n : n / 2;
+    const std::size_t side = std::size_t(grid.cells[f]) + 1;
+    grid.first_slot[f + 1] = grid.first_slot[f] + (grid.cells[f] ? side * side : 0);
   }
-  const std::size_t slots = first_slot[faces];
-  if (slots >= (std::size_t{1} << 31)) {
+  if (grid.size() >= (std::size_t{1} << 31)) {
     return Status::Error(
         fmt::format("density {}: {} Ptex faces would need more than 2^31 "
                     "vertices",
                     n, faces));
   }
-  auto slot = [&](int f, int i, int j) {
-    return first_slot[f] + std::size_t(j) * std::size_t(cells[f] + 1) + std::size_t(i);
-  };
-  std::vector<float> uv(2 * slots);
-  std::vector<std::uint32_t> vertex(slots);
-  // One vertex per name, numbered in order of first use; its truth record is that first use,
-  // so the vertices each face adds are contiguous.
-  SculptLayoutMesh out;
-  std::unordered_map<Key, std::uint32_t, KeyHash> names;
+  return grid;
+}
+
+// Every slot's (u, v) and vertex: one vertex per name, numbered in order of first use; its
+// truth record is that first use, so the vertices each face adds are contiguous. Returns per
+// Ptex face its first vertex (and the count at the end).
+std::vector<std::size_t> NameVertices(const JitteredNames& names, const SlotGrid& grid,
+                                      std::uint32_t seed, std::vector<float>& uv,
+                                      std::vector<std::uint32_t>& vertex, SculptLayoutMesh& out) {
+  const int faces = static_cast<int>(grid.cells.size());
+  std::unordered_map<Key, std::uint32_t, KeyHash> ids;
   std::vector<std::size_t> first_vertex(std::size_t(faces) + 1, 0);
   for (int f = 0; f < faces; ++f) {
     first_vertex[f] = out.ptex_faces.size();
-    const int m = cells[f];
+    const int m = grid.cells[f];
     for (int j = 0; j <= m && m > 0; ++j) {
       for (int i = 0; i <= m; ++i) {
-        const std::size_t s = slot(f, i, j);
+        const std::size_t s = grid(f, i, j);
         Key key;
         if (i > 0 && i < m && j > 0 && j < m) {
           key = {4, f, i, j};
@@ -179,9 +209,9 @@ StatusOr<SculptLayoutMesh> BuildJittered(const Mesh& cage, const LimitSurface& s
         } else {
           const int e = j == 0 ? 0 : i == m ? 1 : j == m ? 2 : 3;
           const int t = e == 0 ? i : e == 1 ? j : e == 2 ? m - i : m - j;
-          boundary(f, e, t, key, &uv[2 * s]);
+          names.BoundaryPoint(f, e, t, key, &uv[2 * s]);
         }
-        auto [it, added] = names.try_emplace(key, std::uint32_t(out.ptex_faces.size()));
+        auto [it, added] = ids.try_emplace(key, std::uint32_t(out.ptex_faces.size()));
         vertex[s] = it->second;
         if (added) {
           out.ptex_faces.push_back(PtexFaceId(f));
@@ -192,24 +222,27 @@ StatusOr<SculptLayoutMesh> BuildJittered(const Mesh& cage, const LimitSurface& s
     }
   }
   first_vertex[faces] = out.ptex_faces.size();
-  const std::size_t count = out.ptex_faces.size();
-  out.mesh.positions.resize(count);
-  out.normals.resize(3 * count);
-  // Two triangles per cell, counter-clockwise in (u, v) as the Ptex face is.
+  return first_vertex;
+}
+
+// Two triangles per cell, counter-clockwise in (u, v) as the Ptex face is: the diagonal picked
+// at random, unless that one folds a triangle in (u, v).
+void Triangulate(const SlotGrid& grid, std::uint32_t seed, const std::vector<float>& uv,
+                 const std::vector<std::uint32_t>& vertex, SculptLayoutMesh& out) {
   out.mesh.face_offsets.push_back(0);
-  for (int f = 0; f < faces; ++f) {
-    const int m = cells[f];
+  for (int f = 0; f < static_cast<int>(grid.cells.size()); ++f) {
+    const int m = grid.cells[f];
     for (int j = 0; j < m; ++j) {
       for (int i = 0; i < m; ++i) {
-        const std::size_t c[4] = {slot(f, i, j), slot(f, i + 1, j), slot(f, i + 1, j + 1),
-                                  slot(f, i, j + 1)};
+        const std::size_t c[4] = {grid(f, i, j), grid(f, i + 1, j), grid(f, i + 1, j + 1),
+                                  grid(f, i, j + 1)};
         auto area = [&](int a, int b, int d) {
           const float* p = &uv[2 * c[a]];
           const float* q = &uv[2 * c[b]];
           const float* r = &uv[2 * c[d]];
           return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
         };
-        bool first = Jitter(seed, slot(f, i, j), 0, 4) < 0;
+        bool first = Jitter(seed, grid(f, i, j), 0, 4) < 0;
         if (first && !(area(0, 1, 2) > 0 && area(0, 2, 3) > 0)) first = false;
         if (!first && !(area(0, 1, 3) > 0 && area(1, 2, 3) > 0)) first = true;
         const int tris[2][2][3] = {{{0, 1, 3}, {1, 2, 3}}, {{0, 1, 2}, {0, 2, 3}}};
@@ -225,10 +258,15 @@ StatusOr<SculptLayoutMesh> BuildJittered(const Mesh& cage, const LimitSurface& s
       }
     }
   }
+}
+
+// Each vertex's limit position and normal at its (Ptex face, u, v), a Ptex face at a time.
+Status PlaceOnLimitSurface(const LimitSurface& surface,
+                           const std::vector<std::size_t>& first_vertex, SculptLayoutMesh& out) {
   tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
   tbb::enumerable_thread_specific<std::vector<float>> positions;
   std::atomic<bool> failed{false};
-  tbb::parallel_for(0, faces, [&](int f) {
+  tbb::parallel_for(0, surface.num_ptex_faces(), [&](int f) {
     const std::size_t begin = first_vertex[f], end = first_vertex[f + 1];
     if (begin == end) return;
     auto& evaluator = evaluators.local();
@@ -244,6 +282,24 @@ StatusOr<SculptLayoutMesh> BuildJittered(const Mesh& cage, const LimitSurface& s
     }
   });
   if (failed) return Status::Error("evaluating the limit surface at a sculpt vertex failed");
+  return Status::Ok();
+}
+
+// The jittered layout (JitteredNames): `n` cells per side of a quad Ptex face.
+StatusOr<SculptLayoutMesh> BuildJittered(const Mesh& cage, const LimitSurface& surface, int n,
+                                         std::uint32_t seed) {
+  DISPEX_RETURN_IF_ERROR(CheckDensity(surface, n));
+  DISPEX_ASSIGN_OR_RETURN(const SlotGrid grid, PlanSlots(surface, n));
+  std::vector<float> uv(2 * grid.size());
+  std::vector<std::uint32_t> vertex(grid.size());
+  SculptLayoutMesh out;
+  const std::vector<std::size_t> first_vertex =
+      NameVertices(JitteredNames(cage, surface, n, seed), grid, seed, uv, vertex, out);
+  const std::size_t count = out.ptex_faces.size();
+  out.mesh.positions.resize(count);
+  out.normals.resize(3 * count);
+  Triangulate(grid, seed, uv, vertex, out);
+  DISPEX_RETURN_IF_ERROR(PlaceOnLimitSurface(surface, first_vertex, out));
   return out;
 }
 
@@ -264,12 +320,121 @@ struct SculptQuality {
   std::size_t folded_faces = 0;
 };
 
+// Points of a face in (u, v), with the linear surface there: the edge midpoints, and the centre
+// of a quad (measured against both diagonals' midpoints: FaceError) or a triangle's centroid.
+struct FacePoints {
+  float uv[10];
+  double linear[5][3];
+  int points = 0;
+};
+
+// `c`: the (u, v) of the face's corners.
+void PointsOfFace(const Mesh& mesh, std::span<const std::int32_t> face, const float* c,
+                  FacePoints& out) {
+  auto add = [&](std::initializer_list<std::size_t> corners) {
+    double w = 1.0 / double(corners.size());
+    const int points = out.points;
+    out.uv[2 * points] = out.uv[2 * points + 1] = 0;
+    for (int d = 0; d < 3; ++d) out.linear[points][d] = 0;
+    for (std::size_t k : corners) {
+      out.uv[2 * points] += float(w * c[2 * k]);
+      out.uv[2 * points + 1] += float(w * c[2 * k + 1]);
+      Float3 q = mesh.positions[static_cast<std::size_t>(face[k])];
+      out.linear[points][0] += w * q.x, out.linear[points][1] += w * q.y,
+          out.linear[points][2] += w * q.z;
+    }
+    ++out.points;
+  };
+  if (face.size() == 4) {
+    add({0, 1, 2, 3});
+    add({0, 1});
+    add({1, 2});
+    add({2, 3});
+    add({3, 0});
+  } else {
+    add({0, 1, 2});
+    add({0, 1});
+    add({1, 2});
+    add({2, 0});
+  }
+}
+
+// The largest distance from the true displaced surface (limit points p, normals n at the
+// face's points) to the face.
+double FaceError(const Mesh& mesh, std::span<const std::int32_t> face, PtexFaceId ptex,
+                 const FacePoints& at, const float* p, const float* n,
+                 const verify::PatternField& pattern) {
+  auto corner = [&](std::size_t k) { return mesh.positions[static_cast<std::size_t>(face[k])]; };
+  double worst = 0;
+  for (int s = 0; s < at.points; ++s) {
+    double disp[3];
+    pattern.Displacement(ptex, at.uv[2 * s], at.uv[2 * s + 1], &p[3 * s], &n[3 * s], disp);
+    double truth[3] = {p[3 * s] + disp[0], p[3 * s + 1] + disp[1], p[3 * s + 2] + disp[2]};
+    auto distance = [&](const double* q) {
+      double dx = q[0] - truth[0], dy = q[1] - truth[1], dz = q[2] - truth[2];
+      return std::sqrt(dx * dx + dy * dy + dz * dz);
+    };
+    if (face.size() == 4 && s == 0) {
+      for (int d = 0; d < 2; ++d) {
+        Float3 a = corner(d), b = corner(d + 2);
+        double mid[3] = {0.5 * (double(a.x) + b.x), 0.5 * (double(a.y) + b.y),
+                         0.5 * (double(a.z) + b.z)};
+        worst = std::max(worst, distance(mid));
+      }
+    } else {
+      worst = std::max(worst, distance(at.linear[s]));
+    }
+  }
+  return worst;
+}
+
+// Whether the face is turned inside out against the limit normal n (at its first point).
+bool IsFolded(const Mesh& mesh, std::span<const std::int32_t> face, const float* n) {
+  const std::size_t size = face.size();
+  auto at = [&](std::size_t k) { return mesh.positions[static_cast<std::size_t>(face[k])]; };
+  Float3 a = at(0), b = at(1), c2 = at(2), d = size == 4 ? at(3) : at(0);
+  double e1[3], e2[3];
+  if (size == 4) {  // the diagonals
+    e1[0] = double(c2.x) - a.x, e1[1] = double(c2.y) - a.y, e1[2] = double(c2.z) - a.z;
+    e2[0] = double(d.x) - b.x, e2[1] = double(d.y) - b.y, e2[2] = double(d.z) - b.z;
+  } else {
+    e1[0] = double(b.x) - a.x, e1[1] = double(b.y) - a.y, e1[2] = double(b.z) - a.z;
+    e2[0] = double(c2.x) - a.x, e2[1] = double(c2.y) - a.y, e2[2] = double(c2.z) - a.z;
+  }
+  double fn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                  e1[0] * e2[1] - e1[1] * e2[0]};
+  return fn[0] * n[0] + fn[1] * n[1] + fn[2] * n[2] < 0;
+}
+
+// Face f's error (FaceError) and whether it folds; false when the limit surface could not be
+// evaluated. Faces other than triangles and quads are left alone.
+bool MeasureFace(LimitEvaluator& evaluator, const SculptLayoutMesh& layout,
+                 const verify::PatternField& pattern, std::size_t f, float& error,
+                 std::uint8_t& folded) {
+  const Mesh& mesh = layout.mesh;
+  auto face = mesh.face(f);
+  const std::size_t size = face.size();
+  if (size != 3 && size != 4) return true;
+  FacePoints at;
+  PointsOfFace(mesh, face, &layout.corner_uvs[2 * mesh.face_offsets[f]], at);
+  const int points = at.points;
+  float p[15], n[15];
+  if (!evaluator
+           .EvaluatePoints(layout.face_ptex[f], std::span<const float>(at.uv, 2 * points),
+                           std::span<float>(p, 3 * points), std::span<float>(n, 3 * points))
+           .ok()) {
+    return false;
+  }
+  error = static_cast<float>(FaceError(mesh, face, layout.face_ptex[f], at, p, n, pattern));
+  folded = IsFolded(mesh, face, n);
+  return true;
+}
+
 // See MakeSculptReport::linear_error and folded_faces. `layout.mesh` already holds the
 // displaced positions.
 StatusOr<SculptQuality> MeasureSculpt(const LimitSurface& surface, const SculptLayoutMesh& layout,
                                       const verify::PatternField& pattern) {
-  const Mesh& mesh = layout.mesh;
-  const std::size_t faces = mesh.num_faces();
+  const std::size_t faces = layout.mesh.num_faces();
   SculptQuality quality;
   quality.face_errors.assign(faces, 0.0f);
   std::vector<std::uint8_t> folded(faces, 0);
@@ -281,86 +446,10 @@ StatusOr<SculptQuality> MeasureSculpt(const LimitSurface& surface, const SculptL
         auto& evaluator = evaluators.local();
         if (!evaluator) evaluator.emplace(surface);
         for (std::size_t f = range.begin(); f < range.end(); ++f) {
-          auto face = mesh.face(f);
-          const std::size_t size = face.size();
-          if (size != 3 && size != 4) continue;
-          const float* c = &layout.corner_uvs[2 * mesh.face_offsets[f]];
-          auto at = [&](std::size_t k) {
-            return mesh.positions[static_cast<std::size_t>(face[k])];
-          };
-          // Points of the face in (u, v), with the linear surface there: the edge midpoints, and
-          // the centre of a quad against both diagonals' midpoints or a triangle's centroid.
-          float uv[10];
-          double linear[5][3];
-          int points = 0;
-          auto add = [&](std::initializer_list<std::size_t> corners) {
-            double w = 1.0 / double(corners.size());
-            uv[2 * points] = uv[2 * points + 1] = 0;
-            for (int d = 0; d < 3; ++d) linear[points][d] = 0;
-            for (std::size_t k : corners) {
-              uv[2 * points] += float(w * c[2 * k]);
-              uv[2 * points + 1] += float(w * c[2 * k + 1]);
-              Float3 q = at(k);
-              linear[points][0] += w * q.x, linear[points][1] += w * q.y,
-                  linear[points][2] += w * q.z;
-            }
-            ++points;
-          };
-          if (size == 4) {
-            add({0, 1, 2, 3});
-            add({0, 1});
-            add({1, 2});
-            add({2, 3});
-            add({3, 0});
-          } else {
-            add({0, 1, 2});
-            add({0, 1});
-            add({1, 2});
-            add({2, 0});
-          }
-          float p[15], n[15];
-          if (!evaluator
-                   ->EvaluatePoints(layout.face_ptex[f], std::span<const float>(uv, 2 * points),
-                                    std::span<float>(p, 3 * points),
-                                    std::span<float>(n, 3 * points))
-                   .ok()) {
+          if (!MeasureFace(*evaluator, layout, pattern, f, quality.face_errors[f], folded[f])) {
             failed = true;
             return;
           }
-          double worst = 0;
-          for (int s = 0; s < points; ++s) {
-            double disp[3];
-            pattern.Displacement(layout.face_ptex[f], uv[2 * s], uv[2 * s + 1], &p[3 * s],
-                                 &n[3 * s], disp);
-            double truth[3] = {p[3 * s] + disp[0], p[3 * s + 1] + disp[1], p[3 * s + 2] + disp[2]};
-            auto distance = [&](const double* q) {
-              double dx = q[0] - truth[0], dy = q[1] - truth[1], dz = q[2] - truth[2];
-              return std::sqrt(dx * dx + dy * dy + dz * dz);
-            };
-            if (size == 4 && s == 0) {
-              for (int d = 0; d < 2; ++d) {
-                Float3 a = at(d), b = at(d + 2);
-                double mid[3] = {0.5 * (double(a.x) + b.x), 0.5 * (double(a.y) + b.y),
-                                 0.5 * (double(a.z) + b.z)};
-                worst = std::max(worst, distance(mid));
-              }
-            } else {
-              worst = std::max(worst, distance(linear[s]));
-            }
-          }
-          quality.face_errors[f] = static_cast<float>(worst);
-          Float3 a = at(0), b = at(1), c2 = at(2), d = size == 4 ? at(3) : at(0);
-          double e1[3], e2[3];
-          if (size == 4) {  // the diagonals
-            e1[0] = double(c2.x) - a.x, e1[1] = double(c2.y) - a.y, e1[2] = double(c2.z) - a.z;
-            e2[0] = double(d.x) - b.x, e2[1] = double(d.y) - b.y, e2[2] = double(d.z) - b.z;
-          } else {
-            e1[0] = double(b.x) - a.x, e1[1] = double(b.y) - a.y, e1[2] = double(b.z) - a.z;
-            e2[0] = double(c2.x) - a.x, e2[1] = double(c2.y) - a.y, e2[2] = double(c2.z) - a.z;
-          }
-          double fn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                          e1[0] * e2[1] - e1[1] * e2[0]};
-          folded[f] = fn[0] * n[0] + fn[1] * n[1] + fn[2] * n[2] < 0;
         }
       });
   if (failed) return Status::Error("evaluating the limit surface at a sculpt face centre failed");
@@ -446,20 +535,10 @@ Status CheckMakeSculptOptions(const MakeSculptOptions& options) {
   return Status::Ok();
 }
 
-}  // namespace
-
-StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
-  Stopwatch clock;
-  DISPEX_RETURN_IF_ERROR(CheckMakeSculptOptions(options).WithCode(StatusCode::kInvalidArgument));
+// What the pattern is evaluated with: the cage's bounding box, the sculpt's edge length, the
+// amplitude (1% of the diagonal unless given) and the seed.
+PatternFrame FrameFor(const Mesh& cage, const MakeSculptOptions& options) {
   const bool jittered = options.layout == SculptLayout::kJittered;
-  std::optional<tbb::global_control> limit;
-  if (options.threads > 0) {
-    limit.emplace(tbb::global_control::max_allowed_parallelism,
-                  static_cast<std::size_t>(options.threads));
-  }
-  DISPEX_ASSIGN_OR_RETURN(Mesh cage, ReadMesh(options.cage_path));
-  DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(cage));
-
   BoundingBox box = ComputeBounds(cage);
   PatternFrame frame;
   frame.center[0] = 0.5f * (box.min.x + box.max.x);
@@ -470,22 +549,26 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
       MedianEdgeLength(cage) / (jittered ? double(options.density) : double(1 << options.levels));
   frame.amplitude = options.amplitude > 0 ? options.amplitude : 0.01 * frame.diagonal;
   frame.seed = options.seed;
-  // Before the refinement, so that a bad image or a cage without UVs fails at once.
-  DISPEX_ASSIGN_OR_RETURN(
-      verify::PatternField pattern,
-      verify::PatternField::Create(options.pattern, options.image_path, frame, cage, surface));
+  return frame;
+}
 
-  SculptLayoutMesh layout;
-  if (jittered) {
-    DISPEX_ASSIGN_OR_RETURN(layout, BuildJittered(cage, surface, options.density, options.seed));
-  } else {
-    RefineOptions refine_options;
-    refine_options.face_charts = true;
-    DISPEX_ASSIGN_OR_RETURN(RefinedMesh refined,
-                            RefineUniform(surface, options.levels, refine_options));
-    layout = FromRefined(std::move(refined));
+// The sculpt before displacement, in the layout the options ask for.
+StatusOr<SculptLayoutMesh> BuildLayout(const Mesh& cage, const LimitSurface& surface,
+                                       const MakeSculptOptions& options) {
+  if (options.layout == SculptLayout::kJittered) {
+    return BuildJittered(cage, surface, options.density, options.seed);
   }
+  RefineOptions refine_options;
+  refine_options.face_charts = true;
+  DISPEX_ASSIGN_OR_RETURN(RefinedMesh refined,
+                          RefineUniform(surface, options.levels, refine_options));
+  return FromRefined(std::move(refined));
+}
 
+// Moves every vertex of the layout by D and returns its truth (no local errors yet), with
+// `tangential` the length of each vertex's D - (D.N) N.
+GroundTruth Displace(SculptLayoutMesh& layout, const verify::PatternField& pattern,
+                     std::vector<float>& tangential) {
   Mesh& sculpt = layout.mesh;
   const std::size_t n = sculpt.num_vertices();
   GroundTruth truth;
@@ -493,7 +576,7 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   truth.uvs = layout.uvs;
   truth.h.resize(n);
   truth.d.resize(3 * n);
-  std::vector<float> tangential(n);
+  tangential.resize(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t v = range.begin(); v < range.end(); ++v) {
@@ -524,8 +607,13 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
                         p.z = static_cast<float>(p.z + d[2]);
                       }
                     });
-  DISPEX_ASSIGN_OR_RETURN(SculptQuality quality, MeasureSculpt(surface, layout, pattern));
-  truth.local_error = LocalErrors(sculpt, quality.face_errors);
+  return truth;
+}
+
+// The sculpt, its first line saying how it was made, and its truth file.
+Status WriteSculpt(const MakeSculptOptions& options, const PatternFrame& frame, const Mesh& sculpt,
+                   const GroundTruth& truth) {
+  const bool jittered = options.layout == SculptLayout::kJittered;
   const std::string pattern_name = options.pattern == Pattern::kImage
                                        ? "image:" + options.image_path
                                        : std::string(PatternName(options.pattern));
@@ -538,27 +626,60 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   DISPEX_RETURN_IF_ERROR(WriteMesh(options.output_path, sculpt, comment));
   std::string truth_path =
       options.truth_path.empty() ? options.output_path + ".truth" : options.truth_path;
-  DISPEX_RETURN_IF_ERROR(WriteGroundTruth(truth_path, truth));
+  return WriteGroundTruth(truth_path, truth);
+}
+
+// The report's figures of the displacement (h, |D| and its tangential part).
+void ReportDisplacement(const GroundTruth& truth, const std::vector<float>& tangential,
+                        MakeSculptReport& report) {
+  const std::size_t n = truth.h.size();
+  if (!n) return;
+  auto [lo, hi] = std::minmax_element(truth.h.begin(), truth.h.end());
+  report.h_min = *lo;
+  report.h_max = *hi;
+  report.max_tangential = *std::max_element(tangential.begin(), tangential.end());
+  for (std::size_t v = 0; v < n; ++v) {
+    const float* d = &truth.d[3 * v];
+    report.max_displacement =
+        std::max(report.max_displacement,
+                 std::sqrt(double(d[0]) * d[0] + double(d[1]) * d[1] + double(d[2]) * d[2]));
+  }
+}
+
+}  // namespace
+
+StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
+  Stopwatch clock;
+  DISPEX_RETURN_IF_ERROR(CheckMakeSculptOptions(options).WithCode(StatusCode::kInvalidArgument));
+  std::optional<tbb::global_control> limit;
+  if (options.threads > 0) {
+    limit.emplace(tbb::global_control::max_allowed_parallelism,
+                  static_cast<std::size_t>(options.threads));
+  }
+  DISPEX_ASSIGN_OR_RETURN(Mesh cage, ReadMesh(options.cage_path));
+  DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(cage));
+  const PatternFrame frame = FrameFor(cage, options);
+  // Before the refinement, so that a bad image or a cage without UVs fails at once.
+  DISPEX_ASSIGN_OR_RETURN(
+      verify::PatternField pattern,
+      verify::PatternField::Create(options.pattern, options.image_path, frame, cage, surface));
+  DISPEX_ASSIGN_OR_RETURN(SculptLayoutMesh layout, BuildLayout(cage, surface, options));
+
+  std::vector<float> tangential;
+  GroundTruth truth = Displace(layout, pattern, tangential);
+  const Mesh& sculpt = layout.mesh;
+  DISPEX_ASSIGN_OR_RETURN(SculptQuality quality, MeasureSculpt(surface, layout, pattern));
+  truth.local_error = LocalErrors(sculpt, quality.face_errors);
+  DISPEX_RETURN_IF_ERROR(WriteSculpt(options, frame, sculpt, truth));
 
   MakeSculptReport report;
-  report.vertices = n;
+  report.vertices = sculpt.num_vertices();
   report.faces = sculpt.num_faces();
   report.amplitude = frame.amplitude;
   report.diagonal = frame.diagonal;
   report.edge = frame.edge;
   report.frame = frame;
-  if (n) {
-    auto [lo, hi] = std::minmax_element(truth.h.begin(), truth.h.end());
-    report.h_min = *lo;
-    report.h_max = *hi;
-    report.max_tangential = *std::max_element(tangential.begin(), tangential.end());
-    for (std::size_t v = 0; v < n; ++v) {
-      const float* d = &truth.d[3 * v];
-      report.max_displacement =
-          std::max(report.max_displacement,
-                   std::sqrt(double(d[0]) * d[0] + double(d[1]) * d[1] + double(d[2]) * d[2]));
-    }
-  }
+  ReportDisplacement(truth, tangential, report);
   report.linear_error = quality.linear_error;
   report.folded_faces = quality.folded_faces;
   report.warnings = IgnoredTagWarnings(cage);

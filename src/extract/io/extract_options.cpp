@@ -122,7 +122,8 @@ Status CheckMapName(const std::string& path) {
 
 namespace {
 
-Status CheckOptions(const ExtractOptions& o) {
+// The inputs and the output are given, and the output is neither input.
+Status CheckFilesGiven(const ExtractOptions& o) {
   if (o.base_path.empty() && !o.base_mesh) return Status::Error("no base mesh given");
   if (o.sculpt_path.empty() && !o.sculpt_mesh) return Status::Error("no sculpt mesh given");
   if (o.output_path.empty()) return Status::Error("no output file given (output_path)");
@@ -131,6 +132,11 @@ Status CheckOptions(const ExtractOptions& o) {
     return Status::Error(
         fmt::format("output {} is also an input; refusing to overwrite it", o.output_path));
   }
+  return Status::Ok();
+}
+
+// Oversampling, tolerance and search distance.
+Status CheckSampling(const ExtractOptions& o) {
   if (o.oversample != 0 && !IsPowerOfTwoIn(o.oversample, 1, kMaxSpectralSize)) {
     return Status::Error(
         fmt::format("oversample = {}: must be 0 (automatic) or a power of two from 1 to {}",
@@ -155,6 +161,11 @@ Status CheckOptions(const ExtractOptions& o) {
       !(std::isfinite(o.search_distance.value) && o.search_distance.value > 0)) {
     return Status::Error(fmt::format("search_distance = {}: must be > 0", o.search_distance.value));
   }
+  return Status::Ok();
+}
+
+// The map's data type and compression, the miss limit, the threads and the method.
+Status CheckMapAndRun(const ExtractOptions& o) {
   if (o.data_type != PtexDataType::kFloat && o.data_type != PtexDataType::kHalf) {
     return Status::Error("data_type: must be float or half");
   }
@@ -172,26 +183,35 @@ Status CheckOptions(const ExtractOptions& o) {
     return Status::Error(
         "method = rays: a vector map reads the sculpt through its correspondence, not rays");
   }
-  if (!o.uv_maps_dir.empty()) {
-    if (o.uv_resolution < 1 || o.uv_resolution > 16384) {
-      return Status::Error(fmt::format("uv_resolution = {}: must be 1..16384", o.uv_resolution));
-    }
-    if (o.uv_padding < 0) {
-      return Status::Error(fmt::format("uv_padding = {}: must be >= 0", o.uv_padding));
-    }
-    if (o.vector && *o.vector != VectorSpace::kObject) {
-      return Status::Error(fmt::format(
-          "uv_maps_dir: a {} space vector map's frame is its Ptex face's, which no UV-space "
-          "reader shares: UV-space vector maps are object space only",
-          VectorSpaceName(*o.vector)));
-    }
-    if (o.incremental) {
-      return Status::Error("uv_maps_dir: UV-space maps are not extracted incrementally");
-    }
-    if (o.shard_count > 0) {
-      return Status::Error("uv_maps_dir: UV-space maps are not made in shards (docs/FARM.md)");
-    }
+  return Status::Ok();
+}
+
+// UV-space maps (when uv_maps_dir is given): their size, and what they cannot be made with.
+Status CheckUvMaps(const ExtractOptions& o) {
+  if (o.uv_maps_dir.empty()) return Status::Ok();
+  if (o.uv_resolution < 1 || o.uv_resolution > 16384) {
+    return Status::Error(fmt::format("uv_resolution = {}: must be 1..16384", o.uv_resolution));
   }
+  if (o.uv_padding < 0) {
+    return Status::Error(fmt::format("uv_padding = {}: must be >= 0", o.uv_padding));
+  }
+  if (o.vector && *o.vector != VectorSpace::kObject) {
+    return Status::Error(fmt::format(
+        "uv_maps_dir: a {} space vector map's frame is its Ptex face's, which no UV-space "
+        "reader shares: UV-space vector maps are object space only",
+        VectorSpaceName(*o.vector)));
+  }
+  if (o.incremental) {
+    return Status::Error("uv_maps_dir: UV-space maps are not extracted incrementally");
+  }
+  if (o.shard_count > 0) {
+    return Status::Error("uv_maps_dir: UV-space maps are not made in shards (docs/FARM.md)");
+  }
+  return Status::Ok();
+}
+
+// A farm shard: its index, and what shards cannot be made with.
+Status CheckShard(const ExtractOptions& o) {
   if (o.shard_count < 0 ||
       (o.shard_count > 0 && (o.shard_index < 1 || o.shard_index > o.shard_count))) {
     return Status::Error(fmt::format("shard {}/{}: the index must be 1..{} and the count > 0",
@@ -208,6 +228,11 @@ Status CheckOptions(const ExtractOptions& o) {
         "shard_sculpt part: needs method rays and a given search_distance (the correspondence "
         "and the automatic search distance read the whole sculpt)");
   }
+  return Status::Ok();
+}
+
+// The output's name, and that the output file (and the UV maps' folder) can be written.
+Status CheckOutputPlaces(const ExtractOptions& o) {
   DISPEX_RETURN_IF_ERROR(CheckMapName(o.output_path));
   const Status output = CheckOutputFile(o.output_path);
   if (!output.ok()) return output.WithPrefix("output_path");
@@ -215,6 +240,11 @@ Status CheckOptions(const ExtractOptions& o) {
     const Status folder = CheckOutputFolder(o.uv_maps_dir);
     if (!folder.ok()) return folder.WithPrefix("uv_maps_dir");
   }
+  return Status::Ok();
+}
+
+// The resolution rule's settings, as the spectral analysis checks them.
+Status CheckResolutionRule(const ExtractOptions& o) {
   SpectralOptions spectral;
   spectral.rule = o.resolution_rule;
   spectral.tolerance = o.tolerance > 0 ? o.tolerance : 1.0;
@@ -222,6 +252,17 @@ Status CheckOptions(const ExtractOptions& o) {
   spectral.fixed_ulog2 = o.fixed_ulog2;
   spectral.fixed_vlog2 = o.fixed_vlog2;
   return ValidateSpectralOptions(spectral);
+}
+
+// Every check, in this order: the first failing one names the problem.
+Status CheckOptions(const ExtractOptions& o) {
+  DISPEX_RETURN_IF_ERROR(CheckFilesGiven(o));
+  DISPEX_RETURN_IF_ERROR(CheckSampling(o));
+  DISPEX_RETURN_IF_ERROR(CheckMapAndRun(o));
+  DISPEX_RETURN_IF_ERROR(CheckUvMaps(o));
+  DISPEX_RETURN_IF_ERROR(CheckShard(o));
+  DISPEX_RETURN_IF_ERROR(CheckOutputPlaces(o));
+  return CheckResolutionRule(o);
 }
 
 }  // namespace

@@ -216,6 +216,145 @@ struct Segment {
   }
 };
 
+// The block of cells under each column (row) of samples, into w.sample_block_of.
+void BlockOfEachSampleRow(int m, int b, int n, MappingScratch& w) {
+  w.sample_block_of.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const auto cell = static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));
+    w.sample_block_of[static_cast<std::size_t>(i)] = cell / b;
+  }
+}
+
+// All n x n samples grouped by block of cells: block at's at
+// w.block_samples[w.block_first[at] .. w.block_first[at + 1]). Rows and columns of a block are
+// runs (the cells rise with i): its samples in row order.
+void GroupGridByBlock(std::size_t un, std::size_t uper, MappingScratch& w) {
+  w.block_samples.resize(un * un);
+  std::size_t next = 0;
+  std::size_t j0 = 0;
+  for (std::size_t bj = 0; bj < uper; ++bj) {
+    std::size_t j1 = j0;
+    while (j1 < un && static_cast<std::size_t>(w.sample_block_of[j1]) == bj) ++j1;
+    std::size_t i0 = 0;
+    for (std::size_t bi = 0; bi < uper; ++bi) {
+      std::size_t i1 = i0;
+      while (i1 < un && static_cast<std::size_t>(w.sample_block_of[i1]) == bi) ++i1;
+      for (std::size_t j = j0; j < j1; ++j) {
+        for (std::size_t i = i0; i < i1; ++i) {
+          w.block_samples[next++] = static_cast<std::int32_t>(j * un + i);
+        }
+      }
+      w.block_first[bj * uper + bi + 1] = static_cast<std::int32_t>(next);
+      i0 = i1;
+    }
+    j0 = j1;
+  }
+}
+
+// The listed samples grouped by block of cells (a counting sort: in the given order within a
+// block), laid out as GroupGridByBlock's.
+void GroupListedByBlock(std::span<const std::int32_t> samples, std::size_t un, std::size_t uper,
+                        MappingScratch& w) {
+  const std::size_t num_blocks = uper * uper;
+  auto block_of = [&](std::int32_t k) {
+    const auto uk = static_cast<std::size_t>(k);
+    return static_cast<std::size_t>(w.sample_block_of[uk / un]) * uper +
+           static_cast<std::size_t>(w.sample_block_of[uk % un]);
+  };
+  for (std::int32_t k : samples) ++w.block_first[block_of(k) + 1];
+  for (std::size_t at = 0; at < num_blocks; ++at) w.block_first[at + 1] += w.block_first[at];
+  w.block_samples.resize(samples.size());
+  w.block_fill.assign(w.block_first.begin(), w.block_first.end() - 1);
+  for (std::int32_t k : samples) {
+    w.block_samples[static_cast<std::size_t>(w.block_fill[block_of(k)]++)] = k;
+  }
+}
+
+// The sculpt blocks that box `all` of block (bi, bj)'s windows meets and that are not near the
+// block, into w.candidate_ids: the near ones are stamped in w.near_stamp (one entry per sculpt
+// block, kept by the thread), so each block met is looked up once.
+void CollectFarBlocks(const SculptBlocks& blocks, int bi, int bj, int per, const Box& all,
+                      MappingScratch& w) {
+  if (++w.stamp == 0) {
+    std::fill(w.near_stamp.begin(), w.near_stamp.end(), 0);
+    w.stamp = 1;
+  }
+  const int width = per + 2;
+  for (int dj = 0; dj <= 2; ++dj) {
+    for (int di = 0; di <= 2; ++di) {
+      const auto slot = static_cast<std::size_t>((bj + dj) * width + bi + di);
+      for (std::int32_t k = w.near_starts[slot]; k < w.near_starts[slot + 1]; ++k) {
+        w.near_stamp[static_cast<std::size_t>(w.near_ids[static_cast<std::size_t>(k)])] = w.stamp;
+      }
+    }
+  }
+  w.candidate_ids.clear();
+  blocks.ForEachMeeting(all, [&](std::int64_t id) {
+    if (w.near_stamp[static_cast<std::size_t>(id)] != w.stamp) w.candidate_ids.push_back(id);
+  });
+}
+
+// What the checks of one face's samples share.
+struct FarCheck {
+  const SculptMapping& mapping;
+  const Mesh& sculpt;
+  std::span<const Float3> origins, normals;
+  const NormalQuery& query;
+  bool nearest;  // the query's policy is HitPolicy::kNearest
+  const NormalHits& out;
+  std::span<std::uint8_t> undecided;
+};
+
+// Sample k's window against sculpt block `id` (its quads gathered into `quads` on first
+// need): whether it crosses a quad of the block.
+bool WindowCrossesBlock(const FarCheck& c, std::size_t k, std::int64_t id, const Box& candidate,
+                        bool& gathered, BlockQuads& quads) {
+  const float window = Window(k, c.query, c.nearest, c.out);
+  const Segment segment(c.origins[k], c.normals[k], window);
+  if (!segment.Meets(candidate)) return false;
+  // The quads of the quarters of the block whose boxes the window meets too.
+  if (!gathered) {
+    GatherBlockQuads(c.mapping, c.sculpt, id, quads);
+    gathered = true;
+  }
+  unsigned quarters = 0;
+  for (int q = 0; q < quads.quarters(); ++q) {
+    quarters |= segment.Meets(quads.quarter_box[q]) ? 1u << q : 0u;
+  }
+  if (quarters == 0) return false;
+  // A crossing within rounding beyond the window's end counts: the ray path may find it
+  // inside.
+  const float reach = window + RoundingMargin(c.origins[k], window);
+  return WindowCrossesQuads(quads, c.sculpt, quarters, c.origins[k], c.normals[k], reach);
+}
+
+// Each candidate (w.candidate_ids) against the samples of a block whose window boxes
+// (w.window_boxes) meet its box, four boxes at a time; a sample undecided by one candidate is
+// not tested against the next. Returns the samples it left undecided.
+std::uint64_t CheckCandidates(const FarCheck& c, std::span<const std::int32_t> block_samples,
+                              MappingScratch& w, BlockQuads& quads) {
+  const SculptBlocks& blocks = c.mapping.blocks();
+  const std::size_t groups = (block_samples.size() + 3) / 4;
+  std::uint64_t sent = 0;
+  for (const std::int64_t id : w.candidate_ids) {
+    const Box& candidate = blocks.box(id);
+    bool gathered = false;
+    for (std::size_t g = 0; g < groups; ++g) {
+      for (unsigned lanes = LanesMeeting(w.window_boxes.data(), g, candidate); lanes != 0;
+           lanes &= lanes - 1) {
+        const auto k = static_cast<std::size_t>(
+            block_samples[4 * g + static_cast<std::size_t>(std::countr_zero(lanes))]);
+        if (c.undecided[k]) continue;
+        if (WindowCrossesBlock(c, k, id, candidate, gathered, quads)) {
+          c.undecided[k] = 1;
+          ++sent;
+        }
+      }
+    }
+  }
+  return sent;
+}
+
 }  // namespace
 
 std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, int face, int n,
@@ -229,126 +368,36 @@ std::uint64_t CheckFarSheets(const SculptMapping& mapping, const Mesh& sculpt, i
   const int per = blocks.blocks_per_side(face);
   if (per == 0) return 0;
   if (w.near_face != face) LayOutNearBlocks(mapping, face, w);
-  // The block of cells under each column (row) of samples; the samples of each block of them
-  // at block_samples[block_first[at] .. block_first[at + 1]).
-  const auto un = static_cast<std::size_t>(n);
-  w.sample_block_of.resize(un);
-  for (int i = 0; i < n; ++i) {
-    const auto cell = static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));
-    w.sample_block_of[static_cast<std::size_t>(i)] = cell / b;
-  }
-  const auto uper = static_cast<std::size_t>(per);
-  const std::size_t num_blocks = uper * uper;
-  w.block_first.assign(num_blocks + 1, 0);
+  // The samples of each block of cells at block_samples[block_first[at] .. block_first[at + 1]).
+  BlockOfEachSampleRow(m, b, n, w);
+  const auto un = static_cast<std::size_t>(n), uper = static_cast<std::size_t>(per);
+  w.block_first.assign(uper * uper + 1, 0);
   if (samples.empty()) {
-    // Rows and columns of a block are runs (the cells rise with i): its samples in row order.
-    w.block_samples.resize(un * un);
-    std::size_t next = 0;
-    std::size_t j0 = 0;
-    for (std::size_t bj = 0; bj < uper; ++bj) {
-      std::size_t j1 = j0;
-      while (j1 < un && static_cast<std::size_t>(w.sample_block_of[j1]) == bj) ++j1;
-      std::size_t i0 = 0;
-      for (std::size_t bi = 0; bi < uper; ++bi) {
-        std::size_t i1 = i0;
-        while (i1 < un && static_cast<std::size_t>(w.sample_block_of[i1]) == bi) ++i1;
-        for (std::size_t j = j0; j < j1; ++j) {
-          for (std::size_t i = i0; i < i1; ++i) {
-            w.block_samples[next++] = static_cast<std::int32_t>(j * un + i);
-          }
-        }
-        w.block_first[bj * uper + bi + 1] = static_cast<std::int32_t>(next);
-        i0 = i1;
-      }
-      j0 = j1;
-    }
+    GroupGridByBlock(un, uper, w);
   } else {
-    auto block_of = [&](std::int32_t k) {
-      const auto uk = static_cast<std::size_t>(k);
-      return static_cast<std::size_t>(w.sample_block_of[uk / un]) * uper +
-             static_cast<std::size_t>(w.sample_block_of[uk % un]);
-    };
-    for (std::int32_t k : samples) ++w.block_first[block_of(k) + 1];
-    for (std::size_t at = 0; at < num_blocks; ++at) w.block_first[at + 1] += w.block_first[at];
-    w.block_samples.resize(samples.size());
-    w.block_fill.assign(w.block_first.begin(), w.block_first.end() - 1);
-    for (std::int32_t k : samples) {
-      w.block_samples[static_cast<std::size_t>(w.block_fill[block_of(k)]++)] = k;
-    }
+    GroupListedByBlock(samples, un, uper, w);
   }
-  // The near blocks of a block of samples are stamped in near_stamp (one entry per sculpt
-  // block, kept by the thread), so each block met is looked up once.
   if (w.near_stamp.size() != static_cast<std::size_t>(blocks.num_blocks())) {
     w.near_stamp.assign(static_cast<std::size_t>(blocks.num_blocks()), 0);
     w.stamp = 0;
   }
-  const int width = per + 2;
-  const bool nearest = query.policy == HitPolicy::kNearest;
+  const FarCheck check{mapping, sculpt,   origins,
+                       normals, query,    query.policy == HitPolicy::kNearest,
+                       out,     undecided};
   std::uint64_t sent = 0;
   BlockQuads quads;
   for (int bj = 0; bj < per; ++bj) {
     for (int bi = 0; bi < per; ++bi) {
       const std::size_t at = static_cast<std::size_t>(bj) * uper + static_cast<std::size_t>(bi);
-      // The box of the block's windows.
       const std::span<const std::int32_t> block_samples(
           w.block_samples.data() + w.block_first[at],
           static_cast<std::size_t>(w.block_first[at + 1] - w.block_first[at]));
-      const Box all = WindowsBox(block_samples, origins, normals, query, nearest, out, undecided,
-                                 w.window_boxes);
+      // The box of the block's windows, and the sculpt blocks it meets that are not near.
+      const Box all = WindowsBox(block_samples, origins, normals, query, check.nearest, out,
+                                 undecided, w.window_boxes);
       if (!(all.lower[0] <= all.upper[0])) continue;
-      // Its candidates: the sculpt blocks the box meets that are not near.
-      if (++w.stamp == 0) {
-        std::fill(w.near_stamp.begin(), w.near_stamp.end(), 0);
-        w.stamp = 1;
-      }
-      for (int dj = 0; dj <= 2; ++dj) {
-        for (int di = 0; di <= 2; ++di) {
-          const auto slot = static_cast<std::size_t>((bj + dj) * width + bi + di);
-          for (std::int32_t k = w.near_starts[slot]; k < w.near_starts[slot + 1]; ++k) {
-            w.near_stamp[static_cast<std::size_t>(w.near_ids[static_cast<std::size_t>(k)])] =
-                w.stamp;
-          }
-        }
-      }
-      w.candidate_ids.clear();
-      blocks.ForEachMeeting(all, [&](std::int64_t id) {
-        if (w.near_stamp[static_cast<std::size_t>(id)] != w.stamp) w.candidate_ids.push_back(id);
-      });
-      // Each candidate against the samples whose window boxes meet its box, four boxes at a
-      // time; a sample undecided by one candidate is not tested against the next.
-      const std::size_t groups = (block_samples.size() + 3) / 4;
-      for (const std::int64_t id : w.candidate_ids) {
-        const Box& candidate = blocks.box(id);
-        bool gathered = false;
-        for (std::size_t g = 0; g < groups; ++g) {
-          for (unsigned lanes = LanesMeeting(w.window_boxes.data(), g, candidate); lanes != 0;
-               lanes &= lanes - 1) {
-            const auto k = static_cast<std::size_t>(
-                block_samples[4 * g + static_cast<std::size_t>(std::countr_zero(lanes))]);
-            if (undecided[k]) continue;
-            const float window = Window(k, query, nearest, out);
-            const Segment segment(origins[k], normals[k], window);
-            if (!segment.Meets(candidate)) continue;
-            // The quads of the quarters of the block whose boxes the window meets too.
-            if (!gathered) {
-              GatherBlockQuads(mapping, sculpt, id, quads);
-              gathered = true;
-            }
-            unsigned quarters = 0;
-            for (int q = 0; q < quads.quarters(); ++q) {
-              quarters |= segment.Meets(quads.quarter_box[q]) ? 1u << q : 0u;
-            }
-            if (quarters == 0) continue;
-            // A crossing within rounding beyond the window's end counts: the ray path may find
-            // it inside.
-            const float reach = window + RoundingMargin(origins[k], window);
-            if (WindowCrossesQuads(quads, sculpt, quarters, origins[k], normals[k], reach)) {
-              undecided[k] = 1;
-              ++sent;
-            }
-          }
-        }
-      }
+      CollectFarBlocks(blocks, bi, bj, per, all, w);
+      sent += CheckCandidates(check, block_samples, w, quads);
     }
   }
   return sent;

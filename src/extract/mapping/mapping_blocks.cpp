@@ -131,16 +131,21 @@ void TraceBlock(const MappingScratch& w, const Mesh& sculpt, int ci, int cj, con
 
 #if defined(__x86_64__)
 // ---- Two blocks at once, in AVX2 -------------------------------------------------------------
-// The 8 lanes of a 256-bit register hold two blocks of the same face (lane 4 h + l: block h's
-// lane l), each of its own cell. Every lane's floats come from the operations TraceBlock does,
-// in the same order (no fused multiply-add in either), so both kernels keep the same samples
-// for the exact test and answer alike (tests/extract/mapping_test.cpp compares them). Its
-// vector code is written out here: lambdas and helper functions would be compiled for the
-// baseline ISA, not this function's.
 
 using f8 = float __attribute__((vector_size(32)));
 using i8 = std::int32_t __attribute__((vector_size(32)));
 
+// TraceBlock for two blocks at once: the 8 lanes of a 256-bit register hold two blocks of the
+// same face (lane 4 h + l: block h's lane l), each of its own cell. Every lane's floats come
+// from the operations TraceBlock does, in the same order (no fused multiply-add in either), so
+// both kernels keep the same samples for the exact test and answer alike
+// (tests/extract/mapping_test.cpp compares them).
+//
+// Why it is one long function: it is the mapping method's hot kernel, and its vector code must
+// all stay inside this target("avx2") function. Lambdas and helper functions are compiled for
+// the baseline ISA, not this function's: a step split out would take its 256-bit vectors
+// through memory (a different ABI without AVX) and, wherever GCC does not inline it, run
+// without AVX2.
 __attribute__((target("avx2"))) void TraceBlockPair(const MappingScratch& w, const Mesh& sculpt,
                                                     const int ci[2], const int cj[2],
                                                     const Lanes* const blocks[2],

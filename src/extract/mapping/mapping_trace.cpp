@@ -28,150 +28,222 @@ using namespace mapping;
 
 namespace {
 
+// The cell of sample row (column) i of n in a face's m x m grid of cells.
+int CellOf(int i, int m, int n) {
+  return static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));
+}
+
+// Lays out the neighbourhood of `face` in w, kept while the same face is traced again: the
+// slots beyond the face unless every listed sample's rings stay inside it (a few samples, the
+// search estimate's), and for the whole grid the lattice the block kernels read.
+void PrepareFace(const SculptMapping& mapping, const Mesh& sculpt, int face, int n,
+                 std::span<const std::int32_t> samples, MappingScratch& w) {
+  const int m = mapping.grid_size(face);
+  bool inside = !samples.empty();
+  for (std::size_t s = 0; inside && s < samples.size(); ++s) {
+    for (const int cell : {CellOf(samples[s] % n, m, n), CellOf(samples[s] / n, m, n)}) {
+      inside = inside && cell >= kMaxRings && cell < m - kMaxRings;
+    }
+  }
+  if (w.face != face || (!w.margins && !inside)) LayOut(mapping, face, w, !inside);
+  if (samples.empty() && w.lattice_face != face) {
+    FillLattice(sculpt, w);
+    w.lattice_face = face;
+  }
+}
+
+// The queries of one face's samples (TraceRingsOfFace). A listed sample goes ring by ring on
+// its own; over the whole grid, the samples of a cell whose rings 0 and 1 are all quads of the
+// lattice go through TraceBlock together, in blocks of kLanes, and with paired blocks a full
+// block waits in the other slot for a second one, and the two are traced together.
+class RingTracer {
+ public:
+  RingTracer(const Mesh& sculpt, int m, int n, std::span<const Float3> origins,
+             std::span<const Float3> normals, const NormalQuery& query, const NormalHits& out,
+             std::span<std::uint8_t> undecided, MappingScratch& w, MappingCounters& counters)
+      : sculpt_(sculpt),
+        m_(m),
+        n_(n),
+        origins_(origins),
+        normals_(normals),
+        query_(query),
+        out_(out),
+        undecided_(undecided),
+        w_(w),
+        counters_(counters),
+        pairs_(w.paired_blocks && CpuPairsBlocks()) {}
+
+  void TraceListed(std::span<const std::int32_t> samples) {
+    for (const std::int32_t s : samples) {
+      const auto k = static_cast<std::size_t>(s);
+      if (Valid(k)) One(k, CellOf(s % n_, m_, n_), CellOf(s / n_, m_, n_));
+    }
+  }
+
+  // Cell by cell, row by row; each cell's samples row by row.
+  void TraceGrid() {
+    FirstSamples();
+    const std::vector<int>& first = w_.first_sample;
+    for (int cj = 0; cj < m_; ++cj) {
+      const int j_begin = first[static_cast<std::size_t>(cj)];
+      const int j_end = first[static_cast<std::size_t>(cj) + 1];
+      for (int ci = 0; ci < m_; ++ci) {
+        const int i_begin = first[static_cast<std::size_t>(ci)];
+        const int i_end = first[static_cast<std::size_t>(ci) + 1];
+        const bool block = j_end > j_begin && i_end > i_begin && Plain(ci, cj);
+        for (int j = j_begin; j < j_end; ++j) {
+          for (int i = i_begin; i < i_end; ++i) {
+            const std::size_t k = static_cast<std::size_t>(j) * n_ + i;
+            if (!Valid(k)) continue;
+            if (!block) {
+              One(k, ci, cj);
+              continue;
+            }
+            AddLane(w_, k, origins_[k], FlushTiny(normals_[k]), blocks_[fill_]);
+            if (blocks_[fill_].count == kLanes) Flush(ci, cj);
+          }
+        }
+        Flush(ci, cj);
+      }
+    }
+    if (waiting_) TraceAlone(1 - fill_);
+  }
+
+ private:
+  // Invalid queries are misses; the others are traced.
+  bool Valid(std::size_t k) {
+    const Float3& o = origins_[k];
+    const Float3& d = normals_[k];
+    if (Finite(o) && Finite(d) && (d.x != 0 || d.y != 0 || d.z != 0)) return true;
+    out_.t[k] = std::numeric_limits<float>::quiet_NaN();
+    out_.flags[k] = 0;
+    if (!out_.prim.empty()) out_.prim[k] = SculptPrimId();
+    undecided_[k] = 0;
+    ++counters_.decided;
+    return false;
+  }
+
+  // Sample k through the rings of cell (ci, cj), one by one.
+  void One(std::size_t k, int ci, int cj) {
+    const bool done = TraceRings(w_, sculpt_, Line(origins_[k], FlushTiny(normals_[k])), ci, cj,
+                                 query_, k, out_, counters_.quads);
+    undecided_[k] = !done;
+    counters_.decided += done;
+  }
+
+  // Whether rings 0 and 1 of cell (ci, cj) are all quads of the lattice (no extraordinary
+  // corner).
+  bool Plain(int ci, int cj) const {
+    for (int c = 0; c < 4; ++c) {
+      if (w_.fan_corner[c] && CornerDistance(ci, cj, m_, c) == 0) return false;
+    }
+    const int width = m_ + 2 * kMargin;
+    for (int b = cj - 1; b <= cj + 1; ++b) {
+      for (int a = ci - 1; a <= ci + 1; ++a) {
+        if (w_.apron[static_cast<std::size_t>((b + kMargin) * width + a + kMargin)].state !=
+            kCell) {
+          return false;
+        }
+      }
+    }
+    return true;
+  }
+
+  // w.first_sample: the first sample row (column) of each cell row (column); n at the end.
+  void FirstSamples() {
+    std::vector<int>& first = w_.first_sample;
+    first.assign(static_cast<std::size_t>(m_) + 1, n_);
+    for (int i = n_ - 1; i >= 0; --i) first[static_cast<std::size_t>(CellOf(i, m_, n_))] = i;
+    for (int c = m_ - 1; c >= 0; --c) {
+      const auto at = static_cast<std::size_t>(c);
+      first[at] = std::min(first[at], first[at + 1]);
+    }
+  }
+
+  // The answers of block b's lanes: decided, settled undecided, or on to the rings one by one.
+  void Finish(int b, const bool* decided, const bool* settled) {
+    for (int l = 0; l < blocks_[b].count; ++l) {
+      const std::size_t k = blocks_[b].k[l];
+      counters_.quads += 9;
+      if (decided[l]) {
+        undecided_[k] = 0;
+        ++counters_.decided;
+      } else if (settled[l]) {
+        undecided_[k] = 1;
+      } else {
+        One(k, block_ci_[b], block_cj_[b]);
+      }
+    }
+    blocks_[b].count = 0;
+  }
+
+  void TraceAlone(int b) {
+    bool decided[kLanes], settled[kLanes];
+    TraceBlock(w_, sculpt_, block_ci_[b], block_cj_[b], blocks_[b], query_, out_, decided, settled);
+    Finish(b, decided, settled);
+  }
+
+  // The block being filled, of cell (ci, cj), is traced: alone, or with paired blocks left
+  // waiting for a second one, or traced with the one waiting.
+  void Flush(int ci, int cj) {
+    if (blocks_[fill_].count == 0) return;
+    block_ci_[fill_] = ci;
+    block_cj_[fill_] = cj;
+    if (!pairs_) {
+      TraceAlone(fill_);
+    } else if (!waiting_) {
+      waiting_ = true;
+      fill_ = 1 - fill_;
+    } else {
+      TracePair();
+    }
+  }
+
+  void TracePair() {
+#if defined(__x86_64__)
+    const int first = 1 - fill_;
+    const int ci_pair[2] = {block_ci_[first], block_ci_[fill_]};
+    const int cj_pair[2] = {block_cj_[first], block_cj_[fill_]};
+    const Lanes* const pair[2] = {&blocks_[first], &blocks_[fill_]};
+    bool decided[2][kLanes], settled[2][kLanes];
+    TraceBlockPair(w_, sculpt_, ci_pair, cj_pair, pair, query_, out_, decided, settled);
+    Finish(first, decided[0], settled[0]);
+    Finish(fill_, decided[1], settled[1]);
+    waiting_ = false;
+#endif
+  }
+
+  const Mesh& sculpt_;
+  const int m_, n_;
+  std::span<const Float3> origins_, normals_;
+  const NormalQuery& query_;
+  const NormalHits& out_;
+  std::span<std::uint8_t> undecided_;
+  MappingScratch& w_;
+  MappingCounters& counters_;
+  // Blocks of samples, one cell's each, filled in blocks_[fill_]; with pairs_, a full block
+  // waits in the other slot (waiting_) for a second one.
+  const bool pairs_;
+  Lanes blocks_[2];
+  int block_ci_[2] = {}, block_cj_[2] = {};
+  int fill_ = 0;
+  bool waiting_ = false;
+};
+
 // TraceMapped's rings, for a face not at risk of folds.
 void TraceRingsOfFace(const SculptMapping& mapping, const Mesh& sculpt, PtexFaceId face, int n,
                       std::span<const std::int32_t> samples, std::span<const Float3> origins,
                       std::span<const Float3> normals, const NormalQuery& query,
                       const NormalHits& out, std::span<std::uint8_t> undecided, MappingScratch& w,
                       MappingCounters& counters) {
-  const int m = mapping.grid_size(face.value);
-  auto cell_of = [&](int i) {
-    return static_cast<int>((std::int64_t{2} * i + 1) * m / (std::int64_t{2} * n));
-  };
-  // A few samples whose rings all stay inside the face (the search estimate's) need no apron
-  // beyond it.
-  bool inside = !samples.empty();
-  for (std::size_t s = 0; inside && s < samples.size(); ++s) {
-    for (const int cell : {cell_of(samples[s] % n), cell_of(samples[s] / n)}) {
-      inside = inside && cell >= kMaxRings && cell < m - kMaxRings;
-    }
+  PrepareFace(mapping, sculpt, face.value, n, samples, w);
+  RingTracer tracer(sculpt, mapping.grid_size(face.value), n, origins, normals, query, out,
+                    undecided, w, counters);
+  if (samples.empty()) {
+    tracer.TraceGrid();
+  } else {
+    tracer.TraceListed(samples);
   }
-  if (w.face != face.value || (!w.margins && !inside)) LayOut(mapping, face.value, w, !inside);
-  if (samples.empty() && w.lattice_face != face.value) {
-    FillLattice(sculpt, w);
-    w.lattice_face = face.value;
-  }
-  // Invalid queries are misses; the others get their cell's rings, one by one.
-  auto valid = [&](std::size_t k) {
-    const Float3& o = origins[k];
-    const Float3& d = normals[k];
-    if (Finite(o) && Finite(d) && (d.x != 0 || d.y != 0 || d.z != 0)) return true;
-    out.t[k] = std::numeric_limits<float>::quiet_NaN();
-    out.flags[k] = 0;
-    if (!out.prim.empty()) out.prim[k] = SculptPrimId();
-    undecided[k] = 0;
-    ++counters.decided;
-    return false;
-  };
-  auto one = [&](std::size_t k, int ci, int cj) {
-    const bool done = TraceRings(w, sculpt, Line(origins[k], FlushTiny(normals[k])), ci, cj, query,
-                                 k, out, counters.quads);
-    undecided[k] = !done;
-    counters.decided += done;
-  };
-  if (!samples.empty()) {
-    for (const std::int32_t s : samples) {
-      const auto k = static_cast<std::size_t>(s);
-      if (valid(k)) one(k, cell_of(s % n), cell_of(s / n));
-    }
-    return;
-  }
-  // The whole grid, cell by cell: where rings 0 and 1 are all quads of the lattice (no
-  // extraordinary corner), the cell's samples go through TraceBlock together.
-  const int width = m + 2 * kMargin;
-  auto plain = [&](int ci, int cj) {
-    for (int c = 0; c < 4; ++c) {
-      if (w.fan_corner[c] && CornerDistance(ci, cj, m, c) == 0) return false;
-    }
-    for (int b = cj - 1; b <= cj + 1; ++b) {
-      for (int a = ci - 1; a <= ci + 1; ++a) {
-        if (w.apron[static_cast<std::size_t>((b + kMargin) * width + a + kMargin)].state != kCell) {
-          return false;
-        }
-      }
-    }
-    return true;
-  };
-  // Blocks of samples, one cell's each, filled in blocks[fill]; paired, a full block
-  // waits in the other slot for a second one, and the two are traced together.
-  const bool pairs = w.paired_blocks && CpuPairsBlocks();
-  Lanes blocks[2];
-  int block_ci[2] = {}, block_cj[2] = {};
-  int fill = 0;
-  bool waiting = false;
-  auto finish = [&](int b, const bool* decided, const bool* settled) {
-    for (int l = 0; l < blocks[b].count; ++l) {
-      const std::size_t k = blocks[b].k[l];
-      counters.quads += 9;
-      if (decided[l]) {
-        undecided[k] = 0;
-        ++counters.decided;
-      } else if (settled[l]) {
-        undecided[k] = 1;
-      } else {
-        one(k, block_ci[b], block_cj[b]);
-      }
-    }
-    blocks[b].count = 0;
-  };
-  auto trace_alone = [&](int b) {
-    bool decided[kLanes], settled[kLanes];
-    TraceBlock(w, sculpt, block_ci[b], block_cj[b], blocks[b], query, out, decided, settled);
-    finish(b, decided, settled);
-  };
-  auto flush = [&](int ci, int cj) {
-    if (blocks[fill].count == 0) return;
-    block_ci[fill] = ci;
-    block_cj[fill] = cj;
-    if (!pairs) {
-      trace_alone(fill);
-    } else if (!waiting) {
-      waiting = true;
-      fill = 1 - fill;
-    } else {
-#if defined(__x86_64__)
-      const int first = 1 - fill;
-      const int ci_pair[2] = {block_ci[first], block_ci[fill]};
-      const int cj_pair[2] = {block_cj[first], block_cj[fill]};
-      const Lanes* const pair[2] = {&blocks[first], &blocks[fill]};
-      bool decided[2][kLanes], settled[2][kLanes];
-      TraceBlockPair(w, sculpt, ci_pair, cj_pair, pair, query, out, decided, settled);
-      finish(first, decided[0], settled[0]);
-      finish(fill, decided[1], settled[1]);
-      waiting = false;
-#endif
-    }
-  };
-  // The first sample row (column) of each cell row (column); n at the end.
-  w.first_sample.assign(static_cast<std::size_t>(m) + 1, n);
-  for (int i = n - 1; i >= 0; --i) w.first_sample[static_cast<std::size_t>(cell_of(i))] = i;
-  for (int c = m - 1; c >= 0; --c) {
-    const auto at = static_cast<std::size_t>(c);
-    w.first_sample[at] = std::min(w.first_sample[at], w.first_sample[at + 1]);
-  }
-  for (int cj = 0; cj < m; ++cj) {
-    const int j_begin = w.first_sample[static_cast<std::size_t>(cj)];
-    const int j_end = w.first_sample[static_cast<std::size_t>(cj) + 1];
-    for (int ci = 0; ci < m; ++ci) {
-      const int i_begin = w.first_sample[static_cast<std::size_t>(ci)];
-      const int i_end = w.first_sample[static_cast<std::size_t>(ci) + 1];
-      const bool block = j_end > j_begin && i_end > i_begin && plain(ci, cj);
-      for (int j = j_begin; j < j_end; ++j) {
-        for (int i = i_begin; i < i_end; ++i) {
-          const std::size_t k = static_cast<std::size_t>(j) * n + i;
-          if (!valid(k)) continue;
-          if (!block) {
-            one(k, ci, cj);
-            continue;
-          }
-          AddLane(w, k, origins[k], FlushTiny(normals[k]), blocks[fill]);
-          if (blocks[fill].count == kLanes) flush(ci, cj);
-        }
-      }
-      flush(ci, cj);
-    }
-  }
-  if (waiting) trace_alone(1 - fill);
 }
 
 }  // namespace
