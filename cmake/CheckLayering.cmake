@@ -9,8 +9,9 @@
 # reach (cmake/Options.cmake); this check also covers the public headers, which every target
 # sees.
 
+# `front` is the front door, include/dispex/dispex.h: public headers only, above every module.
 set(levels core 0 mesh 1 subdiv 2 trace 3 spectral 4 ptex 5 uvmap 5 extract 6 verify 7 render 7
-  view 8)
+  view 8 front 9)
 # The module each public header belongs to.
 set(owners
   status core ids core version core files core cancel core progress core allocator core
@@ -23,7 +24,8 @@ set(owners
   extract extract
   verify verify
   render render
-  view view)
+  view view
+  dispex front)
 
 function(lookup list key out)
   list(FIND ${list} ${key} i)

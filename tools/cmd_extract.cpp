@@ -41,27 +41,13 @@ const std::vector<FlagName>& ExtractFlagNames() {
 }
 
 struct ExtractArgs {
-  ExtractOptions options;
-  std::string oversample = "auto";
-  std::string search_distance = "auto";
+  ExtractOptions options;  // the table's options set as their flags are parsed (AddTableFlags)
   double search_distance_rel = 0;
-  std::string ray_policy = "nearest";
-  std::string resolution_rule = "bound";
-  std::string fixed_resolution = "64x64";
-  std::string data_type = "float";
-  std::string holes = "fill";
-  std::string watertight = "filter";
-  std::string bvh_quality = "low";
-  std::string method = "auto";
-  std::string vector;
   std::string report_path;
   std::string preview_dir;
-  std::string max_memory;
   std::string output_dir;
   std::vector<std::string> shapes;
   std::string manifest_path;
-  std::string shard;
-  std::string shard_sculpt = "whole";
   bool quiet = false;
   bool progress_lines = false;
   ProgressLines* lines = nullptr;  // with --progress-lines, while the work runs
@@ -71,96 +57,46 @@ struct ExtractArgs {
   bool asset() const { return !output_dir.empty() || !manifest_path.empty(); }
 };
 
-Status Resolve(ExtractArgs& a) {
-  ExtractOptions& o = a.options;
-  if (a.oversample != "auto") {
-    try {
-      std::size_t used = 0;
-      o.oversample = std::stoi(a.oversample, &used);
-      if (used != a.oversample.size() || o.oversample <= 0) throw std::invalid_argument("");
-    } catch (...) {
-      return Status::Error(
-          fmt::format("--oversample {}: expected 'auto' or a power of two", a.oversample));
-    }
+// --search-distance-rel: the search distance as a fraction, spelled apart (0: not given).
+Status ApplySearchDistanceRel(ExtractArgs& a) {
+  if (a.search_distance_rel == 0) return Status::Ok();
+  if (a.options.search_distance.kind != SearchDistanceSpec::Kind::kAuto) {
+    return Status::Error("give --search-distance or --search-distance-rel, not both");
   }
-  if (a.search_distance_rel != 0) {
-    if (a.search_distance != "auto") {
-      return Status::Error("give --search-distance or --search-distance-rel, not both");
-    }
-    o.search_distance = {SearchDistanceSpec::Kind::kRelative, a.search_distance_rel};
-  } else {
-    auto spec = ParseSearchDistance(a.search_distance);
-    if (!spec.ok()) return spec.status().WithPrefix("--search-distance");
-    o.search_distance = *spec;
-  }
-  auto policy = ParseHitPolicy(a.ray_policy);
-  if (!policy.ok()) return policy.status().WithPrefix("--ray-policy");
-  o.ray_policy = *policy;
-  auto rule = ParseResolutionRule(a.resolution_rule);
-  if (!rule.ok()) return rule.status().WithPrefix("--resolution-rule");
-  o.resolution_rule = *rule;
-  int rx = 0, ry = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(a.fixed_resolution.c_str(), "%d%c%d%c", &rx, &x, &ry, &extra) != 3 || x != 'x' ||
-      rx < 1 || ry < 1 || (rx & (rx - 1)) || (ry & (ry - 1))) {
-    return Status::Error(fmt::format(
-        "--fixed-resolution {}: expected WxH with powers of two, e.g. 64x64", a.fixed_resolution));
-  }
-  o.fixed_ulog2 = __builtin_ctz(static_cast<unsigned>(rx));
-  o.fixed_vlog2 = __builtin_ctz(static_cast<unsigned>(ry));
-  if (a.data_type == "float") {
-    o.data_type = PtexDataType::kFloat;
-  } else if (a.data_type == "half") {
-    o.data_type = PtexDataType::kHalf;
-  } else {
-    return Status::Error(fmt::format("--data-type {}: expected float or half", a.data_type));
-  }
-  auto holes = ParseHolePolicy(a.holes);
-  if (!holes.ok()) return holes.status().WithPrefix("--holes");
-  o.holes = *holes;
-  auto watertight = ParseWatertightEdges(a.watertight);
-  if (!watertight.ok()) return watertight.status().WithPrefix("--watertight");
-  o.watertight = *watertight;
-  if (!a.vector.empty()) {
-    auto space = ParseVectorSpace(a.vector);
-    if (!space.ok()) return space.status().WithPrefix("--vector");
-    o.vector = *space;
-  }
-  auto quality = ParseBuildQuality(a.bvh_quality);
-  if (!quality.ok()) return quality.status().WithPrefix("--bvh-quality");
-  o.bvh_quality = *quality;
-  auto method = ParseExtractMethod(a.method);
-  if (!method.ok()) return method.status().WithPrefix("--method");
-  o.method = *method;
-  o.progress = !a.quiet && !a.progress_lines && StderrIsInteractive();
-  if (!a.shard.empty()) {
-    Status shard = ParseShard(a.shard, o.shard_index, o.shard_count);
-    if (!shard.ok()) return shard.WithPrefix("--shard");
-  }
-  auto shard_sculpt = ParseShardSculpt(a.shard_sculpt);
-  if (!shard_sculpt.ok()) return shard_sculpt.status().WithPrefix("--shard-sculpt");
-  o.shard_sculpt = *shard_sculpt;
-  if (!a.max_memory.empty()) {
-    auto bytes = ParseByteSize(a.max_memory);
-    if (!bytes.ok()) return bytes.status().WithPrefix("--max-memory");
-    o.max_memory = *bytes;
-  }
+  a.options.search_distance = {SearchDistanceSpec::Kind::kRelative, a.search_distance_rel};
+  return Status::Ok();
+}
+
+// The files beside the map (--report, --preview, --out-dir): writable, the report none of the
+// inputs and outputs.
+Status CheckOtherOutputs(const ExtractArgs& a) {
+  const ExtractOptions& o = a.options;
   if (!a.report_path.empty() && (a.report_path == o.base_path || a.report_path == o.sculpt_path ||
                                  a.report_path == o.output_path)) {
     return Status::Error(
         fmt::format("--report {}: must differ from the inputs and the output", a.report_path));
   }
-  DISPEX_RETURN_IF_ERROR(CheckOutputs({{"--report", a.report_path},
-                                       {"--preview", a.preview_dir, /*folder=*/true},
-                                       {"--out-dir", a.output_dir, /*folder=*/true}}));
-  if (a.watch) {
-    if (a.asset()) {
-      return Status::Error("--watch re-extracts one map (-o), not --out-dir/--manifest");
-    }
-    if (o.shard_count > 0) return Status::Error("--watch re-extracts a whole map, not a --shard");
-    // Each round re-uses the map; UV-space maps are not re-used: a full extraction each round.
-    if (o.uv_maps_dir.empty()) o.incremental = true;
+  return CheckOutputs({{"--report", a.report_path},
+                       {"--preview", a.preview_dir, /*folder=*/true},
+                       {"--out-dir", a.output_dir, /*folder=*/true}});
+}
+
+// --watch: one map re-extracted each round, re-using it (UV-space maps are not re-used: a full
+// extraction each round).
+Status ResolveWatch(ExtractArgs& a) {
+  if (!a.watch) return Status::Ok();
+  if (a.asset()) return Status::Error("--watch re-extracts one map (-o), not --out-dir/--manifest");
+  if (a.options.shard_count > 0) {
+    return Status::Error("--watch re-extracts a whole map, not a --shard");
   }
+  if (a.options.uv_maps_dir.empty()) a.options.incremental = true;
+  return Status::Ok();
+}
+
+// What is written -- one map per shape (--out-dir, --manifest) or one map (-o) -- and the flags
+// that go with it; one map's options are checked here, an asset's shapes' by ExtractAsset.
+Status CheckTargets(const ExtractArgs& a) {
+  const ExtractOptions& o = a.options;
   if (a.asset()) {
     if (!o.output_path.empty()) return Status::Error("give -o or --out-dir/--manifest, not both");
     if (!a.manifest_path.empty() && !a.shapes.empty()) {
@@ -181,6 +117,16 @@ Status Resolve(ExtractArgs& a) {
   }
   if (o.output_path.empty()) return Status::Error("give -o OUT.ptx, or --out-dir DIR");
   return ValidateExtractOptions(o);
+}
+
+// The parsed command line made whole and checked, before any work. The table's options are set
+// and their values checked as they are parsed (AddTableFlags).
+Status Resolve(ExtractArgs& a) {
+  DISPEX_RETURN_IF_ERROR(ApplySearchDistanceRel(a));
+  a.options.progress = !a.quiet && !a.progress_lines && StderrIsInteractive();
+  DISPEX_RETURN_IF_ERROR(CheckOtherOutputs(a));
+  DISPEX_RETURN_IF_ERROR(ResolveWatch(a));
+  return CheckTargets(a);
 }
 
 // The exit status of a run: its error, or 0 once its JSON report is written and its summary
@@ -278,146 +224,98 @@ int RunExtract(ExtractArgs& args) {
   return 0;
 }
 
-void SetupExtract(CLI::App& app, int& exit_code) {
-  auto args = std::make_shared<ExtractArgs>();
-  ExtractOptions& o = args->options;
-  CLI::App* cmd = app.add_subcommand(
-      "extract",
-      "Extract a Ptex displacement map: BASE cage + SCULPT -> OUT.ptx, or one map per shape");
+// BASE, SCULPT and where the maps go.
+void AddInputsAndOutputs(CLI::App* cmd, ExtractArgs& a) {
+  ExtractOptions& o = a.options;
   cmd->add_option("base", o.base_path, "base mesh: the Catmull-Clark cage (.obj, .ply)");
   cmd->add_option("sculpt", o.sculpt_path, "sculpted high-resolution mesh (.obj, .ply)");
   cmd->add_option("-o,--output", o.output_path, "output Ptex file (.ptx) of a single-shape base");
-  cmd->add_option("--out-dir", args->output_dir,
+  cmd->add_option("--out-dir", a.output_dir,
                   "one map per shape (OBJ o/g group) of the base: DIR/<shape>.ptx, each shape's "
                   "rays hitting only the sculpt's shape of the same name");
-  cmd->add_option("--shapes", args->shapes, "with --out-dir: only these shapes (a,b,c)")
+  cmd->add_option("--shapes", a.shapes, "with --out-dir: only these shapes (a,b,c)")
       ->delimiter(',');
-  cmd->add_option("--manifest", args->manifest_path,
+  cmd->add_option("--manifest", a.manifest_path,
                   "JSON naming shapes spread over several files, with options per shape "
                   "(docs/SHAPES.md); the command line's options are its defaults");
-  cmd->add_option("--oversample", args->oversample,
-                  "samples per side of each face: 'auto' (from the sculpt's density) or a "
-                  "power of two 1..512")
-      ->capture_default_str();
-  cmd->add_option("--max-oversample", o.max_oversample, "cap for automatic oversampling")
-      ->capture_default_str();
-  cmd->add_option("--min-oversample", o.min_oversample, "floor for automatic oversampling")
-      ->capture_default_str();
-  cmd->add_option("--search-distance", args->search_distance,
-                  "how far along ±normal to look: 'auto', a length, or N% of the base "
-                  "bounding-box diagonal")
-      ->capture_default_str();
+}
+
+// CLI11's name in --help of the type of an option's value.
+std::string TypeName(OptionKind kind) {
+  switch (kind) {
+    case OptionKind::kInteger:
+      return "INT";
+    case OptionKind::kNumber:
+      return "FLOAT";
+    default:
+      return "TEXT";
+  }
+}
+
+// A flag for every option of the library's table (ExtractOptionSpecs), with its help line and
+// default from there; each value is set through the table's setter as it is parsed, so a bad
+// value is a parse error naming the flag: "--tolerance: x is not a number".
+void AddTableFlags(CLI::App* cmd, ExtractOptions& o) {
+  for (const ExtractOptionSpec& spec : ExtractOptionSpecs()) {
+    auto set = [&o, name = spec.name](const std::string& text) {
+      const Status status = SetExtractOptionText(o, name, text);
+      if (!status.ok()) {
+        throw CLI::ValidationError(WithFlagNames(status.message(), ExtractFlagNames()));
+      }
+    };
+    if (spec.kind == OptionKind::kBool) {
+      // The flag gives the opposite of the default: "!" has CLI11 give "false".
+      const std::string flag = (spec.default_text == "true" ? "!" : "") + std::string(spec.flag);
+      cmd->add_flag(flag)->description(std::string(spec.help))->each(set);
+      continue;
+    }
+    CLI::Option* option = cmd->add_option(std::string(spec.flag))
+                              ->description(std::string(spec.help))
+                              ->type_name(TypeName(spec.kind));
+    if (!spec.default_text.empty()) option->default_str(std::string(spec.default_text));
+    // 0 is automatic, which here is the flag left out: said in --help (":> 0") and refused.
+    if (spec.zero_is_auto && spec.kind != OptionKind::kIntegerOrAuto) option->check(Positive());
+    option->each(set);
+  }
+}
+
+// The command line's own flags: how the run shows itself, and what else it writes.
+void AddRunFlags(CLI::App* cmd, ExtractArgs& a) {
   // 0 stands for "not given" here, so 0 itself is refused as a value.
-  cmd->add_option("--search-distance-rel", args->search_distance_rel,
+  cmd->add_option("--search-distance-rel", a.search_distance_rel,
                   "search distance as a fraction of the base bounding-box diagonal")
       ->check(Positive());
-  cmd->add_option("--ray-policy", args->ray_policy,
-                  "hit kept when both directions hit: nearest, outside-first, inside-first")
-      ->capture_default_str();
-  // The library reads tolerance 0 as automatic; here automatic is the option left out, so 0 is
-  // refused rather than taken silently.
-  cmd->add_option("--tolerance", o.tolerance,
-                  "largest allowed error per face, object units (default: "
-                  "--tolerance-fraction x the sculpt's median edge length)")
-      ->check(Positive());
-  cmd->add_option("--tolerance-fraction", o.tolerance_fraction,
-                  "automatic tolerance as a fraction of the sculpt's median edge length")
-      ->capture_default_str();
-  cmd->add_option("--resolution-rule", args->resolution_rule,
-                  "per-face resolution: bound (error bound), nonzero (published rule), fixed")
-      ->capture_default_str();
-  cmd->add_option("--nonzero-threshold", o.nonzero_threshold,
-                  "|DCT coefficient| counted as non-zero by --resolution-rule nonzero")
-      ->capture_default_str();
-  cmd->add_option("--fixed-resolution", args->fixed_resolution, "WxH for --resolution-rule fixed")
-      ->capture_default_str();
-  cmd->add_option("--data-type", args->data_type, "texel type: float or half")
-      ->capture_default_str();
-  cmd->add_option("--compression-level", o.compression_level,
-                  "deflate level 0..12 (-1: default, 1)")
-      ->capture_default_str();
-  cmd->add_option("--holes", args->holes,
-                  "samples whose rays miss: fill (interpolate), fail (error), zero")
-      ->capture_default_str();
-  cmd->add_option("--watertight", args->watertight,
-                  "shared face edges meet within the tolerance for: filter (the Ptex library's "
-                  "filters), all (also readers that read each face on its own), off")
-      ->capture_default_str();
-  cmd->add_option("--max-miss-fraction", o.max_miss_fraction,
-                  "fail when more than this fraction of the samples miss the sculpt after the "
-                  "second search (0..1; 1: never)")
-      ->capture_default_str();
-  cmd->add_option("--method", args->method,
-                  "where values come from: auto (interpolate when the sculpt is the base "
-                  "refined, else rays), interpolate (the sculpt's vertex displacements "
-                  "interpolated through the subdivision correspondence, no rays), mapping "
-                  "(rays through the correspondence: the map follows the sculpt's flat quads), "
-                  "rays (a BVH of the sculpt); interpolate and mapping fail when the sculpt is "
-                  "not the base refined")
-      ->capture_default_str();
-  cmd->add_option("--bvh-quality", args->bvh_quality, "BVH build quality: low, medium, high")
-      ->capture_default_str();
-  cmd->add_option("--embree-isa", o.embree_isa,
-                  "Embree kernels: sse2, sse4.2, avx, avx2, avx512 (default: $DISPEX_EMBREE_ISA, "
-                  "else the widest this CPU runs)");
-  cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")->capture_default_str();
-  cmd->add_option("--max-memory", args->max_memory,
-                  "refuse work estimated to need more memory than this (e.g. 8G; default: the "
-                  "memory available)");
-  cmd->add_option("--vector", args->vector,
-                  "write a vector displacement map (3 channels: sculpt - limit surface) in this "
-                  "space: tangent (T, B, N), parametric (dP/du, dP/dv, N) or object (x, y, z); "
-                  "the sculpt must be the base refined (see `dispex match`)");
-  cmd->add_option("--uv-maps", o.uv_maps_dir,
-                  "also write UV-space maps: DIR/<map>.<UDIM>.exr (OpenEXR, one float channel, or "
-                  "R, G, B = x, y, z with --vector object) for every UDIM tile the base's UVs "
-                  "touch, extracted at each texel (UVs interpolated face-varying linearly; "
-                  "docs/UV_MAPS.md)");
-  cmd->add_option("--uv-resolution", o.uv_resolution, "texels per side of each UDIM tile")
-      ->capture_default_str();
-  cmd->add_option("--uv-padding", o.uv_padding,
-                  "texels of dilation outside the UV faces, so that filtering at seams never "
-                  "reads empty texels")
-      ->capture_default_str();
-  cmd->add_flag("!--no-input-checks", o.check_inputs,
-                "extract inputs that look like a mistake: a sculpt with fewer faces than its "
-                "base, or one moved, scaled or turned against it as a whole");
-  cmd->add_flag("--plan", o.plan_only,
-                "print the plan -- which faces would be traced and which copied, the method and "
-                "what the BVH holds -- and stop: the inputs are read and matched, nothing is "
-                "written (with --report, the report's \"plan\")");
-  cmd->add_flag("--incremental", o.incremental,
-                "re-use the map at the output path: left as it is when made from the same "
-                "inputs and options, else only the faces whose inputs changed are extracted "
-                "(the result is the file a full extraction writes)");
-  cmd->add_option("--shard", args->shard,
-                  "I/N: extract only the I-th of N shards of the faces (balanced by estimated "
-                  "cost) into a part for `dispex merge` (docs/FARM.md)");
-  cmd->add_option("--shard-sculpt", args->shard_sculpt,
-                  "what a shard keeps of the sculpt: whole, or part (only what its faces' rays "
-                  "reach: memory falls with N; needs --method rays and --search-distance)")
-      ->capture_default_str();
   CLI::Option* watch =
-      cmd->add_flag("--watch", args->watch,
+      cmd->add_flag("--watch", a.watch,
                     "keep running: extract again each time BASE or SCULPT is saved, re-using the "
                     "map (--incremental; UV-space maps: a full extraction), one line per round; "
                     "a broken save leaves the map as it was; Ctrl-C ends it (exit 130)");
-  cmd->add_option("--watch-settle", args->watch_settle_ms,
+  cmd->add_option("--watch-settle", a.watch_settle_ms,
                   "with --watch: milliseconds a file written in place must stay unchanged (size, "
                   "time) before it is read")
       ->check(NonNegative())
       ->needs(watch)
       ->capture_default_str();
-  cmd->add_option("--report", args->report_path, "write a JSON report to this file");
-  cmd->add_option("--preview", args->preview_dir,
+  cmd->add_option("--report", a.report_path, "write a JSON report to this file");
+  cmd->add_option("--preview", a.preview_dir,
                   "also write DIR/<map>_atlas.png and DIR/<map>_compare.png (base and base + "
                   "map side by side)");
-  cmd->add_flag("-q,--quiet", args->quiet, "no progress bar and no summary");
-  cmd->add_flag("--progress-lines", args->progress_lines,
+  cmd->add_flag("-q,--quiet", a.quiet, "no progress bar and no summary");
+  cmd->add_flag("--progress-lines", a.progress_lines,
                 "progress for a program that drives the command: a line 'progress extract "
                 "DONE/TOTAL' (Ptex faces; 'progress shapes' with --out-dir) on stderr up to 10 "
                 "times a second and once at the end, also when stderr is not a terminal (instead "
                 "of the bar; -q leaves them on)");
+}
+
+void SetupExtract(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<ExtractArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "extract",
+      "Extract a Ptex displacement map: BASE cage + SCULPT -> OUT.ptx, or one map per shape");
+  AddInputsAndOutputs(cmd, *args);
+  AddTableFlags(cmd, args->options);
+  AddRunFlags(cmd, *args);
   cmd->callback([args, &exit_code] { exit_code = RunExtract(*args); });
 }
 

@@ -236,7 +236,9 @@ enum class OptionKind : std::uint8_t {
   kDistance,       // 0.05, "auto" or "2%"
 };
 
-// One extract option set by name, declared once (src/extract/io/option_table.cpp).
+// One extract option set by name, declared once (src/extract/io/option_table.cpp): the field
+// and flag, the value it takes, and how `dispex extract` offers it (tools/cmd_extract.cpp makes
+// every one of its flags and their --help lines from this table).
 struct ExtractOptionSpec {
   std::string_view name;  // the ExtractOptions field: manifests, Python keywords, messages
   std::string_view flag;  // the command line's flag
@@ -247,6 +249,16 @@ struct ExtractOptionSpec {
   // incremental run's faces. false: how the run goes, not what the map holds (threads,
   // memory, checks, where other outputs go).
   bool in_map = false;
+  // The flag's line in `dispex extract --help` (one line: what it does, how to spell it).
+  std::string_view help;
+  // The default as the command line spells it ("auto", "128", "64x64"), which --help shows
+  // after the value's type; empty: none is shown (none given, or the help says it). A kBool
+  // option's flag takes no value and gives the opposite of this: "true" for check_inputs,
+  // whose flag --no-input-checks turns it off.
+  std::string_view default_text = {};
+  // 0 is the automatic value (tolerance, oversample). The command line gets it by leaving the
+  // flag out (or with 'auto'), so its text refuses 0 and below rather than take them silently.
+  bool zero_is_auto = false;
 };
 std::span<const ExtractOptionSpec> ExtractOptionSpecs();
 
@@ -260,6 +272,18 @@ std::string ExtractOptionNames();
 // option (known: ...)".
 Status SetExtractOption(ExtractOptions& options, const std::string& name,
                         const std::string& json_value);
+
+// Sets one option by its field name from the text its command-line flag takes ("0.001",
+// "auto", "2%", "64x32", "8G", "tangent"; "true" or "false" for a kBool option), through the
+// same setter as SetExtractOption: the text is read as the option's kind reads it (kInteger: a
+// whole decimal integer, kIntegerOrAuto: one or "auto", kNumber: a number, kBool: true or
+// false; the other kinds take it as it is), and refused at 0 and below where zero_is_auto.
+// Errors (code kInvalidArgument) say what is wrong with the value, leaving the option to be
+// named by the caller, which knows how it was given ("x is not a number"; the command line
+// prints "--tolerance: x is not a number"); a name not in the table: "unknown option 'colour'
+// (known: ...)".
+Status SetExtractOptionText(ExtractOptions& options, std::string_view name,
+                            const std::string& text);
 
 // What one map's extraction does, decided before its faces are traced, each part by the stage
 // that can decide it (the method once the sculpt is matched, the faces once their keys are
@@ -393,6 +417,8 @@ struct ExtractReport {
   bool unchanged = false;  // the map was made from the same inputs and options: not rewritten
   std::int64_t faces_copied = 0;     // from the previous map
   std::int64_t faces_extracted = 0;  // Ptex faces with a surface that were not copied
+  // Of the faces copied, those the watertight edges extracted again: a neighbour's edge changed.
+  std::int64_t faces_copied_redone = 0;
   // Why faces were extracted again: "no previous map", the previous map's notice, or what
   // changed ("base, sculpt, options: tolerance").
   std::string redo_reason;

@@ -71,7 +71,8 @@ def _check_progress(progress):
 
 def option_names():
     """The extract options by name, each with its command-line flag, the kind of value it
-    takes and what it takes in words: {name: {"flag", "kind", "values", "in_manifest",
+    takes, what it takes in words, its one-line help and default as `dispex extract --help`
+    shows them: {name: {"flag", "kind", "values", "help", "default", "in_manifest",
     "in_map"}}; in_map: recorded in the map, so that changing it re-extracts an incremental
     run (threads, max_memory and the like are not)."""
     return {name: {k: v for k, v in spec.items() if k != "name"}

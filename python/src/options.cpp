@@ -52,6 +52,8 @@ void AddOptionSpecs(py::module_& module) {
       d["flag"] = std::string(s.flag);
       d["kind"] = std::string(KindName(s.kind));
       d["values"] = std::string(s.values);
+      d["help"] = std::string(s.help);  // its line in `dispex extract --help`
+      d["default"] = std::string(s.default_text);
       d["in_manifest"] = s.in_manifest;
       d["in_map"] = s.in_map;
       specs.append(d);

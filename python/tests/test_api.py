@@ -33,7 +33,8 @@ def test_every_option_of_the_table_is_a_flag_of_the_command_line():
 
 
 # The command line's flags of `extract` that are not options of the map's extraction: where the
-# outputs go and how the run shows itself (a new extraction option belongs in the table).
+# outputs go and how the run shows itself. Every other flag is made from the library's table
+# (tools/cmd_extract.cpp), so a new extraction option is a table entry, never a flag of its own.
 CLI_ONLY_FLAGS = {"--output", "--out-dir", "--shapes", "--manifest", "--report", "--preview",
                   "--quiet", "--progress-lines", "--watch", "--watch-settle", "--help",
                   "--search-distance-rel"}  # --search-distance's percentage, spelled apart
@@ -44,6 +45,46 @@ def test_every_flag_of_extract_is_in_the_table_or_the_command_lines_own():
     flags = set(re.findall(r"^\s+(?:-\w, )?(--[a-z-]+)", help_text, flags=re.M))
     table = {spec["flag"] for spec in dispex.option_names().values()}
     assert flags - CLI_ONLY_FLAGS == table, (flags - CLI_ONLY_FLAGS) ^ table
+
+
+# CLI11's names of the value types in --help, by the table's kinds.
+HELP_TYPES = {"integer": "INT", "number": "FLOAT"}
+
+
+def test_each_table_flags_help_is_the_tables():
+    """Each option's entry in `extract --help` -- its value's type, default and help line (on the
+    flag's line or the next) -- is the table's, so the two cannot drift apart."""
+    help_text = run_cli("extract", "--help").stdout
+    for name, spec in dispex.option_names().items():
+        assert spec["help"] and "\n" not in spec["help"], name
+        entry = re.search(r"^ +" + re.escape(spec["flag"]) + r"(?P<head>[^\n]*?) *\n? *"
+                          + re.escape(spec["help"]) + "$", help_text, flags=re.M)
+        assert entry, (name, spec["help"])
+        head = entry["head"]
+        if spec["kind"] == "bool":  # a flag: no value; {false} where it turns the option off
+            assert head == ("{false}" if spec["default"] == "true" else ""), (name, head)
+            continue
+        assert head.startswith(" " + HELP_TYPES.get(spec["kind"], "TEXT")), (name, head)
+        shown = head.rpartition("=")[2] if "=" in head else ""
+        assert shown == spec["default"], (name, head)
+
+
+def test_the_defaults_help_shows_are_the_librarys(tmp_path, sculpts):
+    """Every default the table gives, given on the command line or to the module, makes the map
+    that giving none makes."""
+    sculpt = sculpts(CUBE)
+    specs = dispex.option_names()
+    given = [arg for spec in specs.values() if spec["default"] and spec["kind"] != "bool"
+             for arg in (spec["flag"], spec["default"])]
+    assert "--oversample" in given and "--fixed-resolution" in given
+    run_cli("extract", CUBE, sculpt, "-o", tmp_path / "none.ptx", "--quiet")
+    run_cli("extract", CUBE, sculpt, "-o", tmp_path / "given.ptx", "--quiet", *given)
+    defaults = {name: spec["default"] == "true" if spec["kind"] == "bool" else spec["default"]
+                for name, spec in specs.items() if spec["default"]}
+    dispex.extract(CUBE, sculpt, tmp_path / "module.ptx", **defaults)
+    expected = (tmp_path / "none.ptx").read_bytes()
+    assert (tmp_path / "given.ptx").read_bytes() == expected
+    assert (tmp_path / "module.ptx").read_bytes() == expected
 
 
 # A value for each option other than its default, and the command line's arguments for it.

@@ -4,10 +4,7 @@
 #include <cstdio>
 #include <string>
 
-#include "dispex/extract.h"
-#include "dispex/ptex.h"
-#include "dispex/verify.h"
-#include "dispex/version.h"
+#include "dispex/dispex.h"  // the front door alone
 
 namespace {
 int Fail(const std::string& what) {
