@@ -1,13 +1,18 @@
 #include "extract/edge_matching.h"
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include <algorithm>
 #include <array>
 #include <map>
+#include <numeric>
 #include <span>
 #include <utility>
 #include <vector>
 
 #include "dispex/ptex_sampler.h"
+#include "extract/parallel_errors.h"
+#include "extract/vector_faces.h"
 
 namespace dispex::extract {
 
@@ -24,34 +29,63 @@ bool Discontinuous(const FaceStats& stats) {
   return stats.all_missed || stats.filled > 0 || stats.hits_opposed > 0;
 }
 
-// The kept texels into the map the rounds measure (ReturnTexels moves them back).
-EdgeRoundsMap TakeView(const ExtractInputs& inputs, ProcessedFaces& processed) {
-  EdgeRoundsMap view;
-  view.faces = inputs.faces;
-  const std::size_t n = view.faces.size();
-  view.components.resize(1);
-  std::vector<std::vector<float>>& texels = view.components[0];
-  texels.resize(n);
-  view.skip_faces.resize(n);
-  for (std::size_t f = 0; f < n; ++f) {
-    KeptFace& kept = processed.kept[f];
-    view.skip_faces[f] = !kept.kept || inputs.surface.is_hole(PtexFaceId(static_cast<int>(f))) ||
-                         Discontinuous(processed.stats[f]);
-    if (!kept.kept) {
-      texels[f] = {0.0f};
-      continue;
-    }
-    view.faces[f].ulog2 = kept.ulog2;
-    view.faces[f].vlog2 = kept.vlog2;
-    texels[f].swap(kept.texels);
-  }
-  return view;
+// Whether face f's components are its kept channels, moved into the map the rounds measure
+// and back (a scalar map, an object-space vector map, a hole); otherwise they are D turned
+// into object space from them (VectorObjectComponents), and the texels stay where they are.
+bool ComponentsAreChannels(const ExtractInputs& inputs, const ExtractSettings& settings,
+                           std::size_t f) {
+  return !settings.vector || *settings.vector == VectorSpace::kObject ||
+         inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
 }
 
-void ReturnTexels(EdgeRoundsMap& view, ProcessedFaces& processed) {
-  std::vector<std::vector<float>>& texels = view.components[0];
-  for (std::size_t f = 0; f < texels.size(); ++f) {
-    if (processed.kept[f].kept) processed.kept[f].texels.swap(texels[f]);
+// Face f's kept texels into the map the rounds measure (ReturnFace gives them back).
+Status TakeFace(std::size_t f, const ExtractInputs& inputs, const ExtractSettings& settings,
+                ProcessedFaces& processed, FaceScratch& w, EdgeRoundsMap& view) {
+  KeptFace& kept = processed.kept[f];
+  const PtexFaceId face(static_cast<int>(f));
+  view.skip_faces[f] =
+      !kept.kept || inputs.surface.is_hole(face) || Discontinuous(processed.stats[f]);
+  if (!kept.kept) {  // missed entirely: not measured
+    for (auto& component : view.components) component[f] = {0.0f};
+    return Status::Ok();
+  }
+  view.faces[f].ulog2 = kept.ulog2;
+  view.faces[f].vlog2 = kept.vlog2;
+  const std::size_t channels = view.components.size();
+  if (!ComponentsAreChannels(inputs, settings, f)) {
+    return VectorObjectComponents(
+        face, *settings.vector, kept.ulog2, kept.vlog2, kept.texels, w,
+        {&view.components[0][f], &view.components[1][f], &view.components[2][f]});
+  }
+  if (channels == 1) {
+    view.components[0][f].swap(kept.texels);
+    return Status::Ok();
+  }
+  const std::size_t count = kept.texels.size() / channels;
+  for (std::size_t c = 0; c < channels; ++c) {
+    std::vector<float>& component = view.components[c][f];
+    component.resize(count);
+    for (std::size_t i = 0; i < count; ++i) component[i] = kept.texels[channels * i + c];
+  }
+  std::vector<float>().swap(kept.texels);  // the map is held once
+  return Status::Ok();
+}
+
+void ReturnFace(std::size_t f, const ExtractInputs& inputs, const ExtractSettings& settings,
+                ProcessedFaces& processed, EdgeRoundsMap& view) {
+  KeptFace& kept = processed.kept[f];
+  if (!kept.kept || !ComponentsAreChannels(inputs, settings, f)) return;
+  const std::size_t channels = view.components.size();
+  if (channels == 1) {
+    kept.texels.swap(view.components[0][f]);
+    return;
+  }
+  const std::size_t count = view.components[0][f].size();
+  kept.texels.resize(channels * count);
+  for (std::size_t c = 0; c < channels; ++c) {
+    std::vector<float>& component = view.components[c][f];
+    for (std::size_t i = 0; i < count; ++i) kept.texels[channels * i + c] = component[i];
+    std::vector<float>().swap(component);
   }
 }
 
@@ -75,7 +109,9 @@ std::int64_t Texels(const ProcessedFaces& processed, const ExtractInputs& inputs
   for (std::size_t f = 0; f < processed.kept.size(); ++f) {
     if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
     const KeptFace& kept = processed.kept[f];
-    total += kept.kept ? static_cast<std::int64_t>(kept.texels.size()) : 1;
+    total += kept.kept ? static_cast<std::int64_t>(kept.texels.size() /
+                                                   static_cast<std::size_t>(processed.channels))
+                       : 1;
   }
   return total;
 }
@@ -180,19 +216,35 @@ Status RaiseEdgeResolutions(const ExtractInputs& inputs, const ExtractSettings& 
 Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, ProcessedFaces& faces,
                   ExtractReport& report) {
   report.texels_before_edges = Texels(faces, inputs);
-  EdgeRoundsMap view = TakeView(inputs, faces);
+  const std::size_t n = faces.kept.size();
+  EdgeRoundsMap view;
+  view.faces = inputs.faces;
+  view.components.assign(static_cast<std::size_t>(faces.channels),
+                         std::vector<std::vector<float>>(n));
+  view.skip_faces.resize(n);
+  tbb::enumerable_thread_specific<FaceScratch> scratches(
+      [&] { return FaceScratch(inputs.surface); });
+  auto take = [&](std::span<const int> which) {
+    return ForEachFace(
+        static_cast<int>(which.size()), [&](int k) { return which[static_cast<std::size_t>(k)]; },
+        scratches, nullptr,
+        [&](PtexFaceId face, FaceScratch& w) {
+          return TakeFace(static_cast<std::size_t>(face.value), inputs, settings, faces, w, view);
+        });
+  };
+  std::vector<int> all(n);
+  std::iota(all.begin(), all.end(), 0);
+  DISPEX_RETURN_IF_ERROR(take(all));
   const Status raised = RaiseEdgeResolutions(
       inputs, settings, view,
-      [&](std::span<const int> redo, std::span<const std::array<int, 2>> least,
-          EdgeRoundsMap& map) {
-        ReturnTexels(map, faces);
+      [&](std::span<const int> redo, std::span<const std::array<int, 2>> least, EdgeRoundsMap&) {
+        for (int f : redo) ReturnFace(static_cast<std::size_t>(f), inputs, settings, faces, view);
         DISPEX_RETURN_IF_ERROR(ReprocessFaces(inputs, settings, redo, least, faces));
-        map = TakeView(inputs, faces);
-        return Status::Ok();
+        return take(redo);
       },
       report);
   DISPEX_RETURN_IF_ERROR(raised);
-  ReturnTexels(view, faces);
+  for (std::size_t f = 0; f < n; ++f) ReturnFace(f, inputs, settings, faces, view);
   return Status::Ok();
 }
 

@@ -44,8 +44,10 @@ using RedoFaces =
 Status RaiseEdgeResolutions(const ExtractInputs& inputs, const ExtractSettings& settings,
                             EdgeRoundsMap& map, const RedoFaces& redo, ExtractReport& report);
 
-// RaiseEdgeResolutions for a scalar map's kept faces, raised faces run again by ProcessFace;
-// faces whose data may jump (ListDiscontinuousFaces) are not held.
+// RaiseEdgeResolutions for the kept faces (ProcessFaces), raised faces run again by
+// ReprocessFaces. A vector map's edges are measured on D in object space (its channels, or
+// VectorObjectComponents for tangent and parametric maps); faces whose data may jump
+// (ListDiscontinuousFaces) are not held.
 Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, ProcessedFaces& faces,
                   ExtractReport& report);
 

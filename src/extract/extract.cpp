@@ -12,6 +12,7 @@
 #include "core/system.h"
 #include "dispex/cancel.h"
 #include "dispex/shapes.h"
+#include "dispex/vector_space.h"
 #include "dispex/version.h"
 #include "extract/edge_matching.h"
 #include "extract/extract_inputs.h"
@@ -37,11 +38,18 @@ namespace dispex::extract {
 
 namespace {
 
-// A temporary file beside the target until CommitMap.
+// A temporary file beside the target until CommitMap. A vector map's cross-face filter turns
+// a tangent or parametric vector into the neighbour's frame; an object-space one is as is.
 StatusOr<PtexWriter> CreateMap(const ExtractOptions& options, const ExtractInputs& inputs) {
   PtexWriterOptions writer_options;
   writer_options.data_type = options.data_type;
   writer_options.compression_level = options.compression_level;
+  if (options.vector) {
+    writer_options.num_channels = 3;
+    writer_options.edge_filter = *options.vector == VectorSpace::kObject
+                                     ? PtexEdgeFilterMode::kNone
+                                     : PtexEdgeFilterMode::kTangentVector;
+  }
   return PtexWriter::Create(options.output_path, writer_options, inputs.surface.num_ptex_faces());
 }
 
@@ -179,16 +187,35 @@ std::vector<std::uint8_t> ShardFaces(const ExtractOptions& options, const Extrac
   return in_shard;
 }
 
-// A sculpt moved, scaled or turned against its base as a whole is refused (input_checks.h).
+// A sculpt moved, scaled or turned against its base as a whole is refused (input_checks.h):
+// measured through the correspondence where the map reads one, else by the whole sculpt's BVH.
 Status CheckPlacementIfAsked(const ExtractOptions& options, const ExtractInputs& inputs,
                              const ExtractSettings& settings, const ExtractReport& report) {
-  const bool mapping = inputs.mapping != nullptr;
-  if (!options.check_inputs || (!mapping && inputs.tracer == nullptr)) return Status::Ok();
-  std::optional<MappingGrids> grids;
-  if (mapping) grids.emplace(*inputs.mapping);
-  DISPEX_ASSIGN_OR_RETURN(PlacementFit fit,
-                          MeasurePlacement(inputs, mapping ? &*grids : nullptr, &settings));
+  if (!options.check_inputs) return Status::Ok();
+  std::unique_ptr<GridSource> grids;
+  if (inputs.correspondence) {
+    grids = std::make_unique<CorrespondenceGrids>(*inputs.correspondence, inputs.faces);
+  } else if (inputs.mapping) {
+    grids = std::make_unique<MappingGrids>(*inputs.mapping);
+  } else if (inputs.tracer == nullptr) {
+    return Status::Ok();
+  }
+  DISPEX_ASSIGN_OR_RETURN(PlacementFit fit, MeasurePlacement(inputs, grids.get(), &settings));
   return CheckPlacement(fit, report.base_diagonal, inputs.sculpt.source);
+}
+
+// What each face is made from (face_keys.h; a vector map's: VectorFaceKeys).
+FaceKeys KeyFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
+                  ExtractReport& report) {
+  Stopwatch clock;
+  FaceKeys keys;
+  if (settings.vector) {
+    keys.keys = VectorFaceKeys(inputs, settings);
+  } else {
+    keys = ComputeFaceKeys(inputs, settings);
+  }
+  report.t_keys = clock.seconds();
+  return keys;
 }
 
 // A shard's part: its faces' first pass and its record.
@@ -222,6 +249,9 @@ Status WriteMap(const ExtractOptions& options, ExtractInputs& inputs,
   DISPEX_RETURN_IF_ERROR(FillMissedFaces(options, inputs, faces, writer, report));
   if (settings.watertight != WatertightEdges::kOff) {
     DISPEX_RETURN_IF_ERROR(MatchEdges(inputs, settings, faces, report));
+    for (std::size_t f = 0; f < faces.redone.size(); ++f) {
+      report.faces_copied_redone += faces.copied[f] && faces.redone[f];
+    }
     if (inputs.widened) {
       report.tracer += inputs.traced.empty()
                            ? std::string("; then the whole sculpt, for faces the edges raised")
@@ -298,34 +328,30 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   DISPEX_ASSIGN_OR_RETURN(PreviousMap previous, PlanOutput(options, inputs, parts, report));
   if (plan.output == ExtractPlan::Output::kUpToDate)
     return Finished(std::move(report), total_clock);
-  if (options.vector) {
-    return ExtractVectorShape(options, std::move(inputs), std::move(report), total_clock,
-                              previous.usable() ? &previous : nullptr);
-  }
-  // Through the subdivision correspondence no BVH is built (extract_mapping.h). The automatic
-  // search distance is estimated with rays over the whole surface; a given one lets an
-  // incremental run, a merge or a shard of ShardSculpt::kPart trace only the sculpt within
-  // reach of the faces it extracts.
-  DISPEX_RETURN_IF_ERROR(ChooseMethod(options, inputs, report));
+  // Through the subdivision correspondence no BVH is built (extract_mapping.h; a vector map
+  // reads the sculpt through it only, vector_faces.h). Rays estimate the automatic search
+  // distance over the whole surface; a given one lets an incremental run, a merge or a shard
+  // of ShardSculpt::kPart trace only the sculpt within reach of the faces it extracts.
+  DISPEX_RETURN_IF_ERROR(options.vector ? MatchVectorSculpt(options, inputs, report)
+                                        : ChooseMethod(options, inputs, report));
   plan.method = report.method;
   const bool shard = options.shard_count > 0;
-  const bool within_reach = inputs.mapping == nullptr &&
+  const bool traced = !options.vector && inputs.mapping == nullptr;
+  const bool within_reach = traced &&
                             options.search_distance.kind != SearchDistanceSpec::Kind::kAuto &&
                             ((previous.usable() && (options.incremental || parts != nullptr)) ||
                              (shard && options.shard_sculpt == ShardSculpt::kPart));
-  plan.tracer = inputs.mapping != nullptr ? ExtractPlan::Tracer::kNone
-                : within_reach            ? ExtractPlan::Tracer::kWithinReach
-                                          : ExtractPlan::Tracer::kWholeSculpt;
+  plan.tracer = !traced        ? ExtractPlan::Tracer::kNone
+                : within_reach ? ExtractPlan::Tracer::kWithinReach
+                               : ExtractPlan::Tracer::kWholeSculpt;
   if (plan.tracer == ExtractPlan::Tracer::kNone) SetTracerOptions(options, inputs);
   if (plan.tracer == ExtractPlan::Tracer::kWholeSculpt) {
     DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
   }
   DISPEX_ASSIGN_OR_RETURN(ExtractSettings settings, ResolveSettings(options, inputs, report));
   DISPEX_RETURN_IF_ERROR(CheckPlacementIfAsked(options, inputs, settings, report));
-  Stopwatch keys_clock;
-  const FaceKeys face_keys = ComputeFaceKeys(inputs, settings);
+  const FaceKeys face_keys = KeyFaces(inputs, settings, report);
   inputs.face_keys = &face_keys;
-  report.t_keys = keys_clock.seconds();
   // A shard runs its faces' first pass only, no stage that crosses faces (the merge runs them).
   const std::vector<std::uint8_t> in_shard =
       ShardFaces(options, inputs, settings, face_keys, report);

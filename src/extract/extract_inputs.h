@@ -7,6 +7,7 @@
 #include <span>
 #include <vector>
 
+#include "dispex/correspondence.h"
 #include "dispex/extract.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
@@ -40,8 +41,11 @@ struct ExtractInputs {
   // With `mapping`: the sculpt's vertex displacements are interpolated (vertex_displacements.h)
   // instead of traced; no tracer, no search distance.
   bool interpolate = false;
+  // A vector map's sculpt as the base refined (MatchVectorSculpt, vector_faces.h): every face
+  // reads the sculpt through it.
+  std::unique_ptr<SculptCorrespondence> correspondence;
   // With `interpolate`: the grids the displacements are read from, over `mapping` or, for
-  // vector maps, the correspondence the run holds.
+  // vector maps, `correspondence`.
   std::unique_ptr<GridSource> grids;
   const FaceKeys* face_keys = nullptr;
   double fallback_bvh_seconds = 0;  // building those tracers

@@ -16,8 +16,8 @@
 namespace dispex::extract {
 
 // Counts the faces that run, those copied from `previous` (when usable), another shard's
-// (outside `in_shard`, when not empty) and the holes: as ProcessFaces and ProcessVectorFaces
-// decide them from the same keys. Returns which faces run (1), per Ptex face.
+// (outside `in_shard`, when not empty) and the holes: as ProcessFaces decides them
+// from the same keys. Returns which faces run (1), per Ptex face.
 std::vector<std::uint8_t> PlanFaces(ExtractPlan& plan, const ExtractInputs& inputs,
                                     std::span<const Hash128> keys, const PreviousMap* previous,
                                     std::span<const std::uint8_t> in_shard);

@@ -122,6 +122,7 @@ StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
   settings.retry_query.distance = static_cast<float>(report.retry_search_distance);
   settings.mapping = inputs.mapping != nullptr;
   settings.interpolate = inputs.interpolate;
+  settings.vector = options.vector;
   settings.spectral.rule = options.resolution_rule;
   settings.spectral.tolerance = report.tolerance;
   settings.spectral.nonzero_threshold = options.nonzero_threshold;

@@ -2,6 +2,8 @@
 // what every face is asked for.
 #pragma once
 
+#include <optional>
+
 #include "dispex/extract.h"
 #include "dispex/ptex.h"
 #include "dispex/spectral.h"
@@ -31,6 +33,10 @@ struct ExtractSettings {
   bool mapping = false;  // samples traced through the subdivision correspondence
   // With `mapping`: the sculpt's vertex displacements interpolated instead (ExtractInputs).
   bool interpolate = false;
+  // A vector map's space: every face reads the sculpt through the correspondence
+  // (ExtractInputs::correspondence), 3 channels; none: a scalar map, 1 channel.
+  std::optional<VectorSpace> vector;
+  int channels() const { return vector ? 3 : 1; }
 };
 
 // Tolerance (from the sculpt's median edge length unless given), search distance (estimated

@@ -6,6 +6,7 @@
 #include <span>
 
 #include "core/system.h"
+#include "extract/vector_faces.h"
 
 namespace dispex::extract {
 
@@ -160,6 +161,7 @@ std::int32_t TraceRays(const Tracer& tracer, const ExtractSettings& settings,
 StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
                                  const ExtractSettings& settings, FaceScratch& w,
                                  std::array<int, 2> least_log2) {
+  if (settings.vector) return ProcessVectorFace(face, inputs, settings, w, least_log2);
   FaceResult result;
   if (inputs.surface.is_hole(face)) return result;
   FaceStats& r = result.stats;
@@ -224,12 +226,17 @@ StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
   SpectralOptions spectral = settings.spectral;
   spectral.min_ulog2 = least_log2[0];
   spectral.min_vlog2 = least_log2[1];
-  DISPEX_ASSIGN_OR_RETURN(result.analysed, w.analyzer.Analyze(w.values, n, n, spectral));
+  DISPEX_ASSIGN_OR_RETURN(SpectralFace analysed, w.analyzer.Analyze(w.values, n, n, spectral));
   w.cpu_spectral += step.seconds();
-  r.spectral = result.analysed.stats;
-  r.ulog2 = static_cast<std::int8_t>(result.analysed.ulog2);
-  r.vlog2 = static_cast<std::int8_t>(result.analysed.vlog2);
+  r.spectral = analysed.stats;
+  r.ulog2 = static_cast<std::int8_t>(analysed.ulog2);
+  r.vlog2 = static_cast<std::int8_t>(analysed.vlog2);
   result.kind = FaceResult::Kind::kAnalysed;
+  result.ulog2 = analysed.ulog2;
+  result.vlog2 = analysed.vlog2;
+  w.constant[0] = analysed.constant_value;
+  result.texels =
+      analysed.constant ? std::span<const float>(w.constant.data(), 1) : analysed.texels;
   return result;
 }
 

@@ -2,8 +2,9 @@
 // -> rays along +-n (and a longer second search for the samples that missed) -> signed
 // distances -> holes -> the DCT resolution; interpolated (ExtractSettings::interpolate), the
 // signed distances are the sculpt's vertex heights over the limit surface interpolated at the
-// texel centres instead (vertex_displacements.h). ProcessFace can be run for any face, any number
-// of times, on any thread that has its own FaceScratch; it does not write the map.
+// texel centres instead (vertex_displacements.h); a vector map's face reads D through the
+// correspondence (vector_faces.h). ProcessFace can be run for any face, any number of times,
+// on any thread that has its own FaceScratch; it does not write the map.
 #pragma once
 
 #include <array>
@@ -30,8 +31,10 @@ struct FaceStats {
   std::int32_t hits_negative = 0;
   std::int32_t hits_opposed = 0;
   bool all_missed = false;  // no value at all: filled from the neighbours later
-  float min = 0, max = 0;
-  double sum_squares = 0;
+  float min = 0, max = 0;   // of the displacement (a vector map: of D . N)
+  double sum_squares = 0;   // of the displacement (a vector map: of |D|)
+  // A vector map's: the largest |D - (D . N) N| and |D|.
+  double tangential_max = 0, length_max = 0;
   SpectralFaceStats spectral;
   std::int8_t ulog2 = 0, vlog2 = 0;
   std::int64_t rays = 0;              // cast for this face
@@ -51,8 +54,11 @@ struct FaceResult {
   std::int32_t fallback_samples = 0;
   bool needs_tracer = false;
   FaceStats stats;
-  EdgeMeans edge_means;   // what a neighbour that missed entirely is filled from
-  SpectralFace analysed;  // its texels live in the scratch until its next ProcessFace
+  EdgeMeans edge_means;  // what a neighbour that missed entirely is filled from (scalar maps)
+  // kAnalysed: the face at 2^ulog2 x 2^vlog2 texels of the map's channels, interleaved (one
+  // texel: a constant face). They live in the scratch until its next ProcessFace.
+  int ulog2 = 0, vlog2 = 0;
+  std::span<const float> texels;
 };
 
 // Per-thread buffers and evaluators, reused across faces, and the thread's counters.
@@ -60,7 +66,11 @@ struct FaceScratch {
   explicit FaceScratch(const LimitSurface& surface) : evaluator(surface) {}
   LimitEvaluator evaluator;
   SpectralAnalyzer analyzer;
+  SpectralVectorAnalyzer vector_analyzer;
+  std::array<float, 3> constant{};  // a constant face's texel
   std::vector<float> positions, normals, t, values;
+  // Vector maps: the limit frame's derivatives, D in the map's space, the texels as stored.
+  std::vector<float> du, dv, channels, vector_texels;
   std::vector<std::uint8_t> flags, valid;
   std::vector<Float3> retry_origins, retry_normals;  // missed samples, for the longer search
   std::vector<float> retry_t;
@@ -86,6 +96,8 @@ std::int32_t TraceRays(const Tracer& tracer, const ExtractSettings& settings,
                        std::span<const Float3> origins, std::span<const Float3> normals,
                        std::span<float> t, std::span<std::uint8_t> flags, FaceScratch& w);
 
+// One face of the map: a scalar map's (below), or a vector map's (settings.vector:
+// ProcessVectorFace, vector_faces.h).
 // Fails on an evaluation or analysis error, or on a miss under HolePolicy::kFail.
 // `least_log2`: the least resolution (log2 of u and v texels) the face may get, e.g. for its
 // neighbours to meet it without a step (SpectralOptions::min_ulog2); beyond the planned

@@ -23,8 +23,11 @@ void SumFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
     report.holes_filled += r.filled;
     report.faces_with_misses += r.misses > 0;
     report.hits_negative += r.hits_negative;
-    report.hits_positive += r.samples - r.misses - r.hits_negative;
+    // A vector map's samples are read through the correspondence: no rays, no hits.
+    if (!settings.vector) report.hits_positive += r.samples - r.misses - r.hits_negative;
     report.hits_opposed += r.hits_opposed;
+    report.vector_length_max = std::max(report.vector_length_max, r.length_max);
+    report.vector_tangential_max = std::max(report.vector_tangential_max, r.tangential_max);
     if (r.all_missed) {
       SpectralFaceStats constant;
       constant.texels_before = r.samples;

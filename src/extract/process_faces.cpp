@@ -16,21 +16,29 @@ namespace dispex::extract {
 
 namespace {
 
+constexpr std::array<float, 3> kZeros{};
+
+// A face of `texels` (one texel: constant) at 2^ulog2 x 2^vlog2.
+Status WriteTexels(PtexWriter& writer, const ExtractInputs& inputs, PtexFaceId face, int ulog2,
+                   int vlog2, std::span<const float> texels) {
+  const PtexFaceInfo info = FaceInfo(inputs, face, ulog2, vlog2);
+  return ulog2 == 0 && vlog2 == 0 ? writer.SetConstantFace(face, info, texels)
+                                  : writer.SetFace(face, info, texels);
+}
+
 // A face that missed entirely is written later, once its neighbours are known.
 Status WriteFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFaceId face,
-                 const FaceResult& result) {
+                 const FaceResult& result, int channels) {
   switch (result.kind) {
     case FaceResult::Kind::kHole:
-      return WriteConstantFace(writer, inputs, face, 0.0f);
+      return WriteTexels(writer, inputs, face, 0, 0,
+                         std::span(kZeros).first(static_cast<std::size_t>(channels)));
     case FaceResult::Kind::kAllMissed:
       return Status::Ok();
     case FaceResult::Kind::kAnalysed:
       break;
   }
-  const SpectralFace& analysed = result.analysed;
-  const PtexFaceInfo info = FaceInfo(inputs, face, analysed.ulog2, analysed.vlog2);
-  return analysed.constant ? writer.SetConstantFace(face, info, {&analysed.constant_value, 1})
-                           : writer.SetFace(face, info, analysed.texels);
+  return WriteTexels(writer, inputs, face, result.ulog2, result.vlog2, result.texels);
 }
 
 void AddCpuTimes(const tbb::enumerable_thread_specific<FaceScratch>& scratches,
@@ -45,18 +53,18 @@ void AddCpuTimes(const tbb::enumerable_thread_specific<FaceScratch>& scratches,
 
 // Kept texels hold what the map will store, so that the edges are measured on it and a face
 // read back from the map is kept exactly as it was.
-KeptFace Keep(const FaceResult& result, PtexDataType type) {
+KeptFace Keep(const FaceResult& result, PtexDataType type, int channels) {
   KeptFace kept;
   switch (result.kind) {
     case FaceResult::Kind::kAllMissed:
       return kept;
     case FaceResult::Kind::kHole:
-      kept.texels = {0.0f};
+      kept.texels.assign(static_cast<std::size_t>(channels), 0.0f);
       break;
     case FaceResult::Kind::kAnalysed:
-      kept.ulog2 = static_cast<std::int8_t>(result.analysed.ulog2);
-      kept.vlog2 = static_cast<std::int8_t>(result.analysed.vlog2);
-      kept.texels.assign(result.analysed.texels.begin(), result.analysed.texels.end());
+      kept.ulog2 = static_cast<std::int8_t>(result.ulog2);
+      kept.vlog2 = static_cast<std::int8_t>(result.vlog2);
+      kept.texels.assign(result.texels.begin(), result.texels.end());
       RoundToDataType(type, kept.texels);
       break;
   }
@@ -89,11 +97,14 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
                                       std::span<const std::uint8_t> only) {
   const int num_faces = inputs.surface.num_ptex_faces();
   const bool keep = settings.watertight != WatertightEdges::kOff;
+  const int channels = settings.channels();
   ProcessedFaces out;
+  out.channels = channels;
   out.stats.resize(static_cast<std::size_t>(num_faces));
   out.edge_means.resize(static_cast<std::size_t>(num_faces));
   if (keep) out.kept.resize(static_cast<std::size_t>(num_faces));
-  std::vector<std::uint8_t> copied(static_cast<std::size_t>(num_faces), 0);
+  std::vector<std::uint8_t>& copied = out.copied;
+  copied.assign(static_cast<std::size_t>(num_faces), 0);
   std::vector<std::uint8_t> deferred(static_cast<std::size_t>(num_faces), 0);
   std::vector<std::int32_t> fallback(static_cast<std::size_t>(num_faces), 0);
   tbb::enumerable_thread_specific<FaceScratch> scratches(
@@ -114,9 +125,7 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
       out.kept[f] = std::move(kept);
       return Status::Ok();
     }
-    const PtexFaceInfo info = FaceInfo(inputs, face, kept.ulog2, kept.vlog2);
-    return kept.texels.size() == 1 ? writer.SetConstantFace(face, info, {kept.texels.data(), 1})
-                                   : writer.SetFace(face, info, kept.texels);
+    return WriteTexels(writer, inputs, face, kept.ulog2, kept.vlog2, kept.texels);
   };
   auto process = [&](PtexFaceId face, FaceScratch& w) -> Status {
     const auto f = static_cast<std::size_t>(face.value);
@@ -133,11 +142,11 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
     out.stats[f] = result.stats;
     out.edge_means[f] = result.edge_means;
     if (keep) {
-      out.kept[f] = Keep(result, settings.data_type);
+      out.kept[f] = Keep(result, settings.data_type, channels);
       return Status::Ok();
     }
     ThreadCpuStopwatch step;
-    Status written = WriteFace(writer, inputs, face, result);
+    Status written = WriteFace(writer, inputs, face, result, channels);
     if (result.kind == FaceResult::Kind::kAnalysed) w.cpu_write += step.seconds();
     return written;
   };
@@ -192,7 +201,7 @@ Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
     }
     fallback[f] = result.fallback_samples;
     processed.stats[f] = result.stats;
-    processed.kept[f] = Keep(result, settings.data_type);
+    processed.kept[f] = Keep(result, settings.data_type, processed.channels);
     return Status::Ok();
   };
   DISPEX_RETURN_IF_ERROR(ForEachFace(
@@ -210,8 +219,10 @@ Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
   }
   WorkerTotals extra;
   AddCpuTimes(scratches, extra);
+  processed.redone.resize(num_faces, 0);
   for (int f : faces) {
     const auto i = static_cast<std::size_t>(f);
+    processed.redone[i] = 1;
     processed.workers.rays_cast += static_cast<std::uint64_t>(processed.stats[i].rays);
     processed.fallback_samples += fallback[i];
     processed.fallback_faces += fallback[i] > 0;
@@ -229,10 +240,7 @@ Status WriteKeptFaces(PtexWriter& writer, const ExtractInputs& inputs,
   tbb::parallel_for(0, num_faces, [&](int f) {
     const KeptFace& kept = processed.kept[static_cast<std::size_t>(f)];
     if (!kept.kept || error.failed()) return;
-    const PtexFaceInfo info = FaceInfo(inputs, PtexFaceId(f), kept.ulog2, kept.vlog2);
-    Status s = kept.texels.size() == 1
-                   ? writer.SetConstantFace(PtexFaceId(f), info, {kept.texels.data(), 1})
-                   : writer.SetFace(PtexFaceId(f), info, kept.texels);
+    Status s = WriteTexels(writer, inputs, PtexFaceId(f), kept.ulog2, kept.vlog2, kept.texels);
     if (!s.ok()) error.Record(f, s);
   });
   return error.failed() ? error.status() : Status::Ok();

@@ -33,12 +33,15 @@ struct KeptFace {
 void RoundToDataType(PtexDataType type, std::span<float> texels);
 
 struct ProcessedFaces {
+  int channels = 1;                   // of the map
   std::vector<FaceStats> stats;       // per Ptex face
   std::vector<FaceStats> first_pass;  // per Ptex face, before edges raised any (the map keeps it)
   std::vector<EdgeMeans> edge_means;  // per Ptex face
   std::vector<KeptFace> kept;         // per Ptex face, when settings.watertight is on
   WorkerTotals workers;
-  std::int64_t faces_copied = 0;  // taken from the previous map
+  std::vector<std::uint8_t> copied;  // per Ptex face: its first pass taken from the previous map
+  std::vector<std::uint8_t> redone;  // per Ptex face: extracted again by the edge pass
+  std::int64_t faces_copied = 0;     // taken from the previous map
   // Through the mapping: samples it left undecided and the faces they were in, over every face
   // extracted (the edge pass's too).
   std::int64_t fallback_samples = 0, fallback_faces = 0;

@@ -339,9 +339,9 @@ Status WriteTiles(const ExtractOptions& options, const UvRaster& raster, int cha
 }  // namespace
 
 Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
-                   const ExtractSettings& settings, ExtractReport& report,
-                   const SculptCorrespondence* correspondence) {
+                   const ExtractSettings& settings, ExtractReport& report) {
   Stopwatch clock;
+  const SculptCorrespondence* correspondence = inputs.correspondence.get();
   const bool vector = options.vector.has_value();
   DISPEX_CHECK(!vector || (*options.vector == VectorSpace::kObject && correspondence != nullptr));
   const int channels = vector ? 3 : 1;

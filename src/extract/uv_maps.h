@@ -16,10 +16,9 @@ namespace dispex::extract {
 // the run's tracer holds only part of it (scalar maps traced by rays). Interpolated
 // (ExtractSettings::interpolate) each texel is the sculpt's vertex displacements interpolated
 // where it lies, as in the Ptex map. A vector map (ExtractOptions::vector, object space)
-// passes the correspondence its Ptex map was read through. Fills the report's
+// reads the correspondence its Ptex map was read through. Fills the report's
 // uv_* fields and warnings.
 Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
-                   const ExtractSettings& settings, ExtractReport& report,
-                   const SculptCorrespondence* correspondence = nullptr);
+                   const ExtractSettings& settings, ExtractReport& report);
 
 }  // namespace dispex::extract

@@ -25,9 +25,15 @@ void Fields(Io& io, FaceRecord& r) {
   for (float& m : r.edge_means.mean) io(m);
 }
 
+// A vector map's record: the fields a vector face fills.
+struct VectorRecord {
+  FaceStats stats;
+};
+
 template <class Io>
-void Fields(Io& io, VectorFaceStats& s) {
-  io(s.samples), io(s.normal_min), io(s.normal_max), io(s.tangential_max), io(s.length_max);
+void Fields(Io& io, VectorRecord& r) {
+  FaceStats& s = r.stats;
+  io(s.samples), io(s.min), io(s.max), io(s.tangential_max), io(s.length_max);
   io(s.sum_squares);
   Fields(io, s.spectral);
   io(s.ulog2), io(s.vlog2);
@@ -67,7 +73,8 @@ bool Plausible(const FaceRecord& r) {
   const FaceStats& s = r.stats;
   return Plausible(s.spectral, s.samples, s.ulog2, s.vlog2) && s.misses >= 0 && s.rays >= 0;
 }
-bool Plausible(const VectorFaceStats& s) {
+bool Plausible(const VectorRecord& r) {
+  const FaceStats& s = r.stats;
   return Plausible(s.spectral, s.samples, s.ulog2, s.vlog2);
 }
 
@@ -96,10 +103,18 @@ std::optional<std::vector<Record>> Decode(std::span<const std::uint8_t> bytes,
 }  // namespace
 
 std::vector<std::int8_t> EncodeFaceRecords(std::span<const FaceStats> stats,
-                                           std::span<const EdgeMeans> edge_means) {
+                                           std::span<const EdgeMeans> edge_means, int channels) {
   std::vector<std::int8_t> out;
-  out.reserve(stats.size() * RecordSize<FaceRecord>());
   Writer w{out};
+  if (channels == 3) {
+    out.reserve(stats.size() * RecordSize<VectorRecord>());
+    for (const FaceStats& s : stats) {
+      VectorRecord r{s};
+      Fields(w, r);
+    }
+    return out;
+  }
+  out.reserve(stats.size() * RecordSize<FaceRecord>());
   for (std::size_t f = 0; f < stats.size(); ++f) {
     FaceRecord r{stats[f], edge_means[f]};
     Fields(w, r);
@@ -108,21 +123,13 @@ std::vector<std::int8_t> EncodeFaceRecords(std::span<const FaceStats> stats,
 }
 
 std::optional<std::vector<FaceRecord>> DecodeFaceRecords(std::span<const std::uint8_t> bytes,
-                                                         std::size_t num_faces) {
-  return Decode<FaceRecord>(bytes, num_faces);
-}
-
-std::vector<std::int8_t> EncodeVectorFaceRecords(std::span<const VectorFaceStats> stats) {
-  std::vector<std::int8_t> out;
-  out.reserve(stats.size() * RecordSize<VectorFaceStats>());
-  Writer w{out};
-  for (VectorFaceStats s : stats) Fields(w, s);
+                                                         std::size_t num_faces, int channels) {
+  if (channels != 3) return Decode<FaceRecord>(bytes, num_faces);
+  std::optional<std::vector<VectorRecord>> vectors = Decode<VectorRecord>(bytes, num_faces);
+  if (!vectors) return std::nullopt;
+  std::vector<FaceRecord> out(num_faces);
+  for (std::size_t f = 0; f < num_faces; ++f) out[f].stats = (*vectors)[f].stats;
   return out;
-}
-
-std::optional<std::vector<VectorFaceStats>> DecodeVectorFaceRecords(
-    std::span<const std::uint8_t> bytes, std::size_t num_faces) {
-  return Decode<VectorFaceStats>(bytes, num_faces);
 }
 
 std::vector<std::int8_t> EncodeFaceKeys(std::span<const Hash128> keys) {

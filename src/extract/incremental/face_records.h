@@ -22,27 +22,19 @@ struct FaceRecord {
   EdgeMeans edge_means;
 };
 
-// Little-endian, fixed size per face.
+// The meta data key of a map of `channels` channels' records.
+inline const char* FaceRecordsMetaKey(int channels) {
+  return channels == 3 ? kVectorFaceRecordsMetaKey : kFaceRecordsMetaKey;
+}
+
+// Little-endian, fixed size per face. A scalar map's record holds every field of FaceStats
+// and the edge means; a vector map's (3 channels) the fields a vector face fills: samples,
+// min and max (of D . N), tangential_max, length_max, sum_squares, spectral, ulog2, vlog2.
 std::vector<std::int8_t> EncodeFaceRecords(std::span<const FaceStats> stats,
-                                           std::span<const EdgeMeans> edge_means);
+                                           std::span<const EdgeMeans> edge_means, int channels);
 // nullopt when the bytes do not hold `num_faces` records.
 std::optional<std::vector<FaceRecord>> DecodeFaceRecords(std::span<const std::uint8_t> bytes,
-                                                         std::size_t num_faces);
-
-// What one face of a vector map contributes to the report.
-struct VectorFaceStats {
-  std::int64_t samples = 0;
-  float normal_min = 0, normal_max = 0;  // D . N
-  double tangential_max = 0;             // |D - (D . N) N|
-  double length_max = 0;                 // |D|
-  double sum_squares = 0;                // of |D|
-  SpectralFaceStats spectral;
-  std::int8_t ulog2 = 0, vlog2 = 0;
-};
-
-std::vector<std::int8_t> EncodeVectorFaceRecords(std::span<const VectorFaceStats> stats);
-std::optional<std::vector<VectorFaceStats>> DecodeVectorFaceRecords(
-    std::span<const std::uint8_t> bytes, std::size_t num_faces);
+                                                         std::size_t num_faces, int channels);
 
 std::vector<std::int8_t> EncodeFaceKeys(std::span<const Hash128> keys);
 std::optional<std::vector<Hash128>> DecodeFaceKeys(std::span<const std::uint8_t> bytes,

@@ -25,10 +25,10 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces, bo
     return ignore(fmt::format("written by dispex {}, not {}", version->AsString(), Version()));
   }
   const PtexMetaItem* keys = file->FindMetaData(kFaceKeysMetaKey);
-  const PtexMetaItem* records =
-      file->FindMetaData(vector ? kVectorFaceRecordsMetaKey : kFaceRecordsMetaKey);
+  const int channels = vector ? 3 : 1;
+  const PtexMetaItem* records = file->FindMetaData(FaceRecordsMetaKey(channels));
   if (keys == nullptr || records == nullptr) return ignore("has no face keys");
-  if (file->header().num_channels != (vector ? 3 : 1) ||
+  if (file->header().num_channels != channels ||
       (file->header().data_type != PtexDataType::kFloat &&
        file->header().data_type != PtexDataType::kHalf)) {
     return ignore(vector ? "is not a three-channel float or half map"
@@ -38,12 +38,10 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces, bo
     return ignore(fmt::format("has {} faces, the base now {}", file->num_faces(), num_faces));
   }
   auto decoded_keys = DecodeFaceKeys(keys->bytes, num_faces);
-  auto scalar = vector ? std::nullopt : DecodeFaceRecords(records->bytes, num_faces);
-  auto vectors = vector ? DecodeVectorFaceRecords(records->bytes, num_faces) : std::nullopt;
-  if (!decoded_keys || !(scalar || vectors)) return ignore("has malformed face keys");
+  auto decoded_records = DecodeFaceRecords(records->bytes, num_faces, channels);
+  if (!decoded_keys || !decoded_records) return ignore("has malformed face keys");
   out.keys_ = std::move(*decoded_keys);
-  if (scalar) out.records_ = std::move(*scalar);
-  if (vectors) out.vector_records_ = std::move(*vectors);
+  out.records_ = std::move(*decoded_records);
   out.files_.push_back(std::move(*file));
   return out;
 }
@@ -61,7 +59,7 @@ PreviousMap PreviousMap::FromParts(std::vector<ShardPart> parts,
     const std::vector<Hash128> keys =
         *DecodeFaceKeys(part.file.FindMetaData(kFaceKeysMetaKey)->bytes, num_faces);
     const std::vector<FaceRecord> records =
-        *DecodeFaceRecords(part.file.FindMetaData(kFaceRecordsMetaKey)->bytes, num_faces);
+        *DecodeFaceRecords(part.file.FindMetaData(kFaceRecordsMetaKey)->bytes, num_faces, 1);
     for (auto i = static_cast<std::size_t>(part.info.begin);
          i < static_cast<std::size_t>(part.info.end); ++i) {
       const auto f = static_cast<std::size_t>(order[i]);
@@ -92,10 +90,6 @@ std::string PreviousMap::MetaString(const std::string& key) const {
 bool PreviousMap::Reusable(std::size_t f, const Hash128& key) const {
   if (files_.empty() || keys_[f] != key) return false;
   const PtexFaceInfo& info = file(f).face_info(PtexFaceId(static_cast<int>(f)));
-  if (!vector_records_.empty()) {
-    const VectorFaceStats& s = vector_records_[f];
-    return s.samples == 0 || (info.ulog2 == s.ulog2 && info.vlog2 == s.vlog2);
-  }
   const FaceStats& s = records_[f].stats;
   if (s.all_missed || s.samples == 0) return true;  // written from the neighbours, or a hole
   return info.ulog2 == s.ulog2 && info.vlog2 == s.vlog2;

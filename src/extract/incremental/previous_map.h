@@ -39,8 +39,6 @@ class PreviousMap {
   // watertight edges did not raise its resolution afterwards).
   bool Reusable(std::size_t f, const Hash128& key) const;
   const FaceRecord& record(std::size_t f) const { return records_[f]; }
-  // A vector map's (Open with `vector`).
-  const VectorFaceStats& vector_record(std::size_t f) const { return vector_records_[f]; }
   // The face's texels as KeptFace holds them (one value per channel for a constant face).
   Status ReadTexels(std::size_t f, KeptFace& out) const;
 
@@ -50,8 +48,7 @@ class PreviousMap {
   std::vector<PtexFile> files_;
   std::vector<std::uint32_t> part_of_;  // per face, its file; empty: one file
   std::vector<Hash128> keys_;
-  std::vector<FaceRecord> records_;              // a scalar map's
-  std::vector<VectorFaceStats> vector_records_;  // a vector map's
+  std::vector<FaceRecord> records_;
   std::string notice_;
 };
 

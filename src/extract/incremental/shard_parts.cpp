@@ -112,7 +112,7 @@ StatusOr<ShardPart> ReadShardPart(const std::string& path) {
   if (!valid || info.count < 1 || info.index < 1 || info.index > info.count || info.begin < 0 ||
       info.begin > info.end || info.end > part.file.num_faces() || keys == nullptr ||
       records == nullptr || !DecodeFaceKeys(keys->bytes, num_faces) ||
-      !DecodeFaceRecords(records->bytes, num_faces)) {
+      !DecodeFaceRecords(records->bytes, num_faces, 1)) {
     return Status::Error(fmt::format("{}: malformed shard record", path));
   }
   Status data = part.file.Validate();

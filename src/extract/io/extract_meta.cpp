@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "dispex/vector_space.h"
 #include "extract/incremental/face_records.h"
 
 namespace dispex::extract {
@@ -131,8 +132,17 @@ Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractRep
   if (face_keys.empty()) return Status::Ok();  // a map whose faces are not re-used
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
       kFaceKeysMetaKey, std::span<const std::int8_t>(EncodeFaceKeys(face_keys))));
-  return writer.AddMetaData(
-      kFaceRecordsMetaKey, std::span<const std::int8_t>(EncodeFaceRecords(first_pass, edge_means)));
+  const std::optional<VectorSpace> vector = report.options.vector;
+  const int channels = vector ? 3 : 1;
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
+      FaceRecordsMetaKey(channels),
+      std::span<const std::int8_t>(EncodeFaceRecords(first_pass, edge_means, channels))));
+  if (!vector) return Status::Ok();
+  DISPEX_RETURN_IF_ERROR(
+      writer.AddMetaData(std::string(kVectorSpaceMetaKey), std::string(VectorSpaceName(*vector))));
+  DISPEX_RETURN_IF_ERROR(writer.AddMetaData(std::string(kVectorChannelsMetaKey),
+                                            std::string(VectorSpaceChannels(*vector))));
+  return writer.AddMetaData("dispex:frame", std::string(VectorSpaceFrame(*vector)));
 }
 
 }  // namespace dispex::extract

@@ -28,7 +28,8 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& report);
 // dispex:tolerance, dispex:search_distance, dispex:discontinuous_faces (int32 Ptex face
 // ids whose data may jump at their edges; when there are any), and what an incremental
 // extraction re-uses: dispex:inputs_key, dispex:face_keys (16 bytes per face) and
-// dispex:face_records_v1 (each face's first pass) -- these two only when `face_keys` is not
+// dispex:face_records_v1 (each face's first pass; a vector map's dispex:vector_face_records_v1,
+// then its dispex:vector_space, channel names and frame) -- these only when `face_keys` is not
 // empty.
 Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractReport& report,
                           std::span<const Hash128> face_keys, std::span<const FaceStats> first_pass,

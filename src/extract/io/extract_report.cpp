@@ -23,6 +23,7 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
     j["incremental"] = {{"unchanged", r.unchanged},
                         {"faces_copied", r.faces_copied},
                         {"faces_extracted", r.faces_extracted},
+                        {"faces_copied_redone", r.faces_copied_redone},
                         {"redo_reason", r.redo_reason},
                         {"tracer_faces", r.tracer_faces}};
   }
@@ -145,9 +146,121 @@ std::string AssetReportSummary(const AssetReport& r) {
   return out;
 }
 
-std::string ExtractReportSummary(const ExtractReport& r) {
+namespace {
+
+// A shard's summary: its faces, what they cost, where they went.
+std::string ShardSummary(const ExtractReport& r) {
+  std::string copied =
+      r.faces_copied > 0 ? fmt::format(" ({} copied from the part there)", r.faces_copied) : "";
+  return fmt::format(
+      "dispex: shard {}/{}: faces {}..{} in shard order ({:.1f}% of the estimated cost), {} "
+      "extracted{} -> {}\n  time {:.2f}s (read {:.2f}+{:.2f}, bvh {:.2f}, sample+trace {:.2f})  "
+      "peak {:.0f} MB\n",
+      r.options.shard_index, r.options.shard_count, r.shard_begin, r.shard_end - 1,
+      100 * r.shard_cost_fraction, r.faces_extracted, copied, r.output_path, r.t_total,
+      r.t_read_base, r.t_read_sculpt, r.t_bvh, r.t_sample_trace, double(r.peak_rss_bytes) / 1e6);
+}
+
+// Where the values came from -- the correspondence (vector maps, interpolation, the mapping)
+// or rays -- with the tolerance, the samples and what the rays missed.
+std::string SourceLines(const ExtractReport& r) {
+  const char* tolerance_auto = r.tolerance_auto ? " (auto)" : "";
+  if (!r.vector_space.empty()) {
+    return fmt::format(
+               "  vector ({}): the sculpt is the base refined {} times; its vertices lie up to "
+               "{:.4g} (rms {:.4g}) from their points on the limit surface\n",
+               r.vector_space, r.mapping_levels, r.mapping_max_offset, r.mapping_rms_offset) +
+           fmt::format("  tolerance {:.4g}{}  samples {}  matched in {:.2f}s\n", r.tolerance,
+                       tolerance_auto, r.samples, r.t_match);
+  }
+  if (r.method == ExtractMethod::kInterpolate) {
+    return fmt::format(
+               "  the sculpt's vertex displacements interpolated through the subdivision "
+               "correspondence (level {}, {:.2f}s; vertices up to {:.4g} from their points)\n",
+               r.mapping_levels, r.t_match, r.mapping_max_offset) +
+           fmt::format("  tolerance {:.4g}{}  samples {}\n", r.tolerance, tolerance_auto,
+                       r.samples);
+  }
+  std::string out;
+  if (r.method == ExtractMethod::kMapping) {
+    out += fmt::format(
+        "  through the subdivision correspondence (level {}, {:.2f}s); {} samples of {} "
+        "faces left to a BVH\n",
+        r.mapping_levels, r.t_match, r.mapping_fallback_samples, r.mapping_fallback_faces);
+  }
+  out += fmt::format("  tolerance {:.4g}{}  search distance {:.4g}{}\n", r.tolerance,
+                     tolerance_auto, r.search_distance, r.search_distance_auto ? " (auto)" : "");
+  out += fmt::format(
+      "  samples {}  rays {}  misses {} ({} filled in-face, {} faces from "
+      "neighbours; {} more found by the {:.4g} search)\n",
+      r.samples, r.rays_cast, r.misses, r.holes_filled, r.faces_filled_from_neighbours,
+      r.misses_recovered, r.retry_search_distance);
+  return out;
+}
+
+// The watertight edges: a vector map's pinned edge texels, and the steps across shared edges.
+std::string EdgeLines(const ExtractReport& r) {
   const SpectralTotals& s = r.spectral;
   std::string out;
+  if (r.watertight == WatertightEdges::kAll && !r.vector_space.empty()) {
+    out += fmt::format(
+        "  edges ({}): texels pinned to the edges, each face's own reading there within {:.3g} "
+        "({:.2g} tolerances); {} faces whose finest samples are too coarse for it\n",
+        WatertightEdgesName(r.watertight), s.max_edge_error, s.max_edge_error / r.tolerance,
+        s.edge_limited_faces);
+  }
+  if (r.watertight == WatertightEdges::kOff) return out;
+  out += fmt::format(
+      "  edges ({}): {} shared, largest step{} {:.3g} across faces ({:.2g} "
+      "tolerances)",
+      WatertightEdgesName(r.watertight), r.edges_shared, r.vector_space.empty() ? "" : " of D",
+      r.edge_step_across_faces, r.edge_step_across_faces / r.tolerance);
+  if (r.watertight == WatertightEdges::kAll) {
+    out += fmt::format(", {:.3g} per face ({:.2g} tolerances)", r.edge_step_per_face,
+                       r.edge_step_per_face / r.tolerance);
+  }
+  out += fmt::format("; {} faces raised in {} rounds, texels {} -> {}", r.edge_raised_faces,
+                     r.edge_rounds, r.texels_before_edges, s.texels_after);
+  if (r.edges_over + r.edges_sharp + r.edges_discontinuous > 0) {
+    out += fmt::format(
+        "; not held: {} over the tolerance, {} on sharp creases, {} beside "
+        "filled holes or other sheets",
+        r.edges_over, r.edges_sharp, r.edges_discontinuous);
+  }
+  return out + "\n";
+}
+
+// The values of the map: along the normal, or a vector map's lengths.
+std::string DisplacementLine(const ExtractReport& r) {
+  if (r.vector_space.empty()) {
+    return fmt::format("  displacement [{:.4g}, {:.4g}] rms {:.4g}\n", r.displacement_min,
+                       r.displacement_max, r.displacement_rms);
+  }
+  return fmt::format(
+      "  displacement |D| up to {:.4g} (rms {:.4g}), along the normal [{:.4g}, {:.4g}], "
+      "across it up to {:.4g}\n",
+      r.vector_length_max, r.displacement_rms, r.displacement_min, r.displacement_max,
+      r.vector_tangential_max);
+}
+
+// What an incremental run redid and why: the faces whose inputs changed, those copied but
+// extracted again for a neighbour's edge, and what the BVH held.
+std::string IncrementalLine(const ExtractReport& r) {
+  std::string out = fmt::format("dispex: incremental: {} faces copied, {} extracted ({})",
+                                r.faces_copied, r.faces_extracted, r.redo_reason);
+  if (r.faces_copied_redone > 0) {
+    out += fmt::format("; {} copied extracted again for a neighbour's edge", r.faces_copied_redone);
+  }
+  if (r.tracer_faces > 0) {
+    out += fmt::format("; the BVH held the sculpt within reach of {} faces", r.tracer_faces);
+  }
+  return out + "\n";
+}
+
+}  // namespace
+
+std::string ExtractReportSummary(const ExtractReport& r) {
+  const SpectralTotals& s = r.spectral;
   if (r.options.plan_only) return ExtractPlanSummary(r.plan);
   if (r.unchanged) {
     return fmt::format(
@@ -155,56 +268,13 @@ std::string ExtractReportSummary(const ExtractReport& r) {
         "{:.2f}s\n",
         r.output_path, r.t_total);
   }
-  if (r.options.shard_count > 0) {
-    std::string copied =
-        r.faces_copied > 0 ? fmt::format(" ({} copied from the part there)", r.faces_copied) : "";
-    return fmt::format(
-        "dispex: shard {}/{}: faces {}..{} in shard order ({:.1f}% of the estimated cost), {} "
-        "extracted{} -> {}\n  time {:.2f}s (read {:.2f}+{:.2f}, bvh {:.2f}, sample+trace {:.2f})  "
-        "peak {:.0f} MB\n",
-        r.options.shard_index, r.options.shard_count, r.shard_begin, r.shard_end - 1,
-        100 * r.shard_cost_fraction, r.faces_extracted, copied, r.output_path, r.t_total,
-        r.t_read_base, r.t_read_sculpt, r.t_bvh, r.t_sample_trace, double(r.peak_rss_bytes) / 1e6);
-  }
-  if (r.options.incremental) {
-    out += fmt::format("dispex: incremental: {} faces copied, {} extracted ({})\n", r.faces_copied,
-                       r.faces_extracted, r.redo_reason);
-  }
+  if (r.options.shard_count > 0) return ShardSummary(r);
+  std::string out;
+  if (r.options.incremental) out += IncrementalLine(r);
   if (r.parts_merged > 0) out += fmt::format("dispex: merged {} parts\n", r.parts_merged);
   out += fmt::format("dispex: {} ({} Ptex faces) <- {} ({} faces)\n", r.output_path, r.ptex_faces,
                      r.sculpt_path, r.sculpt_faces);
-  if (!r.vector_space.empty()) {
-    out += fmt::format(
-        "  vector ({}): the sculpt is the base refined {} times; its vertices lie up to {:.4g} "
-        "(rms {:.4g}) from their points on the limit surface\n",
-        r.vector_space, r.mapping_levels, r.mapping_max_offset, r.mapping_rms_offset);
-    out += fmt::format("  tolerance {:.4g}{}  samples {}  matched in {:.2f}s\n", r.tolerance,
-                       r.tolerance_auto ? " (auto)" : "", r.samples, r.t_match);
-  } else {
-    if (r.method == ExtractMethod::kInterpolate) {
-      out += fmt::format(
-          "  the sculpt's vertex displacements interpolated through the subdivision "
-          "correspondence (level {}, {:.2f}s; vertices up to {:.4g} from their points)\n",
-          r.mapping_levels, r.t_match, r.mapping_max_offset);
-      out += fmt::format("  tolerance {:.4g}{}  samples {}\n", r.tolerance,
-                         r.tolerance_auto ? " (auto)" : "", r.samples);
-    } else {
-      if (r.method == ExtractMethod::kMapping) {
-        out += fmt::format(
-            "  through the subdivision correspondence (level {}, {:.2f}s); {} samples of {} "
-            "faces left to a BVH\n",
-            r.mapping_levels, r.t_match, r.mapping_fallback_samples, r.mapping_fallback_faces);
-      }
-      out += fmt::format("  tolerance {:.4g}{}  search distance {:.4g}{}\n", r.tolerance,
-                         r.tolerance_auto ? " (auto)" : "", r.search_distance,
-                         r.search_distance_auto ? " (auto)" : "");
-      out += fmt::format(
-          "  samples {}  rays {}  misses {} ({} filled in-face, {} faces from "
-          "neighbours; {} more found by the {:.4g} search)\n",
-          r.samples, r.rays_cast, r.misses, r.holes_filled, r.faces_filled_from_neighbours,
-          r.misses_recovered, r.retry_search_distance);
-    }
-  }
+  out += SourceLines(r);
   if (r.hits_opposed > 0) {
     out += fmt::format(
         "  {} hits on sculpt faces facing against the normal (folds or other "
@@ -215,43 +285,8 @@ std::string ExtractReportSummary(const ExtractReport& r) {
                      s.texels_before, s.texels_after,
                      s.texels_before ? 100.0 * double(s.texels_after) / double(s.texels_before) : 0,
                      s.constant_faces, s.max_measured_error);
-  if (r.watertight == WatertightEdges::kAll && !r.vector_space.empty()) {
-    out += fmt::format(
-        "  edges ({}): texels pinned to the edges, each face's own reading there within {:.3g} "
-        "({:.2g} tolerances); {} faces whose finest samples are too coarse for it\n",
-        WatertightEdgesName(r.watertight), s.max_edge_error, s.max_edge_error / r.tolerance,
-        s.edge_limited_faces);
-  }
-  if (r.watertight != WatertightEdges::kOff) {
-    out += fmt::format(
-        "  edges ({}): {} shared, largest step{} {:.3g} across faces ({:.2g} "
-        "tolerances)",
-        WatertightEdgesName(r.watertight), r.edges_shared, r.vector_space.empty() ? "" : " of D",
-        r.edge_step_across_faces, r.edge_step_across_faces / r.tolerance);
-    if (r.watertight == WatertightEdges::kAll) {
-      out += fmt::format(", {:.3g} per face ({:.2g} tolerances)", r.edge_step_per_face,
-                         r.edge_step_per_face / r.tolerance);
-    }
-    out += fmt::format("; {} faces raised in {} rounds, texels {} -> {}", r.edge_raised_faces,
-                       r.edge_rounds, r.texels_before_edges, s.texels_after);
-    if (r.edges_over + r.edges_sharp + r.edges_discontinuous > 0) {
-      out += fmt::format(
-          "; not held: {} over the tolerance, {} on sharp creases, {} beside "
-          "filled holes or other sheets",
-          r.edges_over, r.edges_sharp, r.edges_discontinuous);
-    }
-    out += "\n";
-  }
-  if (r.vector_space.empty()) {
-    out += fmt::format("  displacement [{:.4g}, {:.4g}] rms {:.4g}\n", r.displacement_min,
-                       r.displacement_max, r.displacement_rms);
-  } else {
-    out += fmt::format(
-        "  displacement |D| up to {:.4g} (rms {:.4g}), along the normal [{:.4g}, {:.4g}], "
-        "across it up to {:.4g}\n",
-        r.vector_length_max, r.displacement_rms, r.displacement_min, r.displacement_max,
-        r.vector_tangential_max);
-  }
+  out += EdgeLines(r);
+  out += DisplacementLine(r);
   out += fmt::format(
       "  time {:.2f}s (read {:.2f}+{:.2f}, bvh {:.2f}, sample+trace {:.2f}, "
       "write {:.2f})  {:.1f} MB  peak {:.0f} MB\n",
