@@ -355,10 +355,11 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   // A shard runs its faces' first pass only, no stage that crosses faces (the merge runs them).
   const std::vector<std::uint8_t> in_shard =
       ShardFaces(options, inputs, settings, face_keys, report);
-  std::vector<std::uint8_t> runs = PlanFaces(plan, inputs, face_keys.keys, &previous, in_shard);
+  const std::vector<FaceSource> sources =
+      PlanFaces(plan, inputs, face_keys.keys, &previous, in_shard);
   std::vector<std::uint8_t> reach;
   if (within_reach) {
-    reach = FacesWithinReach(inputs, std::move(runs), shard ? 0 : kLocalRings);
+    reach = FacesWithinReach(inputs, sources, shard ? 0 : kLocalRings);
     // For a run that is not a shard, the whole sculpt when that is most of it.
     if (!shard && 2 * std::count(reach.begin(), reach.end(), 1) > plan.faces) {
       plan.tracer = ExtractPlan::Tracer::kWholeSculpt;
@@ -373,10 +374,9 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   }
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateMap(options, inputs));
   Stopwatch faces_clock;
-  DISPEX_ASSIGN_OR_RETURN(
-      ProcessedFaces faces,
-      ProcessFaces(inputs, settings, previous.usable() ? &previous : nullptr, face_keys.keys,
-                   options.progress, options.progress_counter, writer, in_shard));
+  DISPEX_ASSIGN_OR_RETURN(ProcessedFaces faces,
+                          ProcessFaces(inputs, settings, &previous, sources, options.progress,
+                                       options.progress_counter, writer));
   report.faces_copied = faces.faces_copied;
   if (shard) {
     report.t_sample_trace = faces_clock.seconds();

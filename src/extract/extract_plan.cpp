@@ -52,34 +52,39 @@ std::string ExtractPlanSummary(const ExtractPlan& plan) {
 
 namespace extract {
 
-std::vector<std::uint8_t> PlanFaces(ExtractPlan& plan, const ExtractInputs& inputs,
-                                    std::span<const Hash128> keys, const PreviousMap* previous,
-                                    std::span<const std::uint8_t> in_shard) {
+std::vector<FaceSource> PlanFaces(ExtractPlan& plan, const ExtractInputs& inputs,
+                                  std::span<const Hash128> keys, const PreviousMap* previous,
+                                  std::span<const std::uint8_t> in_shard) {
   plan.faces_run = plan.faces_copied = plan.faces_elsewhere = plan.hole_faces = 0;
-  std::vector<std::uint8_t> runs(keys.size(), 0);
+  std::vector<FaceSource> sources(keys.size(), FaceSource::kRun);
   for (std::size_t f = 0; f < keys.size(); ++f) {
     if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) {
+      sources[f] = FaceSource::kHole;
       ++plan.hole_faces;
     } else if (!in_shard.empty() && !in_shard[f]) {
+      sources[f] = FaceSource::kElsewhere;
       ++plan.faces_elsewhere;
     } else if (previous != nullptr && previous->usable() && previous->Reusable(f, keys[f])) {
+      sources[f] = FaceSource::kCopy;
       ++plan.faces_copied;
     } else {
       ++plan.faces_run;
-      runs[f] = 1;
     }
   }
-  return runs;
+  return sources;
 }
 
 std::vector<std::uint8_t> FacesWithinReach(const ExtractInputs& inputs,
-                                           std::vector<std::uint8_t> runs, int rings) {
+                                           std::span<const FaceSource> sources, int rings) {
+  std::vector<std::uint8_t> traced(sources.size(), 0);
   std::vector<int> ring;
-  for (std::size_t f = 0; f < runs.size(); ++f) {
-    if (runs[f]) ring.push_back(static_cast<int>(f));
+  for (std::size_t f = 0; f < sources.size(); ++f) {
+    if (sources[f] != FaceSource::kRun) continue;
+    traced[f] = 1;
+    ring.push_back(static_cast<int>(f));
   }
-  AddRings(inputs.faces, rings, std::move(ring), runs);
-  return runs;
+  AddRings(inputs.faces, rings, std::move(ring), traced);
+  return traced;
 }
 
 nlohmann::json ExtractPlanJson(const ExtractPlan& plan) {

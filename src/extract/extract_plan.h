@@ -15,17 +15,17 @@
 
 namespace dispex::extract {
 
-// Counts the faces that run, those copied from `previous` (when usable), another shard's
-// (outside `in_shard`, when not empty) and the holes: as ProcessFaces decides them
-// from the same keys. Returns which faces run (1), per Ptex face.
-std::vector<std::uint8_t> PlanFaces(ExtractPlan& plan, const ExtractInputs& inputs,
-                                    std::span<const Hash128> keys, const PreviousMap* previous,
-                                    std::span<const std::uint8_t> in_shard);
+// Each face's source, from `previous` (when usable: a face whose key is unchanged and whose
+// stored texels are its first pass is copied) and `in_shard` (when not empty: the faces it does
+// not flag are another shard's), counted into the plan. ProcessFaces follows it.
+std::vector<FaceSource> PlanFaces(ExtractPlan& plan, const ExtractInputs& inputs,
+                                  std::span<const Hash128> keys, const PreviousMap* previous,
+                                  std::span<const std::uint8_t> in_shard);
 
-// The faces whose sculpt a BVH of the sculpt within reach holds: those that run (PlanFaces),
-// and `rings` rings of faces around them.
+// The faces whose sculpt a BVH of the sculpt within reach holds: those that run, and `rings`
+// rings of faces around them.
 std::vector<std::uint8_t> FacesWithinReach(const ExtractInputs& inputs,
-                                           std::vector<std::uint8_t> runs, int rings);
+                                           std::span<const FaceSource> sources, int rings);
 
 nlohmann::json ExtractPlanJson(const ExtractPlan& plan);
 

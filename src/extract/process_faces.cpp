@@ -92,9 +92,9 @@ Status WriteConstantFace(PtexWriter& writer, const ExtractInputs& inputs, PtexFa
 }
 
 StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
-                                      const PreviousMap* previous, std::span<const Hash128> keys,
-                                      bool progress, ProgressCounter* counter, PtexWriter& writer,
-                                      std::span<const std::uint8_t> only) {
+                                      const PreviousMap* previous,
+                                      std::span<const FaceSource> sources, bool progress,
+                                      ProgressCounter* counter, PtexWriter& writer) {
   const int num_faces = inputs.surface.num_ptex_faces();
   const bool keep = settings.watertight != WatertightEdges::kOff;
   const int channels = settings.channels();
@@ -129,10 +129,8 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
   };
   auto process = [&](PtexFaceId face, FaceScratch& w) -> Status {
     const auto f = static_cast<std::size_t>(face.value);
-    if (!only.empty() && !only[f]) return Status::Ok();
-    if (previous != nullptr && !inputs.surface.is_hole(face) && previous->Reusable(f, keys[f])) {
-      return copy(face);
-    }
+    if (sources[f] == FaceSource::kElsewhere) return Status::Ok();
+    if (sources[f] == FaceSource::kCopy) return copy(face);
     DISPEX_ASSIGN_OR_RETURN(FaceResult result, ProcessFace(face, inputs, settings, w));
     if (result.needs_tracer) {
       deferred[f] = 1;

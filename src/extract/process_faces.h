@@ -7,7 +7,6 @@
 #include <span>
 #include <vector>
 
-#include "core/hash128.h"
 #include "dispex/ptex.h"
 #include "extract/extract_inputs.h"
 #include "extract/extract_settings.h"
@@ -49,18 +48,21 @@ struct ProcessedFaces {
 
 class PreviousMap;
 
-// Every face through ProcessFace, in parallel, except those `previous` (may be null) holds
-// with the same key (`keys`, per Ptex face), whose first pass is copied from it. Each face is
-// written to the map as soon as it is done, or, with watertight edges, kept for MatchEdges and
-// WriteKeptFaces. Through the mapping, faces with samples it leaves undecided wait until every
-// face has been through it; then one tracer is built for them (TraceFallback) and they are
-// processed again. With `only` (per Ptex face; empty: every face), the faces it does not flag
-// are left out (a shard's). On an error, the error of the lowest face id (whatever the
-// scheduling), or the cancellation.
+// Where a Ptex face's texels come from in this run (PlanFaces decides it): its first pass run
+// here, copied from the previous map or the parts, another shard's (not in this part), or a
+// hole (written as 0).
+enum class FaceSource : std::uint8_t { kRun, kCopy, kElsewhere, kHole };
+
+// Every face as `sources` (per Ptex face, PlanFaces') says: through ProcessFace in parallel,
+// its first pass copied from `previous`, or left out. Each face is written to the map as soon
+// as it is done, or, with watertight edges, kept for MatchEdges and WriteKeptFaces. Through the
+// mapping, faces with samples it leaves undecided wait until every face has been through it;
+// then one tracer is built for them (TraceFallback) and they are processed again. On an error,
+// the error of the lowest face id (whatever the scheduling), or the cancellation.
 StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
-                                      const PreviousMap* previous, std::span<const Hash128> keys,
-                                      bool progress, ProgressCounter* counter, PtexWriter& writer,
-                                      std::span<const std::uint8_t> only = {});
+                                      const PreviousMap* previous,
+                                      std::span<const FaceSource> sources, bool progress,
+                                      ProgressCounter* counter, PtexWriter& writer);
 
 // Runs ProcessFace again for `faces` with their least resolutions (`least_log2`, per Ptex
 // face), replacing their kept texels and statistics; the rays cast count in the totals. Swaps
