@@ -125,8 +125,9 @@ void RunAsset(const BatchArgs& args, const BatchAsset& asset, const std::string&
     entry["report"] = nlohmann::json::parse(extract_json);
     if (!args.quiet) {
       std::fprintf(stderr, "dispex: %s %s: %s, %.2fs, peak %.0f MB -> %s\n", progress.c_str(),
-                   asset.name.c_str(), r->unchanged ? "up to date" : "ok", r->t_total,
-                   double(r->peak_rss_bytes) / 1e6, asset.options.output_path.c_str());
+                   asset.name.c_str(), r->incremental.unchanged ? "up to date" : "ok",
+                   r->times.total, double(r->peak_rss_bytes) / 1e6,
+                   asset.options.output_path.c_str());
     }
     if (!args.view_dir.empty()) WriteAssetPage(args, asset, extract_json, progress, entry, run);
   } else {

@@ -195,7 +195,7 @@ int RunWatchRounds(const ExtractArgs& args) {
           Status written = WriteFileAtomically(args.report_path, text.data(), text.size());
           if (!written.ok()) ReportFailure(written.WithPrefix("--report"));
         }
-        if (!args.preview_dir.empty() && (!report->unchanged || changed.empty())) {
+        if (!args.preview_dir.empty() && (!report->incremental.unchanged || changed.empty())) {
           Status previews = WritePreviews(o.base_path, o.output_path, args.preview_dir);
           if (!previews.ok()) ReportFailure(previews.WithPrefix("--preview"));
         }

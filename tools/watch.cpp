@@ -261,18 +261,19 @@ std::string WatchRoundLines(const std::vector<std::string>& changed, const Extra
                             std::vector<std::string>& warned) {
   const std::string saved = changed.empty() ? "" : JoinFileNames(changed) + " changed: ";
   std::string out;
-  if (r.unchanged) {
+  if (r.incremental.unchanged) {
     out = fmt::format("dispex: {}{} is up to date (made from the same inputs and options)\n", saved,
-                      r.output_path);
+                      r.output.path);
   } else {
     // Without incremental re-use (UV-space maps) every face is extracted each round.
-    const std::string reason =
-        r.options.incremental ? r.redo_reason : "a full extraction with the UV-space maps";
+    const std::string reason = r.options.incremental ? r.incremental.redo_reason
+                                                     : "a full extraction with the UV-space maps";
     const std::string tiles =
-        r.uv_map_paths.empty() ? "" : fmt::format(" and {} UV tiles", r.uv_map_paths.size());
+        r.uv.paths.empty() ? "" : fmt::format(" and {} UV tiles", r.uv.paths.size());
     out = fmt::format("dispex: {}{} of {} faces extracted{} ({}), {}{} written in {:.2f} s\n",
-                      saved, r.faces_extracted, r.faces_extracted + r.faces_copied,
-                      changed.empty() ? "" : " again", reason, r.output_path, tiles, r.t_total);
+                      saved, r.incremental.faces_extracted,
+                      r.incremental.faces_extracted + r.incremental.faces_copied,
+                      changed.empty() ? "" : " again", reason, r.output.path, tiles, r.times.total);
   }
   for (const std::string& warning : r.warnings) {
     if (std::find(warned.begin(), warned.end(), warning) == warned.end()) {

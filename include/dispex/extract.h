@@ -306,7 +306,7 @@ struct ExtractPlan {
   // Where the faces that do not run get their texels: "" (all run), the previous map's path
   // (incremental), or "N shard parts" (a merge).
   std::string faces_from;
-  std::string redo_reason;  // why faces run again (incremental): ExtractReport::redo_reason
+  std::string redo_reason;  // why faces run again (incremental): ExtractReport::incremental
   // Ptex faces: all of them; those extracted in this run; copied from faces_from; another
   // shard's (a shard part); holes of the base (no surface, written as 0). -1: not planned yet.
   std::int64_t faces = 0, faces_run = -1, faces_copied = -1, faces_elsewhere = 0, hole_faces = 0;
@@ -319,145 +319,164 @@ std::string_view ExtractPlanTracerName(
 // The plan in a few lines for people ("plan: a map (scalar), method mapping, BVH: none ...").
 std::string ExtractPlanSummary(const ExtractPlan& plan);
 
+// What one extraction did, grouped as its JSON report (ExtractReportJson) is.
 struct ExtractReport {
   std::string version;
-  ExtractPlan plan;
   std::string shape;  // the shape's name when extracted as part of an asset (ExtractAsset)
-  std::string base_path, sculpt_path, output_path;
-  std::string base_fingerprint, sculpt_fingerprint;
+  ExtractPlan plan;
   ExtractOptions options;  // as given
-
-  // Resolved automatic values.
-  double tolerance = 0;
-  bool tolerance_auto = false;
-  double sculpt_median_edge = 0;
-  double search_distance = 0;
-  bool search_distance_auto = false;
-  SearchDistanceEstimate search_estimate;  // when automatic
-  double base_diagonal = 0;
-  int threads = 0;
-
-  // Inputs.
-  std::size_t base_vertices = 0, base_faces = 0, ptex_faces = 0, hole_faces = 0;
-  std::size_t sculpt_vertices = 0, sculpt_faces = 0;
-  int inf_sharp_edges = 0;
   std::vector<std::string> warnings;
+  std::uint64_t peak_rss_bytes = 0;
+  std::string tracer;  // TracerStats::backend: Embree version, ISA, build
 
-  // Phases, wall seconds.
-  double t_read_base = 0, t_read_sculpt = 0, t_topology = 0, t_bvh = 0, t_search = 0,
-         t_sample_trace = 0, t_write = 0, t_total = 0;
+  struct Inputs {
+    std::string base_path, sculpt_path;
+    std::string base_fingerprint, sculpt_fingerprint;
+    std::size_t base_vertices = 0, base_faces = 0, ptex_faces = 0, hole_faces = 0;
+    std::size_t sculpt_vertices = 0, sculpt_faces = 0;
+    int inf_sharp_edges = 0;
+    double base_diagonal = 0;
+    double sculpt_median_edge = 0;
+  } inputs;
 
-  // The method that ran (ExtractMethod: kRays, kMapping or kInterpolate; vector maps one of
-  // the last two); when the
-  // correspondence was looked for, the match as below (mapping_levels, offsets, t_match), or
-  // why the sculpt is not the base refined.
-  ExtractMethod method = ExtractMethod::kRays;
-  std::string mapping_reason;
-  // Samples the mapping could not decide, answered by a BVH of the sculpt within their reach,
-  // and the Ptex faces they are in (of the faces extracted in this run).
-  std::int64_t mapping_fallback_samples = 0, mapping_fallback_faces = 0;
-  // Through the correspondence with rays (kMapping): the longest hit kept, twice the largest
-  // vertex offset the match measured (mapping_max_offset, over the vertices it checks: all of
-  // them on grids up to 8 x 8) plus the sculpt's median edge; a hit beyond it
-  // is another sheet of the sculpt and counts as a miss. The search distances are cut to it.
-  // 0: none.
-  double mapping_sheet_bound = 0;
-  // Within sample+trace, CPU time of the worker threads (each thread's own clock, summed):
-  // limit evaluation, rays, spectral analysis, compression and writing.
-  double cpu_limit = 0, cpu_trace = 0, cpu_spectral = 0, cpu_compress = 0;
+  struct Output {
+    std::string path;
+    std::uint64_t bytes = 0;  // of the map
+  } output;
+
+  // Automatic values resolved, and the threads used.
+  struct Settings {
+    double tolerance = 0;
+    bool tolerance_auto = false;
+    double search_distance = 0;
+    bool search_distance_auto = false;
+    SearchDistanceEstimate search_estimate;  // when automatic
+    int threads = 0;
+  } settings;
+
+  // Phases, wall seconds; then, within sample+trace, CPU time of the worker threads (each
+  // thread's own clock, summed): limit evaluation, rays, spectral analysis, compression and
+  // writing.
+  struct Times {
+    double read_base = 0, read_sculpt = 0, topology = 0, match = 0, bvh = 0, search = 0, keys = 0,
+           sample_trace = 0, write = 0, uv_maps = 0, total = 0;
+    double cpu_limit = 0, cpu_trace = 0, cpu_spectral = 0, cpu_compress = 0;
+  } times;
+
+  // The method that ran and, when the correspondence was looked for, the match: the sculpt is
+  // the base refined `levels` times (-1 when not matched; `reason` says why), its vertices up to
+  // max_offset (rms rms_offset) from their points on the limit surface.
+  struct Method {
+    ExtractMethod used = ExtractMethod::kRays;  // kRays, kMapping or kInterpolate
+    std::string reason;
+    int levels = -1;
+    double max_offset = 0, rms_offset = 0;
+    // Through the correspondence with rays (kMapping): the longest hit kept, twice the largest
+    // vertex offset the match measured (over the vertices it checks: all of them on grids up to
+    // 8 x 8) plus the sculpt's median edge; a hit beyond it is another sheet of the sculpt and
+    // counts as a miss. The search distances are cut to it. 0: none.
+    double sheet_bound = 0;
+    // Samples the mapping could not decide, answered by a BVH of the sculpt within their
+    // reach, and the Ptex faces they are in (of the faces extracted in this run).
+    std::int64_t fallback_samples = 0, fallback_faces = 0;
+  } method;
 
   // Sampling and rays.
-  std::array<std::int64_t, 10> oversample_faces{};  // faces by log2 of the samples per side
-  // Automatic oversampling's rule: the L of a sculpt that is the base subdivided L times, or
-  // -1 when the sculpt is measured by density (area) or oversampling is fixed.
-  int oversample_subdivision_level = -1;
-  std::int64_t samples = 0;
-  std::uint64_t rays_cast = 0;
-  std::int64_t hits_positive = 0, hits_negative = 0;
-  // Hits on sculpt faces that face against the limit normal: the sculpt folds there or the
-  // ray met another sheet (|displacement| x curvature >= 1, thin parts).
-  std::int64_t hits_opposed = 0;
-  // With an automatic search distance, samples that miss are searched again this far (0 when
-  // the distance was given).
-  double retry_search_distance = 0;
-  std::int64_t misses_recovered = 0;  // samples that hit on that second search
-  std::int64_t misses = 0;            // samples whose rays found nothing
-  double miss_fraction = 0;           // misses / samples
-  std::int64_t holes_filled = 0;      // of those, filled within their face
-  std::int64_t faces_with_misses = 0;
-  std::int64_t faces_filled_from_neighbours = 0;
-  std::int64_t faces_unreachable = 0;  // missed entirely, no neighbour to fill from: 0 written
-  std::int64_t fallback_normals = 0;
+  struct Sampling {
+    std::array<std::int64_t, 10> oversample_faces{};  // faces by log2 of the samples per side
+    // Automatic oversampling's rule: the L of a sculpt that is the base subdivided L times, or
+    // -1 when the sculpt is measured by density (area) or oversampling is fixed.
+    int oversample_subdivision_level = -1;
+    std::int64_t samples = 0;
+    std::uint64_t rays_cast = 0;
+    std::int64_t hits_positive = 0, hits_negative = 0;
+    // Hits on sculpt faces that face against the limit normal: the sculpt folds there or the
+    // ray met another sheet (|displacement| x curvature >= 1, thin parts).
+    std::int64_t hits_opposed = 0;
+    // With an automatic search distance, samples that miss are searched again this far (0
+    // when the distance was given).
+    double retry_search_distance = 0;
+    std::int64_t misses_recovered = 0;  // samples that hit on that second search
+    std::int64_t misses = 0;            // samples whose rays found nothing
+    double miss_fraction = 0;           // misses / samples
+    std::int64_t holes_filled = 0;      // of those, filled within their face
+    std::int64_t faces_with_misses = 0;
+    std::int64_t faces_filled_from_neighbours = 0;
+    std::int64_t faces_unreachable = 0;  // missed entirely, no neighbour to fill from: 0 written
+    std::int64_t fallback_normals = 0;
+  } sampling;
 
-  // Spectral step.
   SpectralTotals spectral;
-  // Watertight edges (kOff when the option is off or the rule is not kErrorBound). Steps are
-  // the largest over every texel breakpoint of every shared edge (MeasurePtexEdgeSteps; of a
-  // vector map, the length of D's step in object space) once the map is final, in object units.
-  WatertightEdges watertight = WatertightEdges::kOff;
-  std::int64_t edge_rounds = 0;          // rounds of raising resolutions
-  std::int64_t edge_raised_faces = 0;    // faces whose resolution the edges raised
-  std::int64_t texels_before_edges = 0;  // texels written had no edge been raised
-  std::int64_t edges_shared = 0;         // between two faces with a surface
-  std::int64_t edges_sharp = 0;          // on infinitely sharp creases: not held
-  // Edges beside faces whose displacement may jump -- samples filled over holes of the
-  // sculpt, hits on another sheet, or no hit at all -- not held; those faces, by id (stored in
-  // the map as dispex:discontinuous_faces for verify).
-  std::int64_t edges_discontinuous = 0;
-  std::vector<std::int32_t> discontinuous_faces;
-  // Held edges still over the tolerance: the samples are too coarse, or the displacement jumps
-  // there (another sheet, a filled hole), so raising the resolution did not bring them down.
-  std::int64_t edges_over = 0;
-  // Largest over held edges; per face only with WatertightEdges::kAll (0 otherwise).
-  double edge_step_per_face = 0, edge_step_across_faces = 0;
-  double displacement_min = 0, displacement_max = 0, displacement_rms = 0;
 
-  // Incremental extraction (ExtractOptions::incremental).
-  std::string inputs_key;  // of the inputs and options: the map stores it as dispex:inputs_key
-  bool unchanged = false;  // the map was made from the same inputs and options: not rewritten
-  std::int64_t faces_copied = 0;     // from the previous map
-  std::int64_t faces_extracted = 0;  // Ptex faces with a surface that were not copied
-  // Of the faces copied, those the watertight edges extracted again: a neighbour's edge changed.
-  std::int64_t faces_copied_redone = 0;
-  // Why faces were extracted again: "no previous map", the previous map's notice, or what
-  // changed ("base, sculpt, options: tolerance").
-  std::string redo_reason;
-  double t_keys = 0;  // computing the face keys, seconds
-  // With a given search distance: the Ptex faces whose reach the BVH holds when it holds only
-  // part of the sculpt (docs/INCREMENTAL.md); 0 when it holds all of it.
-  std::int64_t tracer_faces = 0;
+  // Watertight edges (rule kOff when the option is off or the rule is not kErrorBound). Steps
+  // are the largest over every texel breakpoint of every shared edge (MeasurePtexEdgeSteps; of
+  // a vector map, the length of D's step in object space) once the map is final, in object
+  // units.
+  struct Edges {
+    WatertightEdges rule = WatertightEdges::kOff;
+    std::int64_t rounds = 0;         // rounds of raising resolutions
+    std::int64_t raised_faces = 0;   // faces whose resolution the edges raised
+    std::int64_t texels_before = 0;  // texels written had no edge been raised
+    std::int64_t shared = 0;         // between two faces with a surface
+    std::int64_t sharp = 0;          // on infinitely sharp creases: not held
+    // Edges beside faces whose displacement may jump -- samples filled over holes of the
+    // sculpt, hits on another sheet, or no hit at all -- not held; those faces, by id (stored
+    // in the map as dispex:discontinuous_faces for verify).
+    std::int64_t discontinuous = 0;
+    std::vector<std::int32_t> discontinuous_faces;
+    // Held edges still over the tolerance: the samples are too coarse, or the displacement
+    // jumps there (another sheet, a filled hole), so raising the resolution did not bring them
+    // down.
+    std::int64_t over = 0;
+    // Largest over held edges; per face only with WatertightEdges::kAll (0 otherwise).
+    double step_per_face = 0, step_across_faces = 0;
+  } edges;
 
-  // Vector maps (ExtractOptions::vector): the space; the correspondence (the sculpt is the base
-  // refined mapping_levels times, -1 when not matched; how far its vertices lie from their
-  // points on the limit surface; scalar maps through the mapping too); the largest |D| and its
-  // largest part across the normal (displacement_min, _max hold D . N, displacement_rms |D|).
-  std::string vector_space;  // empty for a scalar map
-  int mapping_levels = -1;
-  double mapping_max_offset = 0, mapping_rms_offset = 0;
-  double t_match = 0;
-  double vector_length_max = 0, vector_tangential_max = 0;
+  // The map's values: along the normal (min, max, rms); a vector map's space (empty for a
+  // scalar map), its largest |D| and largest part across the normal (min, max hold D . N, rms
+  // |D|).
+  struct Displacement {
+    double min = 0, max = 0, rms = 0;
+    std::string vector_space;
+    double length_max = 0, tangential_max = 0;
+  } displacement;
+
+  // Incremental extraction (ExtractOptions::incremental) and the faces of a shard part.
+  struct Incremental {
+    std::string inputs_key;  // of the inputs and options: the map stores it as dispex:inputs_key
+    bool unchanged = false;  // the map was made from the same inputs and options: not rewritten
+    std::int64_t faces_copied = 0;     // from the previous map (or a shard's part)
+    std::int64_t faces_extracted = 0;  // Ptex faces with a surface that were not copied
+    // Of the faces copied, those the watertight edges extracted again: a neighbour's edge
+    // changed.
+    std::int64_t faces_copied_redone = 0;
+    // Why faces were extracted again: "no previous map", the previous map's notice, or what
+    // changed ("base, sculpt, options: tolerance").
+    std::string redo_reason;
+    // With a given search distance: the Ptex faces whose reach the BVH holds when it holds
+    // only part of the sculpt (docs/INCREMENTAL.md); 0 when it holds all of it.
+    std::int64_t tracer_faces = 0;
+  } incremental;
 
   // UV-space maps (ExtractOptions::uv_maps_dir): the files written, texel centres inside a UV
   // face, those of them whose rays missed (filled by dilation as if outside), texel centres in
   // two faces and the Ptex faces involved (UvRaster::overlap_texels), faces whose UVs leave the
-  // UDIM range, seconds.
-  std::vector<std::string> uv_map_paths;
-  std::int64_t uv_texels_inside = 0, uv_texels_missed = 0, uv_overlap_texels = 0;
-  std::vector<std::int32_t> uv_overlap_faces, uv_faces_outside_udim;
-  double t_uv_maps = 0;
+  // UDIM range.
+  struct UvMaps {
+    std::vector<std::string> paths;
+    std::int64_t texels_inside = 0, texels_missed = 0, overlap_texels = 0;
+    std::vector<std::int32_t> overlap_faces, faces_outside_udim;
+  } uv;
 
-  // Output.
-  std::uint64_t bytes_written = 0;
-  std::uint64_t peak_rss_bytes = 0;
-  std::string tracer;  // TracerStats::backend: Embree version, ISA, build
-
-  // A shard (ExtractOptions::shard_count > 0): the run [shard_begin, shard_end) of the shard
-  // order it extracted (the Ptex faces along a Z-order curve of their centres on the base:
-  // docs/FARM.md), and their estimated cost against the whole map's.
-  std::int64_t shard_begin = 0, shard_end = 0;
-  double shard_cost_fraction = 0;
-  // A merge (MergeShards): the parts merged.
-  std::int64_t parts_merged = 0;
+  // A shard (ExtractOptions::shard_count > 0): the run [begin, end) of the shard order it
+  // extracted (the Ptex faces along a Z-order curve of their centres on the base:
+  // docs/FARM.md), and their estimated cost against the whole map's. A merge (MergeShards):
+  // the parts merged.
+  struct Shard {
+    std::int64_t begin = 0, end = 0;
+    double cost_fraction = 0;
+    std::int64_t parts_merged = 0;
+  } shard;
 };
 
 // Runs the whole pipeline. Errors (bad inputs, nothing hit, a miss under HolePolicy::kFail,

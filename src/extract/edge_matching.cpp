@@ -140,8 +140,8 @@ Status RaiseEdgeResolutions(const ExtractInputs& inputs, const ExtractSettings& 
     const PtexEdgeSteps steps =
         MeasurePtexVectorEdgeSteps(view.faces, view.components, sharp, view.skip_faces, measure);
     if (round == 0) {
-      report.edges_shared = static_cast<std::int64_t>(steps.edges);
-      report.edges_sharp = static_cast<std::int64_t>(steps.skipped_edges);
+      report.edges.shared = static_cast<std::int64_t>(steps.edges);
+      report.edges.sharp = static_cast<std::int64_t>(steps.skipped_edges);
     }
     for (const PtexEdgeStep& s : steps.edge_max) current[{s.face, s.edge}] = s;
     if (round == kMaxRounds) break;
@@ -200,22 +200,22 @@ Status RaiseEdgeResolutions(const ExtractInputs& inputs, const ExtractSettings& 
       raised[f] = redone[f] = 1;
     }
     if (redo.empty()) break;
-    ++report.edge_rounds;
+    ++report.edges.rounds;
     DISPEX_RETURN_IF_ERROR(redo_faces(redo, least, view));
   }
 
-  for (std::size_t f = 0; f < n; ++f) report.edge_raised_faces += raised[f];
+  for (std::size_t f = 0; f < n; ++f) report.edges.raised_faces += raised[f];
   for (const auto& [key, s] : current) {
-    report.edge_step_per_face = std::max(report.edge_step_per_face, s.per_face);
-    report.edge_step_across_faces = std::max(report.edge_step_across_faces, s.across_faces);
-    report.edges_over += s.across_faces > budget || (per_face && s.per_face > budget);
+    report.edges.step_per_face = std::max(report.edges.step_per_face, s.per_face);
+    report.edges.step_across_faces = std::max(report.edges.step_across_faces, s.across_faces);
+    report.edges.over += s.across_faces > budget || (per_face && s.per_face > budget);
   }
   return Status::Ok();
 }
 
 Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, ProcessedFaces& faces,
                   ExtractReport& report) {
-  report.texels_before_edges = Texels(faces, inputs);
+  report.edges.texels_before = Texels(faces, inputs);
   const std::size_t n = faces.kept.size();
   EdgeRoundsMap view;
   view.faces = inputs.faces;
@@ -252,13 +252,13 @@ void ListDiscontinuousFaces(const ExtractInputs& inputs, const ProcessedFaces& f
                             ExtractReport& report) {
   const std::size_t n = faces.stats.size();
   std::vector<std::uint8_t> holes(n), discontinuous(n);
-  report.discontinuous_faces.clear();
+  report.edges.discontinuous_faces.clear();
   for (std::size_t f = 0; f < n; ++f) {
     holes[f] = inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
     discontinuous[f] = !holes[f] && Discontinuous(faces.stats[f]);
-    if (discontinuous[f]) report.discontinuous_faces.push_back(static_cast<std::int32_t>(f));
+    if (discontinuous[f]) report.edges.discontinuous_faces.push_back(static_cast<std::int32_t>(f));
   }
-  report.edges_discontinuous =
+  report.edges.discontinuous =
       static_cast<std::int64_t>(CountEdgesTouching(inputs.faces, discontinuous, holes));
 }
 

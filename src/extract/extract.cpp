@@ -62,9 +62,9 @@ Status CommitMap(PtexWriter& writer, const ExtractInputs& inputs,
                                             faces.first_pass, faces.edge_means));
   if (CancelRequested()) return Cancelled();
   DISPEX_RETURN_IF_ERROR(writer.Finish());
-  report.t_write = clock.seconds();
+  report.times.write = clock.seconds();
   std::error_code ec;
-  report.bytes_written = std::filesystem::file_size(report.output_path, ec);
+  report.output.bytes = std::filesystem::file_size(report.output.path, ec);
   return Status::Ok();
 }
 
@@ -91,10 +91,10 @@ Status CommitPart(PtexWriter& writer, const ExtractInputs& inputs,
 std::string RedoReason(const PreviousMap& previous, const ExtractReport& report) {
   if (!previous.usable()) return previous.notice().empty() ? "no previous map" : previous.notice();
   std::vector<std::string> changed;
-  if (previous.MetaString("dispex:base_fingerprint") != report.base_fingerprint) {
+  if (previous.MetaString("dispex:base_fingerprint") != report.inputs.base_fingerprint) {
     changed.push_back("base");
   }
-  if (previous.MetaString("dispex:sculpt_fingerprint") != report.sculpt_fingerprint) {
+  if (previous.MetaString("dispex:sculpt_fingerprint") != report.inputs.sculpt_fingerprint) {
     changed.push_back("sculpt");
   }
   const nlohmann::json before = nlohmann::json::parse(previous.MetaString("dispex:options"),
@@ -122,8 +122,8 @@ Status BuildLocalTracer(const ExtractOptions& options, std::vector<std::uint8_t>
   SetTracerOptions(options, inputs);
   Stopwatch clock;
   Mesh part = SculptWithinReach(inputs, *inputs.face_keys, traced);
-  report.t_bvh = clock.seconds();
-  report.tracer_faces = std::count(traced.begin(), traced.end(), 1);
+  report.times.bvh = clock.seconds();
+  report.incremental.tracer_faces = std::count(traced.begin(), traced.end(), 1);
   // A shard needs no more of the sculpt than its part (no stage crosses faces): released
   // before the BVH is built, its memory falls with the shard count.
   if (shard && part.num_faces() > 0) ReleaseSculpt(inputs);
@@ -141,14 +141,14 @@ StatusOr<PreviousMap> PlanOutput(const ExtractOptions& options, const ExtractInp
   plan.faces = inputs.surface.num_ptex_faces();
   plan.uv_maps = !options.uv_maps_dir.empty();
   const std::string map_inputs_key = InputsKey(report).Hex();
-  report.inputs_key = shard
-                          ? PartInputsKey(map_inputs_key, options.shard_index, options.shard_count)
-                          : map_inputs_key;
+  report.incremental.inputs_key =
+      shard ? PartInputsKey(map_inputs_key, options.shard_index, options.shard_count)
+            : map_inputs_key;
   const auto num_faces = static_cast<std::size_t>(plan.faces);
   PreviousMap previous;
   if (parts != nullptr) {
     DISPEX_RETURN_IF_ERROR(CheckPartsMatchInputs(*parts, report));
-    report.parts_merged = static_cast<std::int64_t>(parts->size());
+    report.shard.parts_merged = static_cast<std::int64_t>(parts->size());
     plan.faces_from = fmt::format("{} shard parts", parts->size());
     previous = PreviousMap::FromParts(std::move(*parts), ShardOrder(inputs.base, inputs.surface));
     return previous;
@@ -156,14 +156,14 @@ StatusOr<PreviousMap> PlanOutput(const ExtractOptions& options, const ExtractInp
   if (!options.incremental) return previous;
   previous = PreviousMap::Open(options.output_path, num_faces, options.vector.has_value());
   const std::string stored = previous.usable() ? previous.MetaString(kInputsKeyMetaKey) : "";
-  if (stored == report.inputs_key) {
-    report.unchanged = true;
+  if (stored == report.incremental.inputs_key) {
+    report.incremental.unchanged = true;
     plan.output = ExtractPlan::Output::kUpToDate;
     return previous;
   }
   previous.CheckFaceData();
   if (!previous.notice().empty()) report.warnings.push_back(previous.notice());
-  report.redo_reason = plan.redo_reason = RedoReason(previous, report);
+  report.incremental.redo_reason = plan.redo_reason = RedoReason(previous, report);
   if (previous.usable()) plan.faces_from = options.output_path;
   return previous;
 }
@@ -177,9 +177,9 @@ std::vector<std::uint8_t> ShardFaces(const ExtractOptions& options, const Extrac
   const std::vector<std::int32_t> order = ShardOrder(inputs.base, inputs.surface);
   const ShardRange range = PlanShard(inputs.surface, settings.plan, keys, order,
                                      options.shard_index, options.shard_count);
-  report.shard_begin = range.begin;
-  report.shard_end = range.end;
-  report.shard_cost_fraction = range.cost_fraction;
+  report.shard.begin = range.begin;
+  report.shard.end = range.end;
+  report.shard.cost_fraction = range.cost_fraction;
   std::vector<std::uint8_t> in_shard(static_cast<std::size_t>(inputs.surface.num_ptex_faces()), 0);
   for (auto i = range.begin; i < range.end; ++i) {
     in_shard[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])] = 1;
@@ -201,7 +201,7 @@ Status CheckPlacementIfAsked(const ExtractOptions& options, const ExtractInputs&
     return Status::Ok();
   }
   DISPEX_ASSIGN_OR_RETURN(PlacementFit fit, MeasurePlacement(inputs, grids.get(), &settings));
-  return CheckPlacement(fit, report.base_diagonal, inputs.sculpt.source);
+  return CheckPlacement(fit, report.inputs.base_diagonal, inputs.sculpt.source);
 }
 
 // What each face is made from (face_keys.h; a vector map's: VectorFaceKeys).
@@ -214,7 +214,7 @@ FaceKeys KeyFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
   } else {
     keys = ComputeFaceKeys(inputs, settings);
   }
-  report.t_keys = clock.seconds();
+  report.times.keys = clock.seconds();
   return keys;
 }
 
@@ -222,16 +222,16 @@ FaceKeys KeyFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
 Status WritePart(const ExtractOptions& options, const ExtractInputs& inputs,
                  std::span<const std::uint8_t> in_shard, const ProcessedFaces& faces,
                  PtexWriter& writer, ExtractReport& report) {
-  report.faces_extracted = -faces.faces_copied;
+  report.incremental.faces_extracted = -faces.faces_copied;
   for (std::size_t f = 0; f < in_shard.size(); ++f) {
-    report.faces_extracted +=
+    report.incremental.faces_extracted +=
         in_shard[f] && !inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)));
   }
   ShardInfo info;
   info.index = options.shard_index;
   info.count = options.shard_count;
-  info.begin = report.shard_begin;
-  info.end = report.shard_end;
+  info.begin = report.shard.begin;
+  info.end = report.shard.end;
   info.map_inputs_key = InputsKey(report).Hex();
   info.base_path = std::filesystem::absolute(options.base_path).lexically_normal().string();
   info.sculpt_path = std::filesystem::absolute(options.sculpt_path).lexically_normal().string();
@@ -244,24 +244,25 @@ Status WritePart(const ExtractOptions& options, const ExtractInputs& inputs,
 Status WriteMap(const ExtractOptions& options, ExtractInputs& inputs,
                 const ExtractSettings& settings, ProcessedFaces& faces, PtexWriter& writer,
                 const Stopwatch& faces_clock, ExtractReport& report) {
-  report.faces_extracted = static_cast<std::int64_t>(inputs.surface.num_ptex_faces()) -
-                           faces.faces_copied - inputs.surface.stats().hole_ptex_faces;
+  report.incremental.faces_extracted = static_cast<std::int64_t>(inputs.surface.num_ptex_faces()) -
+                                       faces.faces_copied - inputs.surface.stats().hole_ptex_faces;
   DISPEX_RETURN_IF_ERROR(FillMissedFaces(options, inputs, faces, writer, report));
   if (settings.watertight != WatertightEdges::kOff) {
     DISPEX_RETURN_IF_ERROR(MatchEdges(inputs, settings, faces, report));
     for (std::size_t f = 0; f < faces.redone.size(); ++f) {
-      report.faces_copied_redone += faces.copied[f] && faces.redone[f];
+      report.incremental.faces_copied_redone += faces.copied[f] && faces.redone[f];
     }
     if (inputs.widened) {
-      report.tracer += inputs.traced.empty()
-                           ? std::string("; then the whole sculpt, for faces the edges raised")
-                           : fmt::format("; then {} of {} sculpt faces, for faces the edges raised",
-                                         inputs.traced_part.num_faces(), report.sculpt_faces);
+      report.tracer +=
+          inputs.traced.empty()
+              ? std::string("; then the whole sculpt, for faces the edges raised")
+              : fmt::format("; then {} of {} sculpt faces, for faces the edges raised",
+                            inputs.traced_part.num_faces(), report.inputs.sculpt_faces);
     }
     DISPEX_RETURN_IF_ERROR(WriteKeptFaces(writer, inputs, faces));
   }
   ListDiscontinuousFaces(inputs, faces, report);
-  report.t_sample_trace = faces_clock.seconds();
+  report.times.sample_trace = faces_clock.seconds();
   if (inputs.mapping != nullptr) ReportMapping(inputs, faces, report);
   DISPEX_RETURN_IF_ERROR(AddFaceTotals(options, inputs, settings, faces, report));
   DISPEX_RETURN_IF_ERROR(CommitMap(writer, inputs, inputs.face_keys->keys, faces, report));
@@ -273,7 +274,7 @@ Status WriteMap(const ExtractOptions& options, ExtractInputs& inputs,
 
 ExtractReport Finished(ExtractReport report, const Stopwatch& total_clock) {
   report.peak_rss_bytes = PeakResidentBytes();
-  report.t_total = total_clock.seconds();
+  report.times.total = total_clock.seconds();
   return report;
 }
 
@@ -311,10 +312,10 @@ ExtractReport StartReport(const ExtractOptions& options, int threads) {
   ExtractReport report;
   report.version = Version();
   report.options = options;
-  report.base_path = options.base_path;
-  report.sculpt_path = options.sculpt_path;
-  report.output_path = options.output_path;
-  report.threads = threads;
+  report.inputs.base_path = options.base_path;
+  report.inputs.sculpt_path = options.sculpt_path;
+  report.output.path = options.output_path;
+  report.settings.threads = threads;
   return report;
 }
 
@@ -334,7 +335,7 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   // of ShardSculpt::kPart trace only the sculpt within reach of the faces it extracts.
   DISPEX_RETURN_IF_ERROR(options.vector ? MatchVectorSculpt(options, inputs, report)
                                         : ChooseMethod(options, inputs, report));
-  plan.method = report.method;
+  plan.method = report.method.used;
   const bool shard = options.shard_count > 0;
   const bool traced = !options.vector && inputs.mapping == nullptr;
   const bool within_reach = traced &&
@@ -377,9 +378,9 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   DISPEX_ASSIGN_OR_RETURN(ProcessedFaces faces,
                           ProcessFaces(inputs, settings, &previous, sources, options.progress,
                                        options.progress_counter, writer));
-  report.faces_copied = faces.faces_copied;
+  report.incremental.faces_copied = faces.faces_copied;
   if (shard) {
-    report.t_sample_trace = faces_clock.seconds();
+    report.times.sample_trace = faces_clock.seconds();
     DISPEX_RETURN_IF_ERROR(WritePart(options, inputs, in_shard, faces, writer, report));
   } else {
     DISPEX_RETURN_IF_ERROR(WriteMap(options, inputs, settings, faces, writer, faces_clock, report));

@@ -58,16 +58,17 @@ StatusOr<MeshesRead> ReadMeshes(const ExtractOptions& options, ExtractReport& re
     group.run([&] {
       Stopwatch clock;
       sculpt_read.emplace(ReadOrCopy(options.sculpt_path, options.sculpt_mesh, read_options));
-      report.t_read_sculpt = clock.seconds();
-      if (sculpt_read->ok()) report.sculpt_fingerprint = MeshFingerprint(sculpt_read->value());
+      report.times.read_sculpt = clock.seconds();
+      if (sculpt_read->ok())
+        report.inputs.sculpt_fingerprint = MeshFingerprint(sculpt_read->value());
     });
     Stopwatch clock;
     base_read.emplace(ReadOrCopy(options.base_path, options.base_mesh, read_options));
-    report.t_read_base = clock.seconds();
+    report.times.read_base = clock.seconds();
     if (base_read->ok()) {
       clock.Reset();
       surface_built.emplace(LimitSurface::Build(base_read->value()));
-      report.t_topology = clock.seconds();
+      report.times.topology = clock.seconds();
     }
     group.wait();
   }
@@ -75,20 +76,20 @@ StatusOr<MeshesRead> ReadMeshes(const ExtractOptions& options, ExtractReport& re
   if (!surface_built->ok()) return surface_built->status();
   if (!sculpt_read->ok()) return sculpt_read->status();
   if (CancelRequested()) return Cancelled();
-  report.base_fingerprint = MeshFingerprint(base_read->value());
+  report.inputs.base_fingerprint = MeshFingerprint(base_read->value());
   return MeshesRead{std::move(*base_read).value(), std::move(*sculpt_read).value(),
                     std::move(*surface_built).value()};
 }
 
 void ReportMeshes(const ExtractOptions& options, const MeshesRead& meshes, ExtractReport& report) {
   const LimitSurfaceStats surface_stats = meshes.surface.stats();
-  report.base_vertices = meshes.base.num_vertices();
-  report.base_faces = meshes.base.num_faces();
-  report.ptex_faces = static_cast<std::size_t>(meshes.surface.num_ptex_faces());
-  report.hole_faces = static_cast<std::size_t>(surface_stats.hole_ptex_faces);
-  report.inf_sharp_edges = surface_stats.inf_sharp_edges;
-  report.sculpt_vertices = meshes.sculpt.num_vertices();
-  report.sculpt_faces = meshes.sculpt.num_faces();
+  report.inputs.base_vertices = meshes.base.num_vertices();
+  report.inputs.base_faces = meshes.base.num_faces();
+  report.inputs.ptex_faces = static_cast<std::size_t>(meshes.surface.num_ptex_faces());
+  report.inputs.hole_faces = static_cast<std::size_t>(surface_stats.hole_ptex_faces);
+  report.inputs.inf_sharp_edges = surface_stats.inf_sharp_edges;
+  report.inputs.sculpt_vertices = meshes.sculpt.num_vertices();
+  report.inputs.sculpt_faces = meshes.sculpt.num_faces();
   for (std::string& w : IgnoredTagWarnings(meshes.base)) report.warnings.push_back(std::move(w));
   if (surface_stats.inf_sharp_edges > 0) {
     report.warnings.push_back(fmt::format(
@@ -96,7 +97,7 @@ void ReportMeshes(const ExtractOptions& options, const MeshesRead& meshes, Extra
         "opens a gap or an overlap along them",
         options.base_path, surface_stats.inf_sharp_edges));
   }
-  report.base_diagonal = ComputeBounds(meshes.base).diagonal();
+  report.inputs.base_diagonal = ComputeBounds(meshes.base).diagonal();
 }
 
 Status CheckMemoryForInputs(const ExtractOptions& options, const MeshesRead& meshes,
@@ -141,11 +142,11 @@ StatusOr<ExtractInputs> ReadInputs(const ExtractOptions& options, std::uint64_t 
 
 StatusOr<ExtractInputs> InputsFromMeshes(const ExtractOptions& options, Mesh base, Mesh sculpt,
                                          std::uint64_t memory_limit, ExtractReport& report) {
-  report.base_fingerprint = MeshFingerprint(base);
-  report.sculpt_fingerprint = MeshFingerprint(sculpt);
+  report.inputs.base_fingerprint = MeshFingerprint(base);
+  report.inputs.sculpt_fingerprint = MeshFingerprint(sculpt);
   Stopwatch clock;
   DISPEX_ASSIGN_OR_RETURN(LimitSurface surface, LimitSurface::Build(base));
-  report.t_topology = clock.seconds();
+  report.times.topology = clock.seconds();
   return FinishInputs(options, MeshesRead{std::move(base), std::move(sculpt), std::move(surface)},
                       memory_limit, report);
 }
@@ -170,7 +171,7 @@ Status BuildTracer(const ExtractOptions& options, ExtractInputs& inputs, Extract
   SetTracerOptions(options, inputs);
   inputs.traced.clear();
   DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, inputs.tracer_options));
-  report.t_bvh += clock.seconds();
+  report.times.bvh += clock.seconds();
   report.tracer = inputs.tracer->stats().backend;
   if (CancelRequested()) return Cancelled();
   return Status::Ok();
@@ -191,16 +192,16 @@ Status BuildPartTracer(Mesh part, std::vector<std::uint8_t> traced, ExtractInput
     inputs.traced.clear();
     inputs.traced_part = Mesh{};
     DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, inputs.tracer_options));
-    report.t_bvh += clock.seconds();
+    report.times.bvh += clock.seconds();
     report.tracer = inputs.tracer->stats().backend;
     return Status::Ok();
   }
   DISPEX_ASSIGN_OR_RETURN(inputs.tracer,
                           MakeEmbreeTracer(inputs.traced_part, inputs.tracer_options));
-  report.t_bvh += clock.seconds();
-  report.tracer =
-      inputs.tracer->stats().backend +
-      fmt::format(", {} of {} sculpt faces", inputs.traced_part.num_faces(), report.sculpt_faces);
+  report.times.bvh += clock.seconds();
+  report.tracer = inputs.tracer->stats().backend + fmt::format(", {} of {} sculpt faces",
+                                                               inputs.traced_part.num_faces(),
+                                                               report.inputs.sculpt_faces);
   return Status::Ok();
 }
 

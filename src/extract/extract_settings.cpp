@@ -17,7 +17,7 @@ namespace {
 // The longer search for samples that missed: this many times the automatic search distance.
 constexpr double kRetryFactor = 4.0;
 // Through the correspondence, the longest hit kept over the largest vertex offset the match
-// measured (ExtractReport::mapping_sheet_bound).
+// measured (ExtractReport::method.sheet_bound).
 constexpr double kSheetFactor = 2.0;
 
 // Automatic values measured over the whole sculpt are kept to a few significant bits, so that
@@ -37,59 +37,64 @@ double RoundToBits(double x, int bits, bool up) {
 }
 
 Status ResolveTolerance(const ExtractOptions& options, const Mesh& sculpt, ExtractReport& report) {
-  report.sculpt_median_edge = MedianEdgeLength(sculpt);
-  report.tolerance_auto = options.tolerance <= 0;
-  report.tolerance =
-      report.tolerance_auto
-          ? RoundToBits(options.tolerance_fraction * report.sculpt_median_edge, kToleranceBits,
+  report.inputs.sculpt_median_edge = MedianEdgeLength(sculpt);
+  report.settings.tolerance_auto = options.tolerance <= 0;
+  report.settings.tolerance =
+      report.settings.tolerance_auto
+          ? RoundToBits(options.tolerance_fraction * report.inputs.sculpt_median_edge,
+                        kToleranceBits,
                         /*up=*/false)
           : options.tolerance;
-  if (!(report.tolerance > 0)) {
+  if (!(report.settings.tolerance > 0)) {
     return Status::Error(
         fmt::format("{}: cannot derive a tolerance (median edge length {}); "
                     "set tolerance",
-                    options.sculpt_path, report.sculpt_median_edge));
+                    options.sculpt_path, report.inputs.sculpt_median_edge));
   }
   return Status::Ok();
 }
 
 Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs& inputs,
                               const CoarseSampling& coarse, ExtractReport& report) {
-  report.search_distance_auto = options.search_distance.kind == SearchDistanceSpec::Kind::kAuto;
-  if (report.search_distance_auto) {
+  report.settings.search_distance_auto =
+      options.search_distance.kind == SearchDistanceSpec::Kind::kAuto;
+  if (report.settings.search_distance_auto) {
     auto estimate = inputs.mapping
-                        ? EstimateSearchDistanceMapped(inputs, coarse, report.base_diagonal)
+                        ? EstimateSearchDistanceMapped(inputs, coarse, report.inputs.base_diagonal)
                         : EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals,
-                                                 report.base_diagonal);
+                                                 report.inputs.base_diagonal);
     if (!estimate.ok()) {
       return Status::Error(StatusCode::kMismatch,
                            fmt::format("{} and {} do not overlap: {}", options.base_path,
                                        options.sculpt_path, estimate.status().message()));
     }
-    report.search_estimate = *estimate;
-    report.search_distance = std::min(
+    report.settings.search_estimate = *estimate;
+    report.settings.search_distance = std::min(
         RoundToBits(estimate->distance, kSearchDistanceBits, /*up=*/true), estimate->ray_length);
   } else {
-    DISPEX_ASSIGN_OR_RETURN(report.search_distance,
-                            ResolveSearchDistance(options.search_distance, report.base_diagonal));
+    DISPEX_ASSIGN_OR_RETURN(
+        report.settings.search_distance,
+        ResolveSearchDistance(options.search_distance, report.inputs.base_diagonal));
   }
   // With an automatic search distance, samples that missed get a second, longer search: the
   // sparse estimate can miss thin or strongly curved parts where the sculpt is farther from
   // the limit surface than almost everywhere else.
-  report.retry_search_distance =
-      report.search_distance_auto
-          ? std::max(report.search_distance, std::min(kRetryFactor * report.search_distance,
-                                                      report.search_estimate.ray_length))
+  report.sampling.retry_search_distance =
+      report.settings.search_distance_auto
+          ? std::max(report.settings.search_distance,
+                     std::min(kRetryFactor * report.settings.search_distance,
+                              report.settings.search_estimate.ray_length))
           : 0.0;
   // Through the correspondence, a hit farther than the match's own offsets is another sheet of
   // the sculpt (a crease corner's far side, a fold), not the one over the sample: a miss.
   // (Plus a median sculpt edge: the flat quads sag from their vertices by a fraction of one.)
   if (inputs.mapping != nullptr) {
-    report.mapping_sheet_bound =
-        kSheetFactor * report.mapping_max_offset + report.sculpt_median_edge;
-    report.search_distance = std::min(report.search_distance, report.mapping_sheet_bound);
-    report.retry_search_distance =
-        std::min(report.retry_search_distance, report.mapping_sheet_bound);
+    report.method.sheet_bound =
+        kSheetFactor * report.method.max_offset + report.inputs.sculpt_median_edge;
+    report.settings.search_distance =
+        std::min(report.settings.search_distance, report.method.sheet_bound);
+    report.sampling.retry_search_distance =
+        std::min(report.sampling.retry_search_distance, report.method.sheet_bound);
   }
   return Status::Ok();
 }
@@ -112,19 +117,19 @@ StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
         PlanOversampling(inputs.surface, inputs.sculpt, coarse.face_areas, options.oversample,
                          options.min_oversample, options.max_oversample);
   }
-  report.oversample_subdivision_level = settings.plan.subdivision_level;
-  report.t_search = clock.seconds();
+  report.sampling.oversample_subdivision_level = settings.plan.subdivision_level;
+  report.times.search = clock.seconds();
 
-  settings.search_distance = report.search_distance;
-  settings.query.distance = static_cast<float>(report.search_distance);
+  settings.search_distance = report.settings.search_distance;
+  settings.query.distance = static_cast<float>(report.settings.search_distance);
   settings.query.policy = options.ray_policy;
   settings.retry_query = settings.query;
-  settings.retry_query.distance = static_cast<float>(report.retry_search_distance);
+  settings.retry_query.distance = static_cast<float>(report.sampling.retry_search_distance);
   settings.mapping = inputs.mapping != nullptr;
   settings.interpolate = inputs.interpolate;
   settings.vector = options.vector;
   settings.spectral.rule = options.resolution_rule;
-  settings.spectral.tolerance = report.tolerance;
+  settings.spectral.tolerance = report.settings.tolerance;
   settings.spectral.nonzero_threshold = options.nonzero_threshold;
   settings.spectral.fixed_ulog2 = options.fixed_ulog2;
   settings.spectral.fixed_vlog2 = options.fixed_vlog2;
@@ -133,15 +138,15 @@ StatusOr<ExtractSettings> ResolveSettings(const ExtractOptions& options,
   settings.watertight = options.resolution_rule == ResolutionRule::kErrorBound
                             ? options.watertight
                             : WatertightEdges::kOff;
-  settings.edge_step_budget = report.tolerance;
+  settings.edge_step_budget = report.settings.tolerance;
   settings.max_samples_log2 = std::bit_width(static_cast<unsigned>(options.max_oversample)) - 1;
   // For faces read on their own (kAll): edge texels hold the edge's values, and each side of
   // an edge stays within half the tolerance of them, so two faces meet within the tolerance.
   if (settings.watertight == WatertightEdges::kAll) {
     settings.spectral.pin_edges = true;
-    settings.spectral.edge_tolerance = 0.5 * report.tolerance;
+    settings.spectral.edge_tolerance = 0.5 * report.settings.tolerance;
   }
-  report.watertight = settings.watertight;
+  report.edges.rule = settings.watertight;
   return settings;
 }
 

@@ -16,18 +16,19 @@ void SumFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
   for (int f = 0; f < inputs.surface.num_ptex_faces(); ++f) {
     const FaceStats& r = faces.stats[static_cast<std::size_t>(f)];
     if (inputs.surface.is_hole(PtexFaceId(f))) continue;
-    report.oversample_faces[settings.plan.log2[static_cast<std::size_t>(f)]]++;
-    report.samples += r.samples;
-    report.misses += r.misses;
-    report.misses_recovered += r.recovered;
-    report.holes_filled += r.filled;
-    report.faces_with_misses += r.misses > 0;
-    report.hits_negative += r.hits_negative;
+    report.sampling.oversample_faces[settings.plan.log2[static_cast<std::size_t>(f)]]++;
+    report.sampling.samples += r.samples;
+    report.sampling.misses += r.misses;
+    report.sampling.misses_recovered += r.recovered;
+    report.sampling.holes_filled += r.filled;
+    report.sampling.faces_with_misses += r.misses > 0;
+    report.sampling.hits_negative += r.hits_negative;
     // A vector map's samples are read through the correspondence: no rays, no hits.
-    if (!settings.vector) report.hits_positive += r.samples - r.misses - r.hits_negative;
-    report.hits_opposed += r.hits_opposed;
-    report.vector_length_max = std::max(report.vector_length_max, r.length_max);
-    report.vector_tangential_max = std::max(report.vector_tangential_max, r.tangential_max);
+    if (!settings.vector) report.sampling.hits_positive += r.samples - r.misses - r.hits_negative;
+    report.sampling.hits_opposed += r.hits_opposed;
+    report.displacement.length_max = std::max(report.displacement.length_max, r.length_max);
+    report.displacement.tangential_max =
+        std::max(report.displacement.tangential_max, r.tangential_max);
     if (r.all_missed) {
       SpectralFaceStats constant;
       constant.texels_before = r.samples;
@@ -38,16 +39,19 @@ void SumFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
       report.spectral.Add(r.spectral, r.ulog2, r.vlog2);
     }
     sum_squares += r.sum_squares;
-    report.displacement_min = first ? r.min : std::min<double>(report.displacement_min, r.min);
-    report.displacement_max = first ? r.max : std::max<double>(report.displacement_max, r.max);
+    report.displacement.min = first ? r.min : std::min<double>(report.displacement.min, r.min);
+    report.displacement.max = first ? r.max : std::max<double>(report.displacement.max, r.max);
     first = false;
   }
-  report.displacement_rms = report.samples ? std::sqrt(sum_squares / double(report.samples)) : 0;
-  report.miss_fraction = report.samples ? double(report.misses) / double(report.samples) : 0;
+  report.displacement.rms =
+      report.sampling.samples ? std::sqrt(sum_squares / double(report.sampling.samples)) : 0;
+  report.sampling.miss_fraction =
+      report.sampling.samples ? double(report.sampling.misses) / double(report.sampling.samples)
+                              : 0;
 }
 
 Status CheckMissFraction(const ExtractOptions& options, const ExtractReport& report) {
-  if (!(report.miss_fraction > options.max_miss_fraction)) return Status::Ok();
+  if (!(report.sampling.miss_fraction > options.max_miss_fraction)) return Status::Ok();
   return Status::Error(
       StatusCode::kMismatch,
       fmt::format(
@@ -55,11 +59,12 @@ Status CheckMissFraction(const ExtractOptions& options, const ExtractReport& rep
           "{:.6g} ({}){}, more than max_miss_fraction ({:.4g}%): the sculpt covers only part of {} "
           "or is not aligned with it; align the meshes, give a longer search_distance, or raise "
           "max_miss_fraction",
-          100 * report.miss_fraction, report.misses, report.samples, options.sculpt_path,
-          report.search_distance,
+          100 * report.sampling.miss_fraction, report.sampling.misses, report.sampling.samples,
+          options.sculpt_path, report.settings.search_distance,
           options.search_distance.kind == SearchDistanceSpec::Kind::kAuto ? "automatic" : "given",
-          report.retry_search_distance > report.search_distance
-              ? fmt::format(" (and {:.6g} on the second search)", report.retry_search_distance)
+          report.sampling.retry_search_distance > report.settings.search_distance
+              ? fmt::format(" (and {:.6g} on the second search)",
+                            report.sampling.retry_search_distance)
               : "",
           100 * options.max_miss_fraction, options.base_path));
 }
@@ -73,21 +78,21 @@ Status AddFaceTotals(const ExtractOptions& options, const ExtractInputs& inputs,
   DISPEX_RETURN_IF_ERROR(CheckMissFraction(options, report));
   // A sculpt that is the base refined is read reversed when it winds the other way
   // (MatchSculpt); any other can only be named.
-  const std::int64_t hits = report.samples - report.misses;
-  if (hits > 0 && 2 * report.hits_opposed > hits) {
+  const std::int64_t hits = report.sampling.samples - report.sampling.misses;
+  if (hits > 0 && 2 * report.sampling.hits_opposed > hits) {
     report.warnings.push_back(fmt::format(
         "{} of {} hits are on sculpt faces facing against the base's normal: {} may wind the "
         "other way from {} (flipped normals), and edges beside those faces are not held; "
         "reverse its faces",
-        report.hits_opposed, hits, options.sculpt_path, options.base_path));
+        report.sampling.hits_opposed, hits, options.sculpt_path, options.base_path));
   }
   const WorkerTotals& w = faces.workers;
-  report.rays_cast += w.rays_cast;
-  report.cpu_limit += w.cpu_limit;
-  report.cpu_trace += w.cpu_trace;
-  report.cpu_spectral += w.cpu_spectral;
-  report.cpu_compress += w.cpu_write;
-  report.fallback_normals += w.fallback_normals;
+  report.sampling.rays_cast += w.rays_cast;
+  report.times.cpu_limit += w.cpu_limit;
+  report.times.cpu_trace += w.cpu_trace;
+  report.times.cpu_spectral += w.cpu_spectral;
+  report.times.cpu_compress += w.cpu_write;
+  report.sampling.fallback_normals += w.fallback_normals;
   return inputs.tracer ? inputs.tracer->status() : Status::Ok();
 }
 

@@ -21,7 +21,7 @@ Status FillMissedFaces(const ExtractOptions& options, const ExtractInputs& input
         StatusCode::kMismatch,
         fmt::format(
             "no ray from {} hit {} within the search distance {:.6g}: the meshes do not overlap",
-            options.base_path, options.sculpt_path, report.search_distance));
+            options.base_path, options.sculpt_path, report.settings.search_distance));
   }
   CrossFaceFill cross = FillEmptyFaces(has_values, faces.edge_means, inputs.faces);
   std::int64_t filled = 0;
@@ -38,8 +38,8 @@ Status FillMissedFaces(const ExtractOptions& options, const ExtractInputs& input
     if (has_values[f] || inputs.surface.is_hole(PtexFaceId(f))) continue;
     DISPEX_RETURN_IF_ERROR(WriteConstantFace(writer, inputs, PtexFaceId(f), 0.0f));
   }
-  report.faces_filled_from_neighbours = filled;
-  report.faces_unreachable = static_cast<std::int64_t>(cross.unreachable);
+  report.sampling.faces_filled_from_neighbours = filled;
+  report.sampling.faces_unreachable = static_cast<std::int64_t>(cross.unreachable);
   if (cross.unreachable > 0) {
     report.warnings.push_back(fmt::format(
         "{} Ptex faces missed the sculpt entirely and have no neighbour with values: written "

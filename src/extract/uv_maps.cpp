@@ -84,17 +84,18 @@ std::vector<std::pair<std::string, std::string>> TileAttributes(const ExtractOpt
        "face-varying linear (OpenSubdiv FVAR_LINEAR_ALL; Blender Subdivision Surface UV "
        "Smooth: None); texel (i, j) centred at ((i+0.5)/N, (j+0.5)/N) of its UDIM tile"},
       {"dispex:padding", fmt::format("{}", options.uv_padding)},
-      {"dispex:base", report.base_path},
-      {"dispex:sculpt", report.sculpt_path},
-      {"dispex:base_fingerprint", report.base_fingerprint},
-      {"dispex:sculpt_fingerprint", report.sculpt_fingerprint},
+      {"dispex:base", report.inputs.base_path},
+      {"dispex:sculpt", report.inputs.sculpt_path},
+      {"dispex:base_fingerprint", report.inputs.base_fingerprint},
+      {"dispex:sculpt_fingerprint", report.inputs.sculpt_fingerprint},
       // The Ptex map's tolerance, which verify's truth bounds scale with (the texels
       // themselves are samples, not fitted to it).
-      {"dispex:tolerance", fmt::format("{}", report.tolerance)},
+      {"dispex:tolerance", fmt::format("{}", report.settings.tolerance)},
   };
   // A vector map's samples read the correspondence: no rays, no search distance.
   if (!vector) {
-    attributes.emplace_back("dispex:search_distance", fmt::format("{}", report.search_distance));
+    attributes.emplace_back("dispex:search_distance",
+                            fmt::format("{}", report.settings.search_distance));
   }
   return attributes;
 }
@@ -268,11 +269,11 @@ Status ExtractTexels(const ExtractSettings& settings, const ExtractInputs& input
 // The raster's and the misses' part of the report, and their warnings.
 void ReportTexels(const ExtractOptions& options, const UvRaster& raster,
                   const std::vector<std::int64_t>& face_misses, ExtractReport& report) {
-  for (std::int64_t m : face_misses) report.uv_texels_missed += m;
-  report.uv_texels_inside = raster.inside;
-  report.uv_overlap_texels = raster.overlap_texels;
-  report.uv_overlap_faces = raster.overlap_faces;
-  report.uv_faces_outside_udim = raster.faces_outside_udim;
+  for (std::int64_t m : face_misses) report.uv.texels_missed += m;
+  report.uv.texels_inside = raster.inside;
+  report.uv.overlap_texels = raster.overlap_texels;
+  report.uv.overlap_faces = raster.overlap_faces;
+  report.uv.faces_outside_udim = raster.faces_outside_udim;
   if (raster.overlap_texels > 0) {
     report.warnings.push_back(fmt::format(
         "{}: {} texel centres of the UV maps lie in more than one UV face (overlapping UVs, "
@@ -293,10 +294,10 @@ void ReportTexels(const ExtractOptions& options, const UvRaster& raster,
         "texel, no texel centre inside ({})",
         options.base_path, tile.udim, tile.faces.size(), FaceList(tile.faces)));
   }
-  if (report.uv_texels_missed > 0) {
+  if (report.uv.texels_missed > 0) {
     report.warnings.push_back(
         fmt::format("{} of {} UV map texels missed the sculpt and were filled by dilation",
-                    report.uv_texels_missed, raster.inside));
+                    report.uv.texels_missed, raster.inside));
   }
 }
 
@@ -330,7 +331,7 @@ Status WriteTiles(const ExtractOptions& options, const UvRaster& raster, int cha
   }
   // All the tiles or none: a failure leaves the previous run's set as it was.
   DISPEX_RETURN_IF_ERROR(WriteUvMapTiles(paths, out, options.data_type == PtexDataType::kHalf));
-  report.uv_map_paths = paths;
+  report.uv.paths = paths;
   const std::set<std::string> written(paths.begin(), paths.end());
   RemoveStaleTiles(options.uv_maps_dir, shape, written, report);
   return Status::Ok();
@@ -357,7 +358,7 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
       ExtractTexels(settings, inputs, correspondence, vector, raster, by_face, tiles, face_misses));
   ReportTexels(options, raster, face_misses, report);
   DISPEX_RETURN_IF_ERROR(WriteTiles(options, raster, channels, tiles, report));
-  report.t_uv_maps = clock.seconds();
+  report.times.uv_maps = clock.seconds();
   return Status::Ok();
 }
 

@@ -107,11 +107,11 @@ void ScaleTangentChannels(std::span<float> channels, float scale) {
 
 Status MatchVectorSculpt(const ExtractOptions& options, ExtractInputs& inputs,
                          ExtractReport& report) {
-  report.vector_space = std::string(VectorSpaceName(*options.vector));
+  report.displacement.vector_space = std::string(VectorSpaceName(*options.vector));
   Stopwatch clock;
   MatchOptions match;
-  match.threads = report.threads;
-  DISPEX_ASSIGN_OR_RETURN(match.max_offset, OffsetBound(options, report.base_diagonal));
+  match.threads = report.settings.threads;
+  DISPEX_ASSIGN_OR_RETURN(match.max_offset, OffsetBound(options, report.inputs.base_diagonal));
   auto correspondence = MatchSculpt(match, inputs, report);
   if (!correspondence.ok()) {
     return Status::Error(fmt::format(
@@ -119,17 +119,17 @@ Status MatchVectorSculpt(const ExtractOptions& options, ExtractInputs& inputs,
         "there is none: {}",
         correspondence.status().message()));
   }
-  report.t_match = clock.seconds();
-  report.mapping_levels = correspondence->levels;
-  report.mapping_max_offset = correspondence->max_offset;
-  report.mapping_rms_offset = correspondence->rms_offset;
-  report.search_distance = match.max_offset;
+  report.times.match = clock.seconds();
+  report.method.levels = correspondence->levels;
+  report.method.max_offset = correspondence->max_offset;
+  report.method.rms_offset = correspondence->rms_offset;
+  report.settings.search_distance = match.max_offset;
   inputs.correspondence = std::make_unique<SculptCorrespondence>(std::move(*correspondence));
   inputs.interpolate = options.method != ExtractMethod::kMapping;
   if (inputs.interpolate) {
     inputs.grids = std::make_unique<CorrespondenceGrids>(*inputs.correspondence, inputs.faces);
   }
-  report.method = inputs.interpolate ? ExtractMethod::kInterpolate : ExtractMethod::kMapping;
+  report.method.used = inputs.interpolate ? ExtractMethod::kInterpolate : ExtractMethod::kMapping;
   return Status::Ok();
 }
 

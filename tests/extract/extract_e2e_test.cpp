@@ -76,51 +76,55 @@ TEST_P(ExtractRealCages, MapMatchesTheKnownDisplacementAndTheReportAddsUp) {
   ASSERT_NE(map->FindMetaData("PtexFaceVertCounts"), nullptr);
 
   // The report adds up.
-  EXPECT_EQ(report->ptex_faces, static_cast<std::size_t>(faces->num_faces()));
+  EXPECT_EQ(report->inputs.ptex_faces, static_cast<std::size_t>(faces->num_faces()));
   EXPECT_EQ(report->spectral.texels_after, texels);
   std::int64_t samples = 0;
-  for (std::size_t k = 0; k < report->oversample_faces.size(); ++k) {
-    samples += report->oversample_faces[k] << (2 * k);
+  for (std::size_t k = 0; k < report->sampling.oversample_faces.size(); ++k) {
+    samples += report->sampling.oversample_faces[k] << (2 * k);
   }
-  EXPECT_EQ(report->samples, samples);
+  EXPECT_EQ(report->sampling.samples, samples);
   EXPECT_EQ(report->spectral.texels_before, samples);
   // A refined sculpt's vertex displacements are interpolated through the subdivision
   // correspondence (ExtractMethod::kAuto): no rays.
-  EXPECT_EQ(report->method, density == 0 ? ExtractMethod::kInterpolate : ExtractMethod::kRays);
-  const std::int64_t traced = report->method == ExtractMethod::kRays ? samples : 0;
-  EXPECT_GE(report->rays_cast, static_cast<std::uint64_t>(traced));
-  EXPECT_LE(report->rays_cast, static_cast<std::uint64_t>(3 * traced));
-  EXPECT_EQ(report->hits_positive + report->hits_negative + report->misses, samples);
-  EXPECT_EQ(report->misses, 0);
-  EXPECT_EQ(report->hits_opposed, 0);  // the sculpt does not fold
-  EXPECT_LE(report->spectral.max_measured_error, report->tolerance);
+  EXPECT_EQ(report->method.used, density == 0 ? ExtractMethod::kInterpolate : ExtractMethod::kRays);
+  const std::int64_t traced = report->method.used == ExtractMethod::kRays ? samples : 0;
+  EXPECT_GE(report->sampling.rays_cast, static_cast<std::uint64_t>(traced));
+  EXPECT_LE(report->sampling.rays_cast, static_cast<std::uint64_t>(3 * traced));
+  EXPECT_EQ(
+      report->sampling.hits_positive + report->sampling.hits_negative + report->sampling.misses,
+      samples);
+  EXPECT_EQ(report->sampling.misses, 0);
+  EXPECT_EQ(report->sampling.hits_opposed, 0);  // the sculpt does not fold
+  EXPECT_LE(report->spectral.max_measured_error, report->settings.tolerance);
   if (density == 0) {
     // A level-3 sculpt of the cage: 2^4 samples per side on quads, 2^3 on n-gon sub-faces.
-    EXPECT_EQ(report->oversample_subdivision_level, 3);
-    EXPECT_EQ(report->oversample_faces[0] + report->oversample_faces[1] +
-                  report->oversample_faces[2] + report->oversample_faces[5],
+    EXPECT_EQ(report->sampling.oversample_subdivision_level, 3);
+    EXPECT_EQ(report->sampling.oversample_faces[0] + report->sampling.oversample_faces[1] +
+                  report->sampling.oversample_faces[2] + report->sampling.oversample_faces[5],
               0);
   } else {
     // Not a subdivision of the base: by the sculpt's density (the area-based path), about
     // two samples per cell side on average (per face it follows the face's area, not its
     // cells: small n-gon sub-faces get fewer).
-    EXPECT_EQ(report->oversample_subdivision_level, -1);
+    EXPECT_EQ(report->sampling.oversample_subdivision_level, -1);
     auto json = nlohmann::json::parse(ExtractReportJson(*report));
     EXPECT_EQ(json["statistics"]["oversample_rule"], "sculpt density");
-    EXPECT_GE(report->samples, static_cast<std::int64_t>(2 * made->faces));
+    EXPECT_GE(report->sampling.samples, static_cast<std::int64_t>(2 * made->faces));
   }
 
   // Sign and magnitude: the map against the exact displacement, with verify's bounds
   // (1.5 tolerances + 2 x the sculpt's local linear error per vertex, RMS and p99 in
   // tolerances).
   const std::string truth = make.output_path + ".truth";
-  VerifyReport checked = testing::CheckTruth(cage, options.output_path, truth, report->tolerance);
+  VerifyReport checked =
+      testing::CheckTruth(cage, options.output_path, truth, report->settings.tolerance);
   EXPECT_TRUE(checked.passed) << GetParam().what << ": " << checked.failure;
   EXPECT_TRUE(checked.truth_local_checked);
   // The same check rejects every negative control.
   for (testing::WrongMap kind : testing::kWrongMaps) {
     testing::WriteWrongMap(options.output_path, dir / "wrong.ptx", kind);
-    VerifyReport wrong = testing::CheckTruth(cage, dir / "wrong.ptx", truth, report->tolerance);
+    VerifyReport wrong =
+        testing::CheckTruth(cage, dir / "wrong.ptx", truth, report->settings.tolerance);
     EXPECT_FALSE(wrong.passed) << GetParam().what << ", " << testing::WrongMapName(kind);
   }
   MakeSculptOptions other = make;
@@ -128,7 +132,7 @@ TEST_P(ExtractRealCages, MapMatchesTheKnownDisplacementAndTheReportAddsUp) {
   other.output_path = dir / "other.obj";
   ASSERT_TRUE(MakeSculpt(other).ok());
   EXPECT_FALSE(testing::CheckTruth(cage, options.output_path, other.output_path + ".truth",
-                                   report->tolerance)
+                                   report->settings.tolerance)
                    .passed)
       << GetParam().what << ", another pattern";
 }
@@ -180,7 +184,7 @@ TEST_F(ExtractTest, OneTwoAndEightThreadsGiveIdenticalBytes) {
     o.threads = threads;
     auto report = Extract(o);
     ASSERT_TRUE(report.ok()) << report.status().message();
-    EXPECT_EQ(report->threads, threads);
+    EXPECT_EQ(report->settings.threads, threads);
     std::string bytes = testing::Slurp(o.output_path);
     ASSERT_GT(bytes.size(), 1000u);
     if (first.empty()) {
@@ -294,8 +298,8 @@ TEST(ExtractFolds, HitsOnAFoldedSculptAreCounted) {
   options.method = ExtractMethod::kMapping;  // rays (interpolated vertices meet no sheet)
   auto report = Extract(options);
   ASSERT_TRUE(report.ok()) << report.status().message();
-  EXPECT_GT(report->hits_opposed, 0);
-  EXPECT_LT(report->hits_opposed, report->samples / 10);
+  EXPECT_GT(report->sampling.hits_opposed, 0);
+  EXPECT_LT(report->sampling.hits_opposed, report->sampling.samples / 10);
 }
 
 TEST_F(ExtractTest, HolesFailMakesAnyMissAnError) {

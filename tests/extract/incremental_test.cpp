@@ -50,10 +50,10 @@ std::optional<StoredFaces> ReadStoredFaces(const std::string& path) {
   return out;
 }
 
-// What ExtractReport::faces_copied_redone must be, from the maps before and after the run
-// alone: faces copied (same key, and stored as their first pass before) that are now stored
-// at another resolution than their first pass -- raised by the edges, the only stage that
-// changes a face after its first pass.
+// What ExtractReport::incremental.faces_copied_redone must be, from the maps before and after the
+// run alone: faces copied (same key, and stored as their first pass before) that are now stored at
+// another resolution than their first pass -- raised by the edges, the only stage that changes a
+// face after its first pass.
 std::int64_t CopiedThenRaised(const std::optional<StoredFaces>& before, const StoredFaces& after) {
   if (!before || before->keys.size() != after.keys.size()) return 0;
   auto first_pass = [](const StoredFaces& m, std::size_t f) {
@@ -137,17 +137,19 @@ class Incremental : public ::testing::TestWithParam<Variant> {
     auto report = Extract(inc);
     EXPECT_TRUE(report.ok()) << what << ": " << report.status().message();
     if (!report.ok() || !expected.ok()) return {};
-    if (!report->unchanged) {
+    if (!report->incremental.unchanged) {
       const std::optional<StoredFaces> after = ReadStoredFaces(inc.output_path);
       EXPECT_TRUE(after.has_value()) << what;
       if (after) {
-        EXPECT_EQ(report->faces_copied_redone, CopiedThenRaised(before, *after)) << what;
-        redone_ += report->faces_copied_redone;
+        EXPECT_EQ(report->incremental.faces_copied_redone, CopiedThenRaised(before, *after))
+            << what;
+        redone_ += report->incremental.faces_copied_redone;
       }
     }
     EXPECT_TRUE(Slurp(inc.output_path) == Slurp(full.output_path))
-        << what << ": the incremental map differs from a full extraction (" << report->faces_copied
-        << " faces copied, " << report->faces_extracted
+        << what << ": the incremental map differs from a full extraction ("
+        << report->incremental.faces_copied << " faces copied, "
+        << report->incremental.faces_extracted
         << " extracted): " << testing::MapDifference(inc.output_path, full.output_path);
     return *report;
   }
@@ -192,7 +194,7 @@ class Incremental : public ::testing::TestWithParam<Variant> {
   }
 
   std::int64_t SurfaceFaces(const ExtractReport& r) const {
-    return static_cast<std::int64_t>(r.ptex_faces - r.hole_faces);
+    return static_cast<std::int64_t>(r.inputs.ptex_faces - r.inputs.hole_faces);
   }
 
   TempDir dir_;
@@ -205,26 +207,26 @@ class Incremental : public ::testing::TestWithParam<Variant> {
 
 TEST_P(Incremental, EveryStepEqualsAFullExtraction) {
   ExtractReport first = Step("first run, no map yet");
-  EXPECT_EQ(first.faces_copied, 0);
-  EXPECT_EQ(first.redo_reason, "no previous map");
+  EXPECT_EQ(first.incremental.faces_copied, 0);
+  EXPECT_EQ(first.incremental.redo_reason, "no previous map");
 
   // Nothing changed: the map is not rewritten.
   const auto before = std::filesystem::last_write_time(dir_ / "inc.ptx");
   ExtractReport same = Step("unchanged inputs");
-  EXPECT_TRUE(same.unchanged);
+  EXPECT_TRUE(same.incremental.unchanged);
   EXPECT_EQ(std::filesystem::last_write_time(dir_ / "inc.ptx"), before);
 
-  const double diagonal = first.base_diagonal;
+  const double diagonal = first.inputs.base_diagonal;
   for (unsigned seed : {1u, 2u, 3u}) {
     EditSculptInBall(seed, GetParam().edit_radius * diagonal, 0.002);
     ExtractReport r = Step("sculpt edited in a ball, seed " + std::to_string(seed));
-    EXPECT_FALSE(r.unchanged);
-    EXPECT_GT(r.faces_copied, 0) << "a local edit re-extracted every face";
-    EXPECT_GT(r.faces_extracted, 0);
+    EXPECT_FALSE(r.incremental.unchanged);
+    EXPECT_GT(r.incremental.faces_copied, 0) << "a local edit re-extracted every face";
+    EXPECT_GT(r.incremental.faces_extracted, 0);
     if (GetParam().local_tracer) {
       EXPECT_NE(r.tracer.find(" sculpt faces"), std::string::npos) << r.tracer;
     }
-    EXPECT_EQ(r.redo_reason, "sculpt");
+    EXPECT_EQ(r.incremental.redo_reason, "sculpt");
   }
 
   // Triangles: the sculpt is no longer the base subdivided, so where the oversampling rule
@@ -233,26 +235,26 @@ TEST_P(Incremental, EveryStepEqualsAFullExtraction) {
   if (!GetParam().vector) {
     RemeshSculptLocally(4, 0.04 * diagonal);
     ExtractReport remeshed = Step("sculpt re-meshed locally");
-    EXPECT_GT(remeshed.faces_extracted, 0);
+    EXPECT_GT(remeshed.incremental.faces_extracted, 0);
   }
 
   // A base vertex moved: the faces around it change (their limit patches), not the others.
   cage_.positions[cage_.num_vertices() / 2].x += static_cast<float>(0.002 * diagonal);
   ASSERT_TRUE(WriteObj(base_, cage_).ok());
   ExtractReport moved = Step("base vertex moved");
-  EXPECT_GT(moved.faces_copied, SurfaceFaces(moved) / 2);
-  EXPECT_LT(moved.faces_extracted, SurfaceFaces(moved) / 2);
-  EXPECT_GT(moved.faces_extracted, 0);
-  EXPECT_EQ(moved.redo_reason, "base");
+  EXPECT_GT(moved.incremental.faces_copied, SurfaceFaces(moved) / 2);
+  EXPECT_LT(moved.incremental.faces_extracted, SurfaceFaces(moved) / 2);
+  EXPECT_GT(moved.incremental.faces_extracted, 0);
+  EXPECT_EQ(moved.incremental.redo_reason, "base");
 
   // A crease on one edge of the base.
   const auto face = cage_.face(0);
   ASSERT_TRUE(
       WriteObj(base_, cage_, fmt::format("t crease 2/1/0 {} {} 2.5\n", face[0], face[1])).ok());
   ExtractReport creased = Step("crease added");
-  EXPECT_GT(creased.faces_extracted, 0);
+  EXPECT_GT(creased.incremental.faces_extracted, 0);
   if (!GetParam().auto_search_distance) {
-    EXPECT_GT(creased.faces_copied, SurfaceFaces(creased) / 2);
+    EXPECT_GT(creased.incremental.faces_copied, SurfaceFaces(creased) / 2);
   }
 
   // A map damaged since (a byte of its face data flipped): not re-used, with a warning.
@@ -266,13 +268,13 @@ TEST_P(Incremental, EveryStepEqualsAFullExtraction) {
     map.put(byte);
   }
   // An option every face depends on: nothing can be copied.
-  tolerance_ = 0.9 * first.tolerance;
+  tolerance_ = 0.9 * first.settings.tolerance;
   ExtractReport retuned = Step("tolerance changed");
-  EXPECT_EQ(retuned.faces_copied, 0);
+  EXPECT_EQ(retuned.incremental.faces_copied, 0);
   ASSERT_FALSE(retuned.warnings.empty());
   EXPECT_NE(retuned.warnings.back().find("corrupt face data"), std::string::npos)
       << retuned.warnings.back();
-  EXPECT_NE(retuned.redo_reason.find("corrupt face data"), std::string::npos);
+  EXPECT_NE(retuned.incremental.redo_reason.find("corrupt face data"), std::string::npos);
 
   // With the new option in the map, local edits are incremental again.
   // A larger bump that moves the sculpt's outermost points (which the tracer's scale once
@@ -352,13 +354,13 @@ TEST(IncrementalMaps, ASculptFaceOfManyCornersIsKeyedByEveryCorner) {
   o.incremental = true;
   auto first = Extract(o);
   ASSERT_TRUE(first.ok()) << first.status().message();
-  EXPECT_EQ(first->method, ExtractMethod::kRays);  // the sculpt is no longer the base refined
+  EXPECT_EQ(first->method.used, ExtractMethod::kRays);  // the sculpt is no longer the base refined
 
   // m moves half the search distance along the quad's normal.
   const Float3 a = at(q[0]), b = at(q[1]), c = at(q[2]), d = at(q[3]);
   const Float3 u{c.x - a.x, c.y - a.y, c.z - a.z}, v{d.x - b.x, d.y - b.y, d.z - b.z};
   const Float3 n{u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
-  const double scale = 0.005 * first->base_diagonal / std::hypot(n.x, n.y, n.z);
+  const double scale = 0.005 * first->inputs.base_diagonal / std::hypot(n.x, n.y, n.z);
   Float3& p = edited.positions[static_cast<std::size_t>(m)];
   p = {static_cast<float>(p.x + scale * n.x), static_cast<float>(p.y + scale * n.y),
        static_cast<float>(p.z + scale * n.z)};
@@ -366,16 +368,17 @@ TEST(IncrementalMaps, ASculptFaceOfManyCornersIsKeyedByEveryCorner) {
   const std::string before = Slurp(o.output_path);
   auto again = Extract(o);
   ASSERT_TRUE(again.ok()) << again.status().message();
-  EXPECT_FALSE(again->unchanged);
-  EXPECT_GT(again->faces_extracted, 0);
-  EXPECT_GT(again->faces_copied, 0) << "moving one vertex re-extracted every face";
+  EXPECT_FALSE(again->incremental.unchanged);
+  EXPECT_GT(again->incremental.faces_extracted, 0);
+  EXPECT_GT(again->incremental.faces_copied, 0) << "moving one vertex re-extracted every face";
 
   ExtractOptions full = o;
   full.incremental = false;
   full.output_path = dir / "full.ptx";
   ASSERT_TRUE(Extract(full).ok());
   EXPECT_TRUE(Slurp(o.output_path) == Slurp(full.output_path))
-      << "the incremental map differs from a full extraction (" << again->faces_extracted
+      << "the incremental map differs from a full extraction ("
+      << again->incremental.faces_extracted
       << " faces extracted): " << testing::MapDifference(o.output_path, full.output_path);
   // The edit shows in the map: a map left as it was would fail the comparison.
   const std::string old_map = dir / "before.ptx";
@@ -400,7 +403,7 @@ TEST(IncrementalMaps, AMapNotWrittenByDispexIsIgnoredWithANotice) {
     o.incremental = true;
     auto r = Extract(o);
     ASSERT_TRUE(r.ok()) << r.status().message();
-    EXPECT_EQ(r->faces_copied, 0);
+    EXPECT_EQ(r->incremental.faces_copied, 0);
     ASSERT_FALSE(r->warnings.empty());
     EXPECT_NE(r->warnings.back().find("not re-used"), std::string::npos) << r->warnings.back();
     EXPECT_EQ(Slurp(o.output_path), Slurp(dir / "full.ptx"));

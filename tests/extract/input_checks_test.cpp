@@ -69,7 +69,7 @@ TEST_P(InputChecks, ASculptMovedAsAWholeIsRefusedAndItsOwnDetailIsNot) {
   ASSERT_TRUE(MakeSculpt(make).ok());
   auto made = ExtractWith(cage, dir / "s.obj", dir);
   ASSERT_TRUE(made.ok()) << made.status().message();
-  EXPECT_EQ(made->method, jittered ? ExtractMethod::kRays : ExtractMethod::kInterpolate);
+  EXPECT_EQ(made->method.used, jittered ? ExtractMethod::kRays : ExtractMethod::kInterpolate);
   testing::fs::remove(dir / "map.ptx");
   struct Case {
     Move move;

@@ -93,15 +93,15 @@ TEST(Interpolate, SculptOnTheLimitSurfaceGivesZeroMaps) {
     auto scalar =
         Extract(MethodOptions(cage, dir / "zero.obj", dir / "h.ptx", ExtractMethod::kAuto));
     ASSERT_TRUE(scalar.ok()) << scalar.status().message();
-    EXPECT_EQ(scalar->method, ExtractMethod::kInterpolate);
-    EXPECT_EQ(scalar->rays_cast, 0u);
+    EXPECT_EQ(scalar->method.used, ExtractMethod::kInterpolate);
+    EXPECT_EQ(scalar->sampling.rays_cast, 0u);
     EXPECT_LE(LargestTexel(dir / "h.ptx"), 1e-5 * diagonal);
     for (VectorSpace space : {VectorSpace::kObject, VectorSpace::kTangent}) {
       ExtractOptions o = MethodOptions(cage, dir / "zero.obj", dir / "d.ptx", ExtractMethod::kAuto);
       o.vector = space;
       auto vector = Extract(o);
       ASSERT_TRUE(vector.ok()) << vector.status().message();
-      EXPECT_EQ(vector->method, ExtractMethod::kInterpolate);
+      EXPECT_EQ(vector->method.used, ExtractMethod::kInterpolate);
       EXPECT_LE(LargestTexel(dir / "d.ptx"), 1e-5 * diagonal) << VectorSpaceName(space);
     }
     // The control: the map of the flat quads holds their sag, far above rounding. (On the
@@ -130,12 +130,12 @@ TEST(Interpolate, ReadAtTheVerticesTheMapGivesTheirDisplacement) {
     o.oversample = 16;
     auto report = Extract(o);
     ASSERT_TRUE(report.ok()) << report.status().message();
-    ASSERT_GT(made->linear_error, 4 * report->tolerance);
+    ASSERT_GT(made->linear_error, 4 * report->settings.tolerance);
     const VerifyReport r =
-        testing::CheckTruth(cage, dir / "m.ptx", dir / "s.obj.truth", report->tolerance);
+        testing::CheckTruth(cage, dir / "m.ptx", dir / "s.obj.truth", report->settings.tolerance);
     const int k = method == ExtractMethod::kMapping;
-    rms[k] = r.truth.rms / report->tolerance;
-    p99[k] = r.truth.p99 / report->tolerance;
+    rms[k] = r.truth.rms / report->settings.tolerance;
+    p99[k] = r.truth.p99 / report->settings.tolerance;
     if (!k) {
       EXPECT_TRUE(r.passed) << r.failure;
     }
@@ -256,13 +256,15 @@ TEST(Interpolate, SharpCreaseCornersHoldNoOtherSheet) {
       const std::string map = dir / "map.ptx";
       auto report = Extract(MethodOptions(cage, dir / "sculpt.obj", map, method));
       ASSERT_TRUE(report.ok()) << report.status().message();
-      const VerifyReport checked = testing::CheckTruth(cage, map, truth, report->tolerance);
+      const VerifyReport checked =
+          testing::CheckTruth(cage, map, truth, report->settings.tolerance);
       EXPECT_TRUE(checked.truth_local_checked);
       worst[method == ExtractMethod::kRays] = checked.truth_worst_ratio;
       if (method != ExtractMethod::kAuto) continue;
       EXPECT_TRUE(checked.passed) << checked.failure;  // every bound: per record, RMS, p99
       testing::WriteWrongMap(map, dir / "wrong.ptx", testing::WrongMap::kFourFifths);
-      EXPECT_FALSE(testing::CheckTruth(cage, dir / "wrong.ptx", truth, report->tolerance).passed);
+      EXPECT_FALSE(
+          testing::CheckTruth(cage, dir / "wrong.ptx", truth, report->settings.tolerance).passed);
     }
     EXPECT_LE(worst[0], 0.5) << "interpolated: the worst record over its bound";
     EXPECT_GT(worst[1], 1.0) << "rays: the worst record over its bound";

@@ -361,15 +361,16 @@ TEST_P(MappingMaps, EveryTexelAgreesWithTheRayMap) {
     ASSERT_TRUE(report.ok()) << report.status().message();
     reports[m] = *report;
   }
-  EXPECT_EQ(reports[0].method, ExtractMethod::kMapping);
-  EXPECT_EQ(reports[0].mapping_levels, c.levels);
-  EXPECT_EQ(reports[1].method, ExtractMethod::kRays);
+  EXPECT_EQ(reports[0].method.used, ExtractMethod::kMapping);
+  EXPECT_EQ(reports[0].method.levels, c.levels);
+  EXPECT_EQ(reports[1].method.used, ExtractMethod::kRays);
   // The same automatic search distance: the same long rays, answered both ways.
-  EXPECT_EQ(reports[0].search_distance, reports[1].search_distance);
-  EXPECT_EQ(reports[0].misses, reports[1].misses);
-  EXPECT_EQ(reports[0].hits_negative, reports[1].hits_negative);
-  EXPECT_EQ(reports[0].hits_opposed, reports[1].hits_opposed);
-  EXPECT_LE(reports[0].rays_cast, reports[1].rays_cast / 10) << "the mapping cast many rays";
+  EXPECT_EQ(reports[0].settings.search_distance, reports[1].settings.search_distance);
+  EXPECT_EQ(reports[0].sampling.misses, reports[1].sampling.misses);
+  EXPECT_EQ(reports[0].sampling.hits_negative, reports[1].sampling.hits_negative);
+  EXPECT_EQ(reports[0].sampling.hits_opposed, reports[1].sampling.hits_opposed);
+  EXPECT_LE(reports[0].sampling.rays_cast, reports[1].sampling.rays_cast / 10)
+      << "the mapping cast many rays";
   const TexelComparison t = CompareTexels(paths[0], paths[1], UlpOfScale(*base));
   EXPECT_TRUE(t.same_resolutions);
   EXPECT_GT(t.texels, 0u);
@@ -413,10 +414,10 @@ TEST(MappingMaps, MappingMapsAgreeWithTheRayMaps) {
     auto rays = Extract(Options(cage, sculpt, dir / "rays.ptx", ExtractMethod::kRays));
     ASSERT_TRUE(mapping.ok() && rays.ok())
         << (mapping.ok() ? rays.status().message() : mapping.status().message());
-    EXPECT_EQ(mapping->method, ExtractMethod::kMapping);
-    EXPECT_EQ(mapping->search_distance, rays->search_distance);
+    EXPECT_EQ(mapping->method.used, ExtractMethod::kMapping);
+    EXPECT_EQ(mapping->settings.search_distance, rays->settings.search_distance);
     EXPECT_EQ(mapping->spectral.texels_after, rays->spectral.texels_after);
-    EXPECT_EQ(mapping->edge_raised_faces, rays->edge_raised_faces);
+    EXPECT_EQ(mapping->edges.raised_faces, rays->edges.raised_faces);
     const TexelComparison t =
         CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
     EXPECT_TRUE(t.same_resolutions);
@@ -437,34 +438,34 @@ TEST(MappingMethod, AutoFallsBackToRaysAndMappingFailsWithTheReason) {
           .ok());
   auto automatic = Extract(Options(cage, sculpt, dir / "auto.ptx", ExtractMethod::kAuto));
   ASSERT_TRUE(automatic.ok()) << automatic.status().message();
-  EXPECT_EQ(automatic->method, ExtractMethod::kRays);
-  EXPECT_EQ(automatic->mapping_levels, -1);
-  EXPECT_NE(automatic->mapping_reason.find("only quads"), std::string::npos)
-      << automatic->mapping_reason;
+  EXPECT_EQ(automatic->method.used, ExtractMethod::kRays);
+  EXPECT_EQ(automatic->method.levels, -1);
+  EXPECT_NE(automatic->method.reason.find("only quads"), std::string::npos)
+      << automatic->method.reason;
   const nlohmann::json json = nlohmann::json::parse(ExtractReportJson(*automatic));
   EXPECT_EQ(json["method"]["used"], "rays");
 
   auto forced = Extract(Options(cage, sculpt, dir / "mapping.ptx", ExtractMethod::kMapping));
   ASSERT_FALSE(forced.ok());
-  EXPECT_EQ(forced.status().message(), "method mapping: " + automatic->mapping_reason);
+  EXPECT_EQ(forced.status().message(), "method mapping: " + automatic->method.reason);
   EXPECT_EQ(forced.status().message().find('\n'), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir / "mapping.ptx"));
   auto interpolated =
       Extract(Options(cage, sculpt, dir / "interpolated.ptx", ExtractMethod::kInterpolate));
   ASSERT_FALSE(interpolated.ok());
-  EXPECT_EQ(interpolated.status().message(), "method interpolate: " + automatic->mapping_reason);
+  EXPECT_EQ(interpolated.status().message(), "method interpolate: " + automatic->method.reason);
   EXPECT_FALSE(std::filesystem::exists(dir / "interpolated.ptx"));
 
   // Rays on a refined sculpt when asked, and the option recorded only when given.
   const std::string refined = MakeRefined(dir, cage, 2, Pattern::kSmooth, "refined.obj");
   auto rays = Extract(Options(cage, refined, dir / "rays.ptx", ExtractMethod::kRays));
   ASSERT_TRUE(rays.ok());
-  EXPECT_EQ(rays->method, ExtractMethod::kRays);
-  EXPECT_EQ(rays->t_match, 0.0);
+  EXPECT_EQ(rays->method.used, ExtractMethod::kRays);
+  EXPECT_EQ(rays->times.match, 0.0);
   auto chosen = Extract(Options(cage, refined, dir / "chosen.ptx", ExtractMethod::kAuto));
   ASSERT_TRUE(chosen.ok());
-  EXPECT_EQ(chosen->method, ExtractMethod::kInterpolate);
-  EXPECT_EQ(chosen->rays_cast, 0u);
+  EXPECT_EQ(chosen->method.used, ExtractMethod::kInterpolate);
+  EXPECT_EQ(chosen->sampling.rays_cast, 0u);
   auto options_of = [](const std::string& path) {
     auto map = PtexFile::Open(path);
     EXPECT_TRUE(map.ok());
@@ -505,11 +506,11 @@ TEST(MappingMethod, SculptWoundTheOtherWayIsReadReversed) {
       reports[flipped] = *report;
     }
     const ExtractReport& flipped = *reports[1];
-    EXPECT_EQ(flipped.mapping_levels, 3);
+    EXPECT_EQ(flipped.method.levels, 3);
     if (!vector) {
-      EXPECT_EQ(flipped.method, ExtractMethod::kInterpolate);
-      EXPECT_EQ(flipped.hits_opposed, 0);
-      EXPECT_EQ(flipped.edges_discontinuous, 0);
+      EXPECT_EQ(flipped.method.used, ExtractMethod::kInterpolate);
+      EXPECT_EQ(flipped.sampling.hits_opposed, 0);
+      EXPECT_EQ(flipped.edges.discontinuous, 0);
     }
     ASSERT_EQ(flipped.warnings.size(), reports[0]->warnings.size() + 1);
     EXPECT_NE(flipped.warnings.back().find(
@@ -525,7 +526,7 @@ TEST(MappingMethod, SculptWoundTheOtherWayIsReadReversed) {
   // Through rays nothing is matched: most hits face against the normal, and the report says why.
   auto rays = Extract(Options(cage, dir / "flipped.obj", dir / "rays.ptx", ExtractMethod::kRays));
   ASSERT_TRUE(rays.ok()) << rays.status().message();
-  EXPECT_GT(2 * rays->hits_opposed, rays->samples);
+  EXPECT_GT(2 * rays->sampling.hits_opposed, rays->sampling.samples);
   ASSERT_FALSE(rays->warnings.empty());
   EXPECT_NE(rays->warnings.back().find("flipped.obj may wind the other way"), std::string::npos)
       << rays->warnings.back();
@@ -605,13 +606,14 @@ TEST(MappingFallback, HitsBeyondTheRingsGoToABvhAndTheMapEqualsTheRayMap) {
   auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, fixed);
   ASSERT_TRUE(mapping.ok()) << mapping.status().message();
   ASSERT_TRUE(rays.ok()) << rays.status().message();
-  EXPECT_EQ(mapping->method, ExtractMethod::kMapping);
-  EXPECT_GT(mapping->mapping_fallback_samples, 0);
-  EXPECT_GT(mapping->mapping_fallback_faces, 0);
-  EXPECT_LT(mapping->mapping_fallback_samples, mapping->samples);
-  EXPECT_GE(mapping->rays_cast, static_cast<std::uint64_t>(mapping->mapping_fallback_samples));
+  EXPECT_EQ(mapping->method.used, ExtractMethod::kMapping);
+  EXPECT_GT(mapping->method.fallback_samples, 0);
+  EXPECT_GT(mapping->method.fallback_faces, 0);
+  EXPECT_LT(mapping->method.fallback_samples, mapping->sampling.samples);
+  EXPECT_GE(mapping->sampling.rays_cast,
+            static_cast<std::uint64_t>(mapping->method.fallback_samples));
   EXPECT_NE(mapping->tracer.find("left undecided"), std::string::npos) << mapping->tracer;
-  EXPECT_EQ(mapping->misses, rays->misses);
+  EXPECT_EQ(mapping->sampling.misses, rays->sampling.misses);
   const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
   EXPECT_TRUE(t.same_resolutions);
   EXPECT_LE(t.max_ulps, kUlps) << t.differ << " of " << t.texels << " texels differ";
@@ -620,8 +622,8 @@ TEST(MappingFallback, HitsBeyondTheRingsGoToABvhAndTheMapEqualsTheRayMap) {
   one.threads = 1;
   auto single = Extract(one);
   ASSERT_TRUE(single.ok());
-  EXPECT_EQ(single->mapping_fallback_samples, mapping->mapping_fallback_samples);
-  EXPECT_EQ(single->mapping_fallback_faces, mapping->mapping_fallback_faces);
+  EXPECT_EQ(single->method.fallback_samples, mapping->method.fallback_samples);
+  EXPECT_EQ(single->method.fallback_faces, mapping->method.fallback_faces);
   EXPECT_EQ(dispex::testing::Slurp(dir / "one.ptx"), dispex::testing::Slurp(dir / "mapping.ptx"));
 }
 
@@ -638,8 +640,8 @@ TEST(MappingFallback, DefaultPipelineIsTheSameAtAnyThreadCount) {
   auto a = Extract(two);
   auto b = Extract(one);
   ASSERT_TRUE(a.ok() && b.ok()) << (a.ok() ? b.status().message() : a.status().message());
-  EXPECT_EQ(a->method, ExtractMethod::kMapping);
-  EXPECT_EQ(a->mapping_fallback_samples, b->mapping_fallback_samples);
+  EXPECT_EQ(a->method.used, ExtractMethod::kMapping);
+  EXPECT_EQ(a->method.fallback_samples, b->method.fallback_samples);
   EXPECT_EQ(dispex::testing::Slurp(dir / "one.ptx"), dispex::testing::Slurp(dir / "two.ptx"));
 }
 
@@ -675,17 +677,17 @@ TEST(MappingFallback, FoldsGoToTheBvh) {
   ASSERT_TRUE(base.ok());
   auto given = [&](ExtractOptions o) {
     o = PerSample(o, 3);
-    // Within the mapping's sheet bound (ExtractReport::mapping_sheet_bound, 0.08 here), which
+    // Within the mapping's sheet bound (ExtractReport::method.sheet_bound, 0.08 here), which
     // cuts longer distances: hits beyond it are other sheets.
     o.search_distance = {SearchDistanceSpec::Kind::kAbsolute, 0.05};
     return o;
   };
   auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, given);
   ASSERT_TRUE(mapping.ok() && rays.ok());
-  EXPECT_GT(mapping->mapping_sheet_bound, 0.05);
-  EXPECT_GT(mapping->mapping_fallback_faces, 0);
-  EXPECT_EQ(mapping->search_distance, rays->search_distance);
-  EXPECT_EQ(mapping->misses, rays->misses);
+  EXPECT_GT(mapping->method.sheet_bound, 0.05);
+  EXPECT_GT(mapping->method.fallback_faces, 0);
+  EXPECT_EQ(mapping->settings.search_distance, rays->settings.search_distance);
+  EXPECT_EQ(mapping->sampling.misses, rays->sampling.misses);
   const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
   EXPECT_TRUE(t.same_resolutions);
   EXPECT_GT(t.texels, 0u);
@@ -706,7 +708,7 @@ TEST(MappingFallback, AutomaticDistanceIsTheRayPaths) {
   ASSERT_TRUE(base.ok());
   auto [mapping, rays] = ExtractBothWays(cage, sculpt, dir, [](ExtractOptions o) { return o; });
   ASSERT_TRUE(mapping.ok() && rays.ok());
-  EXPECT_EQ(mapping->search_distance, rays->search_distance);
+  EXPECT_EQ(mapping->settings.search_distance, rays->settings.search_distance);
   const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
   EXPECT_TRUE(t.same_resolutions);
   EXPECT_EQ(t.beyond, 0u) << t.beyond << " of " << t.texels << " texels differ beyond rounding";
@@ -763,8 +765,8 @@ void ExpectSheetsMatchRays(const TempDir& dir, const std::string& cage, const st
   ASSERT_TRUE(through_mapping.ok()) << through_mapping.status().message();
   ASSERT_TRUE(rays.ok()) << rays.status().message();
   mapping = *through_mapping;
-  EXPECT_EQ(mapping.method, ExtractMethod::kMapping);
-  EXPECT_EQ(mapping.misses, rays->misses);
+  EXPECT_EQ(mapping.method.used, ExtractMethod::kMapping);
+  EXPECT_EQ(mapping.sampling.misses, rays->sampling.misses);
   const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
   EXPECT_TRUE(t.same_resolutions);
   EXPECT_GT(t.texels, 0u);
@@ -785,15 +787,15 @@ TEST(MappingFallback, NearerSheetOfAnotherPartGoesToTheBvh) {
   ASSERT_FALSE(sculpt.empty());
   ExtractReport mapping;
   ExpectSheetsMatchRays(dir, cage, sculpt, mapping);
-  EXPECT_GT(mapping.mapping_fallback_samples, 0);
-  EXPECT_LT(mapping.mapping_fallback_samples, mapping.samples);
+  EXPECT_GT(mapping.method.fallback_samples, 0);
+  EXPECT_LT(mapping.method.fallback_samples, mapping.sampling.samples);
 
   ExtractOptions one =
       SheetOptions(Options(cage, sculpt, dir / "one.ptx", ExtractMethod::kMapping));
   one.threads = 1;
   auto single = Extract(one);
   ASSERT_TRUE(single.ok());
-  EXPECT_EQ(single->mapping_fallback_samples, mapping.mapping_fallback_samples);
+  EXPECT_EQ(single->method.fallback_samples, mapping.method.fallback_samples);
   EXPECT_EQ(dispex::testing::Slurp(dir / "one.ptx"), dispex::testing::Slurp(dir / "mapping.ptx"));
 }
 
@@ -810,7 +812,7 @@ TEST(MappingFallback, OnlySamplesWhoseLinesCrossAnotherSheetGoToTheBvh) {
   ASSERT_FALSE(sculpt.empty());
   ExtractReport mapping;
   ExpectSheetsMatchRays(dir, cage, sculpt, mapping);
-  EXPECT_EQ(mapping.mapping_fallback_samples, 8 * 48);
+  EXPECT_EQ(mapping.method.fallback_samples, 8 * 48);
 }
 
 // The tilted sheets of OnlySamplesWhoseLinesCrossAnotherSheetGoToTheBvh sampled 2 x 2 per face:
@@ -832,8 +834,8 @@ TEST(MappingFallback, SamplesAfterTheLastGroupOfFourAreChecked) {
   });
   ASSERT_TRUE(mapping.ok()) << mapping.status().message();
   ASSERT_TRUE(rays.ok()) << rays.status().message();
-  EXPECT_EQ(mapping->method, ExtractMethod::kMapping);
-  EXPECT_EQ(mapping->mapping_fallback_samples, 6);
+  EXPECT_EQ(mapping->method.used, ExtractMethod::kMapping);
+  EXPECT_EQ(mapping->method.fallback_samples, 6);
   const TexelComparison t = CompareTexels(dir / "mapping.ptx", dir / "rays.ptx", UlpOfScale(*base));
   EXPECT_TRUE(t.same_resolutions);
   EXPECT_GT(t.texels, 0u);

@@ -75,8 +75,8 @@ class RealPairs : public ::testing::Test {
     options.output_path = dir_ / "bunny.ptx";
     auto report = Extract(options);
     ASSERT_TRUE(report.ok()) << report.status().message();
-    tolerance_ = report->tolerance;
-    misses_ = report->miss_fraction;
+    tolerance_ = report->settings.tolerance;
+    misses_ = report->sampling.miss_fraction;
   }
 
   // The two-sided bounds that `map` breaks.

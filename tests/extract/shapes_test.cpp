@@ -100,7 +100,7 @@ TEST_F(Shapes, EachShapeSeesOnlyItsOwnSculptShape) {
   // stands out by more.
   EXPECT_EQ(MapDifference(dir_ / "maps/detail.ptx", Alone(detail_, "detail"), true), "");
   EXPECT_EQ(MapDifference(dir_ / "maps/flat.ptx", Alone(flat_, "flat"), true), "");
-  EXPECT_GT(report->shapes[0].report.displacement_max, 0.004);
+  EXPECT_GT(report->shapes[0].report.displacement.max, 0.004);
   auto map = PtexFile::Open(dir_ / "maps/flat.ptx");
   ASSERT_TRUE(map.ok());
   ASSERT_NE(map->FindMetaData("dispex:shape"), nullptr);
@@ -186,8 +186,8 @@ TEST_F(Shapes, ManifestNamesShapesInSeveralFilesWithTheirOwnOptions) {
   auto report = ExtractAsset(*options);
   ASSERT_TRUE(report.ok()) << report.status().message();
   ASSERT_EQ(report->shapes.size(), 2u);
-  EXPECT_EQ(report->shapes[0].report.tolerance, 0.002);
-  EXPECT_EQ(report->shapes[0].report.watertight, WatertightEdges::kOff);
+  EXPECT_EQ(report->shapes[0].report.settings.tolerance, 0.002);
+  EXPECT_EQ(report->shapes[0].report.edges.rule, WatertightEdges::kOff);
   EXPECT_EQ(report->shapes[1].report.options.max_oversample, 64);
   EXPECT_EQ(report->shapes[1].report.spectral.ulog2_faces[3], 252);
   EXPECT_EQ(report->shapes[1].report.spectral.vlog2_faces[4], 252);
@@ -213,8 +213,8 @@ TEST_F(Shapes, IncrementalRedoesOnlyTheShapeThatChanged) {
   WriteGroups(sculpt_, {{"flat", Read(flat_)}, {"detail", Read(detail_)}});
   auto report = ExtractAsset(o);
   ASSERT_TRUE(report.ok()) << report.status().message();
-  EXPECT_FALSE(report->shapes[0].report.unchanged);
-  EXPECT_TRUE(report->shapes[1].report.unchanged);
+  EXPECT_FALSE(report->shapes[0].report.incremental.unchanged);
+  EXPECT_TRUE(report->shapes[1].report.incremental.unchanged);
   EXPECT_EQ(fs::last_write_time(dir_ / "maps/flat.ptx"), flat_time);
   ExtractAssetOptions full = Asset(dir_ / "full");
   ASSERT_TRUE(ExtractAsset(full).ok());
@@ -236,7 +236,7 @@ TEST_F(Shapes, AddedAndRemovedShapesLeaveTheOthersUntouched) {
   auto removed = ExtractAsset(o);
   ASSERT_TRUE(removed.ok()) << removed.status().message();
   ASSERT_EQ(removed->shapes.size(), 1u);
-  EXPECT_TRUE(removed->shapes[0].report.unchanged);
+  EXPECT_TRUE(removed->shapes[0].report.incremental.unchanged);
   EXPECT_EQ(fs::last_write_time(dir_ / "maps/detail.ptx"), detail_time);
   // "flat" back and a third shape added (a sculpt shape of the same name exists now).
   WriteGroups(base_, {{"detail", cage}, {"flat", cage}, {"again", cage}});
@@ -245,9 +245,9 @@ TEST_F(Shapes, AddedAndRemovedShapesLeaveTheOthersUntouched) {
   auto added = ExtractAsset(o);
   ASSERT_TRUE(added.ok()) << added.status().message();
   ASSERT_EQ(added->shapes.size(), 3u);
-  EXPECT_TRUE(added->shapes[0].report.unchanged);
-  EXPECT_TRUE(added->shapes[1].report.unchanged);
-  EXPECT_EQ(added->shapes[2].report.redo_reason, "no previous map");
+  EXPECT_TRUE(added->shapes[0].report.incremental.unchanged);
+  EXPECT_TRUE(added->shapes[1].report.incremental.unchanged);
+  EXPECT_EQ(added->shapes[2].report.incremental.redo_reason, "no previous map");
   ASSERT_TRUE(ExtractAsset(Asset(dir_ / "full")).ok());
   for (const char* name : {"detail.ptx", "flat.ptx", "again.ptx"}) {
     EXPECT_EQ(Slurp(dir_ / ("maps/" + std::string(name))),

@@ -116,9 +116,10 @@ TEST_P(Shards, MergedPartsEqualOneExtractionForAnyCountAndOrder) {
   const std::string full_bytes = Slurp(full.output_path);
   if (GetParam().watertight != WatertightEdges::kOff) {
     // The edge pass, which crosses shards, raises faces: the merge must run it over all faces.
-    EXPECT_GT(expected->edge_raised_faces, 0);
+    EXPECT_GT(expected->edges.raised_faces, 0);
   }
-  const auto surface_faces = static_cast<std::int64_t>(expected->ptex_faces - expected->hole_faces);
+  const auto surface_faces =
+      static_cast<std::int64_t>(expected->inputs.ptex_faces - expected->inputs.hole_faces);
 
   for (int n : {1, 2, 3, 5}) {
     std::vector<std::string> parts;
@@ -126,7 +127,7 @@ TEST_P(Shards, MergedPartsEqualOneExtractionForAnyCountAndOrder) {
     for (int i = 1; i <= n; ++i) {
       auto shard = Shard(i, n, full);
       ASSERT_TRUE(shard.ok()) << i << "/" << n << ": " << shard.status().message();
-      EXPECT_EQ(shard->shard_begin, next) << i << "/" << n;
+      EXPECT_EQ(shard->shard.begin, next) << i << "/" << n;
       if (TracesPart()) {
         // The shard traces, and keeps, only the sculpt within reach of its faces; the tie
         // rule keeps its hits those of the whole sculpt.
@@ -137,11 +138,11 @@ TEST_P(Shards, MergedPartsEqualOneExtractionForAnyCountAndOrder) {
           EXPECT_LT(part->kept, part->total) << i << "/" << n << ": " << shard->tracer;
         }
       }
-      next = shard->shard_end;
-      extracted += shard->faces_extracted;
+      next = shard->shard.end;
+      extracted += shard->incremental.faces_extracted;
       parts.push_back(PartPath(i, n));
     }
-    EXPECT_EQ(next, static_cast<std::int64_t>(expected->ptex_faces));
+    EXPECT_EQ(next, static_cast<std::int64_t>(expected->inputs.ptex_faces));
     EXPECT_EQ(extracted, surface_faces) << "every face extracted by exactly one shard";
     // Any order: reversed, and shuffled.
     std::reverse(parts.begin(), parts.end());
@@ -151,8 +152,8 @@ TEST_P(Shards, MergedPartsEqualOneExtractionForAnyCountAndOrder) {
     merge.output_path = dir_ / ("merged_" + std::to_string(n) + ".ptx");
     auto merged = MergeShards(merge);
     ASSERT_TRUE(merged.ok()) << n << " shards: " << merged.status().message();
-    EXPECT_EQ(merged->parts_merged, n);
-    EXPECT_EQ(merged->faces_copied, surface_faces);
+    EXPECT_EQ(merged->shard.parts_merged, n);
+    EXPECT_EQ(merged->incremental.faces_copied, surface_faces);
     EXPECT_TRUE(Slurp(merge.output_path) == full_bytes)
         << n << " shards: the merged map differs from one extraction: "
         << testing::MapDifference(merge.output_path, full.output_path);
@@ -223,18 +224,18 @@ TEST_F(ShardParts, AnIncrementalShardWithUnchangedInputsFinishesAtOnce) {
   o.incremental = true;
   auto first = Extract(o);
   ASSERT_TRUE(first.ok()) << first.status().message();
-  EXPECT_FALSE(first->unchanged);
+  EXPECT_FALSE(first->incremental.unchanged);
   const auto written = fs::last_write_time(o.output_path);
   auto again = Extract(o);
   ASSERT_TRUE(again.ok()) << again.status().message();
-  EXPECT_TRUE(again->unchanged);
+  EXPECT_TRUE(again->incremental.unchanged);
   EXPECT_EQ(fs::last_write_time(o.output_path), written);
   // Another shard at the same path is not up to date: its faces are other faces.
   o.shard_index = 2;
   auto other = Extract(o);
   ASSERT_TRUE(other.ok()) << other.status().message();
-  EXPECT_FALSE(other->unchanged);
-  EXPECT_GT(other->faces_extracted, 0);
+  EXPECT_FALSE(other->incremental.unchanged);
+  EXPECT_GT(other->incremental.faces_extracted, 0);
 }
 
 TEST_F(ShardParts, AMergeOfPartsThatDoNotBelongTogetherFailsNamingThePart) {

@@ -223,7 +223,7 @@ TEST_P(VectorMapTest, FullResolutionHoldsTheSculptAtEverySample) {
     o.fixed_ulog2 = o.fixed_vlog2 = GetParam().levels + 1;
     auto report = Extract(o);
     ASSERT_TRUE(report.ok()) << report.status().message();
-    EXPECT_EQ(report->mapping_levels, GetParam().levels);
+    EXPECT_EQ(report->method.levels, GetParam().levels);
     auto map = PtexFile::Open(o.output_path);
     ASSERT_TRUE(map.ok());
     LimitEvaluator eval(*surface_);
@@ -281,7 +281,7 @@ void VectorMapTest::ExpectWithinTolerance(VectorSpace space) {
       }
     }
   }
-  EXPECT_LE(worst, report->tolerance * (1 + 1e-3) + 1e-6);
+  EXPECT_LE(worst, report->settings.tolerance * (1 + 1e-3) + 1e-6);
 }
 
 INSTANTIATE_TEST_SUITE_P(Cages, VectorMapTest,
@@ -353,7 +353,7 @@ TEST(VectorMapEdges, AllPinsEdgesSoThePerFaceReaderMeetsTheTruthAtBorders) {
     auto report = Extract(o);
     ASSERT_TRUE(report.ok()) << report.status().message();
     const bool all = mode == WatertightEdges::kAll;
-    EXPECT_EQ(report->watertight, mode);
+    EXPECT_EQ(report->edges.rule, mode);
     VerifyOptions v;
     v.base_path = cage;
     v.sculpt_path = dir / "sculpt.obj";
@@ -393,7 +393,7 @@ TEST(VectorMapEdges, FilterHoldsTheCrossFaceStepsOfD) {
       o.watertight = mode;
       auto report = Extract(o);
       ASSERT_TRUE(report.ok()) << report.status().message();
-      EXPECT_EQ(report->watertight, mode);
+      EXPECT_EQ(report->edges.rule, mode);
       VerifyOptions v;
       v.base_path = cage;
       v.sculpt_path = dir / "sculpt.obj";
@@ -401,7 +401,7 @@ TEST(VectorMapEdges, FilterHoldsTheCrossFaceStepsOfD) {
       auto verified = Verify(v);
       ASSERT_TRUE(verified.ok()) << verified.status().message();
       ASSERT_TRUE(verified->measured_edges);
-      const double tau = report->tolerance;
+      const double tau = report->settings.tolerance;
       const double step = verified->edge_across_faces.max;
       if (mode == WatertightEdges::kOff) {
         std::printf("%s without the rounds: step %.3g tolerances\n",
@@ -409,10 +409,10 @@ TEST(VectorMapEdges, FilterHoldsTheCrossFaceStepsOfD) {
         EXPECT_GT(step, tau) << "the case must step";
         continue;
       }
-      EXPECT_GT(report->edge_raised_faces, 0);
-      EXPECT_EQ(report->edges_over, 0);
-      EXPECT_LE(report->edge_step_across_faces, tau);
-      EXPECT_NEAR(step, report->edge_step_across_faces, 1e-6 * tau);
+      EXPECT_GT(report->edges.raised_faces, 0);
+      EXPECT_EQ(report->edges.over, 0);
+      EXPECT_LE(report->edges.step_across_faces, tau);
+      EXPECT_NEAR(step, report->edges.step_across_faces, 1e-6 * tau);
       EXPECT_LE(step, tau);
     }
   }

@@ -71,10 +71,10 @@ TEST_F(Watertight, DetailedSculptMeetsUnderBothReaders) {
   const std::string sculpt = Sculpt(cage, 4, Pattern::kDetail);
 
   const Extracted filter = Run(cage, sculpt, WatertightEdges::kFilter, "filter.ptx");
-  const double tau = filter.report.tolerance;
-  EXPECT_EQ(filter.report.watertight, WatertightEdges::kFilter);
+  const double tau = filter.report.settings.tolerance;
+  EXPECT_EQ(filter.report.edges.rule, WatertightEdges::kFilter);
   ExpectHeld(filter.edges.edge_across_faces, tau, "filter map, across faces");
-  EXPECT_LE(filter.report.edge_step_across_faces, 2 * tau);
+  EXPECT_LE(filter.report.edges.step_across_faces, 2 * tau);
 
   const Extracted all = Run(cage, sculpt, WatertightEdges::kAll, "all.ptx");
   ExpectHeld(all.edges.edge_across_faces, tau, "all map, across faces");
@@ -84,7 +84,7 @@ TEST_F(Watertight, DetailedSculptMeetsUnderBothReaders) {
   // The negative control: without watertight edges faces read on their own step by more.
   const Extracted off = Run(cage, sculpt, WatertightEdges::kOff, "off.ptx");
   EXPECT_GT(off.edges.edge_per_face.max, 2 * tau);
-  EXPECT_EQ(off.report.edge_rounds, 0);
+  EXPECT_EQ(off.report.edges.rounds, 0);
 }
 
 TEST_F(Watertight, RidgesMeetUnderBothReaders) {
@@ -93,12 +93,12 @@ TEST_F(Watertight, RidgesMeetUnderBothReaders) {
   // Rays through the correspondence: they meet the folds.
   const Extracted all =
       Run(cage, sculpt, WatertightEdges::kAll, "all.ptx", 0, 128, ExtractMethod::kMapping);
-  const double tau = all.report.tolerance;
+  const double tau = all.report.settings.tolerance;
   ExpectHeld(all.edges.edge_across_faces, tau, "across faces");
   ExpectHeld(all.edges.edge_per_face, tau, "per face");
   // Folds of the sculpt (other-sheet hits) are counted, by extract and verify alike.
-  EXPECT_GT(all.report.edges_discontinuous, 0);
-  EXPECT_EQ(static_cast<std::size_t>(all.report.edges_discontinuous),
+  EXPECT_GT(all.report.edges.discontinuous, 0);
+  EXPECT_EQ(static_cast<std::size_t>(all.report.edges.discontinuous),
             all.edges.discontinuous_edges);
 }
 
@@ -110,10 +110,10 @@ TEST_F(Watertight, RealScanMeetsUnderBothReaders) {
   const std::string cage = DataPath("meshes/stanford_bunny/bun_zipper_quadriflow_1000.obj");
   const std::string scan = DataPath("meshes/stanford_bunny/bun_zipper.ply");
   const Extracted filter = Run(cage, scan, WatertightEdges::kFilter, "filter.ptx");
-  const double tau = filter.report.tolerance;
+  const double tau = filter.report.settings.tolerance;
   ExpectHeld(filter.edges.edge_across_faces, tau, "across faces");
   EXPECT_GT(filter.edges.discontinuous_edges, 0u);
-  EXPECT_EQ(static_cast<std::size_t>(filter.report.edges_discontinuous),
+  EXPECT_EQ(static_cast<std::size_t>(filter.report.edges.discontinuous),
             filter.edges.discontinuous_edges);
 
   const Extracted all = Run(cage, scan, WatertightEdges::kAll, "all.ptx", 0, 512);
@@ -127,7 +127,7 @@ TEST_F(Watertight, RaisedMapIsTheSameAtAnyThreadCount) {
   const std::string sculpt = Sculpt(cage, 4, Pattern::kDetail);
   const Extracted one = Run(cage, sculpt, WatertightEdges::kAll, "one.ptx", 1);
   const Extracted two = Run(cage, sculpt, WatertightEdges::kAll, "two.ptx", 3);
-  EXPECT_GT(one.report.edge_raised_faces, 0);
+  EXPECT_GT(one.report.edges.raised_faces, 0);
   EXPECT_EQ(testing::Slurp(dir_ / "one.ptx"), testing::Slurp(dir_ / "two.ptx"));
 }
 

@@ -205,16 +205,16 @@ TEST(UvExtract, SpotTexelsMatchTheExactDisplacement) {
   Extracted e = ExtractUv(dir, cage, 3, 0.005, 256);
   // Two faces reach into 1011 by 0.00065 of a tile, short of its first texel centre at this
   // resolution: no tile of nothing is written, and the report says so.
-  ASSERT_EQ(e.report.uv_map_paths.size(), 1u);
-  EXPECT_EQ(e.report.uv_map_paths[0], dir / "uv/shape.1001.exr");
+  ASSERT_EQ(e.report.uv.paths.size(), 1u);
+  EXPECT_EQ(e.report.uv.paths[0], dir / "uv/shape.1001.exr");
   bool warned = false;
   for (const std::string& w : e.report.warnings) {
     warned |= w.find("UDIM tile 1011 is not written") != std::string::npos &&
               w.find("(28, 31)") != std::string::npos;
   }
   EXPECT_TRUE(warned);
-  EXPECT_EQ(e.report.uv_texels_missed, 0);
-  EXPECT_GT(e.report.uv_overlap_texels, 0);  // spot's flipped UV faces, reported
+  EXPECT_EQ(e.report.uv.texels_missed, 0);
+  EXPECT_GT(e.report.uv.overlap_texels, 0);  // spot's flipped UV faces, reported
   auto map = UvMap::Open(dir / "uv/shape.<UDIM>.exr");
   ASSERT_TRUE(map.ok()) << map.status().message();
   EXPECT_EQ(map->Attribute("dispex:space"), "normal");
@@ -273,13 +273,13 @@ TEST(UvExtract, BoxOverSixTilesWithSeams) {
   TempDir dir;
   const std::string cage = DataPath("uv_maps/udim_box.obj");
   Extracted e = ExtractUv(dir, cage, 5, 0.02, 64);
-  ASSERT_EQ(e.report.uv_map_paths.size(), 6u);
+  ASSERT_EQ(e.report.uv.paths.size(), 6u);
   const int udims[] = {1001, 1002, 1003, 1011, 1012, 1013};
   for (int t = 0; t < 6; ++t) {
-    EXPECT_EQ(e.report.uv_map_paths[t], dir / ("uv/shape." + std::to_string(udims[t]) + ".exr"));
+    EXPECT_EQ(e.report.uv.paths[t], dir / ("uv/shape." + std::to_string(udims[t]) + ".exr"));
   }
-  EXPECT_EQ(e.report.uv_overlap_texels, 0);
-  EXPECT_EQ(e.report.uv_texels_inside, 6 * 52 * 52);  // centres in [0.1, 0.9]: 6..57
+  EXPECT_EQ(e.report.uv.overlap_texels, 0);
+  EXPECT_EQ(e.report.uv.texels_inside, 6 * 52 * 52);  // centres in [0.1, 0.9]: 6..57
   auto map = UvMap::Open(dir / "uv/shape.<UDIM>.exr");
   ASSERT_TRUE(map.ok());
   const TexelErrors err = CompareWithTruth(cage, *map, e.sculpt, Pattern::kDetail);
@@ -438,8 +438,8 @@ TEST(UvExtract, ObjectSpaceVectorTexelsMatchTheExactDisplacement) {
   options.uv_resolution = 512;  // at 256 the bilinear reads between texels miss the truth's RMS
   auto report = Extract(options);
   ASSERT_TRUE(report.ok()) << report.status().message();
-  ASSERT_EQ(report->uv_map_paths.size(), 6u);
-  EXPECT_EQ(report->uv_texels_missed, 0);
+  ASSERT_EQ(report->uv.paths.size(), 6u);
+  EXPECT_EQ(report->uv.texels_missed, 0);
   auto map = UvMap::Open(dir / "uv/shape.<UDIM>.exr");
   ASSERT_TRUE(map.ok()) << map.status().message();
   ASSERT_EQ(map->channels(), 3);

@@ -90,10 +90,10 @@ TEST_P(GroundTruth, ExtractionIsWithinToleranceAndTheSculptsLinearError) {
   ASSERT_TRUE(report.ok()) << report.status().message();
   if (!c.self_intersecting) {
     // The tent's open boundary moves inwards when displaced: a ray or two there can miss.
-    EXPECT_LE(report->misses, std::string(c.name) == "tent" ? 2 : 0);
+    EXPECT_LE(report->sampling.misses, std::string(c.name) == "tent" ? 2 : 0);
   }
   // A jittered sculpt is not a subdivision of the base: oversampling goes by its density.
-  EXPECT_EQ(report->oversample_subdivision_level, c.density > 0 ? -1 : c.levels);
+  EXPECT_EQ(report->sampling.oversample_subdivision_level, c.density > 0 ? -1 : c.levels);
 
   VerifyOptions verify;
   verify.base_path = cage;
@@ -103,19 +103,19 @@ TEST_P(GroundTruth, ExtractionIsWithinToleranceAndTheSculptsLinearError) {
   auto checked = Verify(verify);
   ASSERT_TRUE(checked.ok()) << checked.status().message();
   EXPECT_TRUE(checked->passed) << checked->failure;
-  EXPECT_EQ(checked->truth_tolerance, report->tolerance);  // from the map's meta data
+  EXPECT_EQ(checked->truth_tolerance, report->settings.tolerance);  // from the map's meta data
   EXPECT_TRUE(checked->truth_local_checked);
   EXPECT_EQ(checked->truth_over_bound, 0u);
-  EXPECT_LE(checked->truth.rms, VerifyOptions::kDefaultTruthRmsFactor * report->tolerance);
-  EXPECT_LE(checked->truth.p99, VerifyOptions::kDefaultTruthP99Factor * report->tolerance);
+  EXPECT_LE(checked->truth.rms, VerifyOptions::kDefaultTruthRmsFactor * report->settings.tolerance);
+  EXPECT_LE(checked->truth.p99, VerifyOptions::kDefaultTruthP99Factor * report->settings.tolerance);
   EXPECT_EQ(checked->truth.count, made->vertices);
   // Two-sided distances agree with the truth: both measure how far the displaced surface is
   // from the sculpt, so neither exceeds the global bound plus the sculpt's linear error.
-  const double bound = report->tolerance + 2 * made->linear_error;
+  const double bound = report->settings.tolerance + 2 * made->linear_error;
   EXPECT_LE(checked->map_to_sculpt.max, bound + made->linear_error);
   EXPECT_LE(checked->sculpt_to_map.max, bound + made->linear_error);
   EXPECT_LE(checked->map_to_sculpt.rms, 2 * checked->truth.rms + made->linear_error);
-  EXPECT_EQ(checked->map_misses, report->misses);
+  EXPECT_EQ(checked->map_misses, report->sampling.misses);
 
   // Negative controls: the same check (the map's tolerance, default bounds) rejects each.
   const std::string truth = make.output_path + ".truth";
@@ -127,7 +127,7 @@ TEST_P(GroundTruth, ExtractionIsWithinToleranceAndTheSculptsLinearError) {
     }
     const std::string wrong = dir / "wrong.ptx";
     testing::WriteWrongMap(options.output_path, wrong, kind);
-    VerifyReport r = CheckTruth(cage, wrong, truth, report->tolerance);
+    VerifyReport r = CheckTruth(cage, wrong, truth, report->settings.tolerance);
     EXPECT_FALSE(r.passed) << WrongMapName(kind) << ": truth rms " << r.truth.rms << " p99 "
                            << r.truth.p99 << " worst ratio " << r.truth_worst_ratio;
   }
@@ -135,8 +135,8 @@ TEST_P(GroundTruth, ExtractionIsWithinToleranceAndTheSculptsLinearError) {
   other.pattern = c.pattern == Pattern::kNoise ? Pattern::kSmooth : Pattern::kNoise;
   other.output_path = dir / "other.obj";
   ASSERT_TRUE(MakeSculpt(other).ok());
-  VerifyReport r =
-      CheckTruth(cage, options.output_path, other.output_path + ".truth", report->tolerance);
+  VerifyReport r = CheckTruth(cage, options.output_path, other.output_path + ".truth",
+                              report->settings.tolerance);
   EXPECT_FALSE(r.passed) << "another pattern: truth rms " << r.truth.rms;
 }
 
@@ -228,7 +228,7 @@ class WrongMaps : public ::testing::Test {
     options.output_path = dir_ / "good.ptx";
     auto report = Extract(options);
     ASSERT_TRUE(report.ok()) << report.status().message();
-    tolerance_ = report->tolerance;
+    tolerance_ = report->settings.tolerance;
   }
 
   // A copy of the good map with every texel of face f replaced by edit(f, value), read from

@@ -143,7 +143,7 @@ TEST(ViewPage, ScalarMapWithSculptVerifyAndExtractReport) {
   EXPECT_TRUE(data["map"]["meta"].contains("dispex:options"));
   EXPECT_TRUE(data["map"]["meta"]["dispex:statistics"].is_object());
   EXPECT_FALSE(data["map"]["meta"].contains("dispex:face_keys"));
-  EXPECT_DOUBLE_EQ(data["map"]["tolerance"].get<double>(), extracted->tolerance);
+  EXPECT_DOUBLE_EQ(data["map"]["tolerance"].get<double>(), extracted->settings.tolerance);
   EXPECT_EQ(data["extract_report"]["phases_seconds"].size(),
             json::parse(ExtractReportJson(*extracted))["phases_seconds"].size());
   EXPECT_FALSE(data["verify"].contains("per_face")) << "the faces hold them";
@@ -184,7 +184,7 @@ TEST(ViewPage, ScalarMapWithSculptVerifyAndExtractReport) {
   }
 
   // The sculpt: within its budget.
-  EXPECT_EQ(report.sculpt_vertices_read, std::int64_t(extracted->sculpt_vertices));
+  EXPECT_EQ(report.sculpt_vertices_read, std::int64_t(extracted->inputs.sculpt_vertices));
   EXPECT_LE(report.sculpt_vertices, o.max_sculpt_vertices);
   EXPECT_GT(report.sculpt_vertices, o.max_sculpt_vertices / 4);
   EXPECT_GT(report.sculpt_cell, 0);
@@ -222,7 +222,7 @@ TEST(ViewPage, MissesPerFaceFromTheMapsRecords) {
   extract.check_inputs = false;
   auto extracted = Extract(extract);
   ASSERT_TRUE(extracted.ok()) << extracted.status().message();
-  ASSERT_GT(extracted->misses, 0);
+  ASSERT_GT(extracted->sampling.misses, 0);
 
   ViewPageOptions o;
   o.base_path = kSpot;
@@ -240,9 +240,10 @@ TEST(ViewPage, MissesPerFaceFromTheMapsRecords) {
   for (std::size_t f = 0; f < misses.size(); ++f) {
     sum += misses[f], sum_filled += filled[f], whole += all_missed[f];
   }
-  EXPECT_EQ(sum, extracted->misses);
-  EXPECT_EQ(sum_filled, extracted->holes_filled);
-  EXPECT_EQ(whole, extracted->faces_filled_from_neighbours + extracted->faces_unreachable);
+  EXPECT_EQ(sum, extracted->sampling.misses);
+  EXPECT_EQ(sum_filled, extracted->sampling.holes_filled);
+  EXPECT_EQ(whole, extracted->sampling.faces_filled_from_neighbours +
+                       extracted->sampling.faces_unreachable);
   EXPECT_LE(report.surface_vertices, 20'000);
   EXPECT_FALSE(data.contains("verify") && !data["verify"].is_null());
 }

@@ -177,27 +177,28 @@ StatusOr<std::vector<ShardPart>> CheckShardParts(std::vector<ShardPart> parts) {
 
 Status CheckPartsMatchInputs(const std::vector<ShardPart>& parts, const ExtractReport& report) {
   const ShardPart& part = parts.front();
-  if (Meta(part.file, "dispex:base_fingerprint") != report.base_fingerprint) {
+  if (Meta(part.file, "dispex:base_fingerprint") != report.inputs.base_fingerprint) {
     return Status::Error(StatusCode::kMismatch,
                          fmt::format("{}: made from another {} than the file there now (its "
                                      "fingerprint differs); run the shards again",
-                                     part.path, report.base_path));
+                                     part.path, report.inputs.base_path));
   }
-  if (Meta(part.file, "dispex:sculpt_fingerprint") != report.sculpt_fingerprint) {
+  if (Meta(part.file, "dispex:sculpt_fingerprint") != report.inputs.sculpt_fingerprint) {
     return Status::Error(StatusCode::kMismatch,
                          fmt::format("{}: made from another {} than the file there now (its "
                                      "fingerprint differs); run the shards again",
-                                     part.path, report.sculpt_path));
+                                     part.path, report.inputs.sculpt_path));
   }
-  if (part.info.map_inputs_key != report.inputs_key) {
+  if (part.info.map_inputs_key != report.incremental.inputs_key) {
     return Status::Error(StatusCode::kMismatch,
                          fmt::format("{}: made from other inputs than {} and {} now", part.path,
-                                     report.base_path, report.sculpt_path));
+                                     report.inputs.base_path, report.inputs.sculpt_path));
   }
-  if (static_cast<std::size_t>(part.file.num_faces()) != report.ptex_faces) {
-    return Status::Error(StatusCode::kMismatch,
-                         fmt::format("{}: has {} faces, {} now {}", part.path,
-                                     part.file.num_faces(), report.base_path, report.ptex_faces));
+  if (static_cast<std::size_t>(part.file.num_faces()) != report.inputs.ptex_faces) {
+    return Status::Error(
+        StatusCode::kMismatch,
+        fmt::format("{}: has {} faces, {} now {}", part.path, part.file.num_faces(),
+                    report.inputs.base_path, report.inputs.ptex_faces));
   }
   return Status::Ok();
 }

@@ -38,29 +38,29 @@ StatusOr<double> OffsetBound(const ExtractOptions& options, double base_diagonal
 }
 
 Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, ExtractReport& report) {
-  report.method = ExtractMethod::kRays;
+  report.method.used = ExtractMethod::kRays;
   if (options.method == ExtractMethod::kRays) return Status::Ok();
   const bool interpolate = options.method != ExtractMethod::kMapping;
   Stopwatch clock;
   MatchOptions match;
-  match.threads = report.threads;
+  match.threads = report.settings.threads;
   match.face_tables = false;  // the mapping reads the cells
   if (interpolate) {          // the bound vector maps take too
-    DISPEX_ASSIGN_OR_RETURN(match.max_offset, OffsetBound(options, report.base_diagonal));
+    DISPEX_ASSIGN_OR_RETURN(match.max_offset, OffsetBound(options, report.inputs.base_diagonal));
   }
   StatusOr<SculptCorrespondence> correspondence = MatchSculpt(match, inputs, report);
   if (!correspondence.ok()) {
-    report.t_match = clock.seconds();
-    report.mapping_reason = correspondence.status().message();
+    report.times.match = clock.seconds();
+    report.method.reason = correspondence.status().message();
     if (options.method != ExtractMethod::kAuto) {
       return Status::Error(
-          fmt::format("method {}: {}", ExtractMethodName(options.method), report.mapping_reason));
+          fmt::format("method {}: {}", ExtractMethodName(options.method), report.method.reason));
     }
     return CancelRequested() ? Cancelled() : Status::Ok();
   }
-  report.mapping_levels = correspondence->levels;
-  report.mapping_max_offset = correspondence->max_offset;
-  report.mapping_rms_offset = correspondence->rms_offset;
+  report.method.levels = correspondence->levels;
+  report.method.max_offset = correspondence->max_offset;
+  report.method.rms_offset = correspondence->rms_offset;
   DISPEX_ASSIGN_OR_RETURN(SculptMapping mapping, SculptMapping::Build(std::move(*correspondence),
                                                                       inputs.sculpt, inputs.faces));
   if (!interpolate) {  // what the rays through the cells need
@@ -70,8 +70,8 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   inputs.mapping = std::make_unique<SculptMapping>(std::move(mapping));
   if (interpolate) inputs.grids = std::make_unique<MappingGrids>(*inputs.mapping);
   inputs.interpolate = interpolate;
-  report.t_match = clock.seconds();
-  report.method = interpolate ? ExtractMethod::kInterpolate : ExtractMethod::kMapping;
+  report.times.match = clock.seconds();
+  report.method.used = interpolate ? ExtractMethod::kInterpolate : ExtractMethod::kMapping;
   return CancelRequested() ? Cancelled() : Status::Ok();
 }
 
@@ -257,17 +257,17 @@ Status TraceFallback(ExtractInputs& inputs, std::span<const int> faces) {
 
 void ReportMapping(const ExtractInputs& inputs, const ProcessedFaces& faces,
                    ExtractReport& report) {
-  report.mapping_fallback_samples = faces.fallback_samples;
-  report.mapping_fallback_faces = faces.fallback_faces;
-  report.t_bvh += inputs.fallback_bvh_seconds;
+  report.method.fallback_samples = faces.fallback_samples;
+  report.method.fallback_faces = faces.fallback_faces;
+  report.times.bvh += inputs.fallback_bvh_seconds;
   if (inputs.interpolate) {
     report.tracer = fmt::format(
         "none: the sculpt's vertex displacements interpolated through the subdivision "
         "correspondence (level {})",
-        report.mapping_levels);
+        report.method.levels);
     return;
   }
-  report.tracer = fmt::format("subdivision correspondence (level {}; {})", report.mapping_levels,
+  report.tracer = fmt::format("subdivision correspondence (level {}; {})", report.method.levels,
                               PairedBlocksByDefault() ? "cells traced two at a time, AVX2"
                                                       : "cells traced one at a time, SSE2");
   if (!inputs.tracer) return;

@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
   if (version == nullptr || version->AsString() != dispex::Version()) {
     return Fail("the map does not record the library's version");
   }
-  if (map->num_faces() != static_cast<int>(report->ptex_faces)) {
+  if (map->num_faces() != static_cast<int>(report->inputs.ptex_faces)) {
     return Fail("the map's faces are not the report's");
   }
   std::printf("dispex %s: %d faces\n", dispex::Version(), map->num_faces());
