@@ -1,29 +1,27 @@
 #include "dispex/status.h"
 
+#include "core/enum_names.h"
+
 namespace dispex {
 
+namespace {
+
+constexpr auto kStatusCodeNames = EnumTable<StatusCode>({
+    {StatusCode::kOk, "ok"},
+    {StatusCode::kFailed, "failed"},
+    {StatusCode::kInvalidArgument, "invalid_argument"},
+    {StatusCode::kBadInput, "bad_input"},
+    {StatusCode::kMismatch, "mismatch"},
+    {StatusCode::kCheckFailed, "check_failed"},
+    {StatusCode::kCancelled, "cancelled"},
+    {StatusCode::kOverBudget, "over_budget"},
+    {StatusCode::kOutput, "output"},
+});
+
+}  // namespace
+
 std::string_view StatusCodeName(StatusCode code) {
-  switch (code) {
-    case StatusCode::kOk:
-      return "ok";
-    case StatusCode::kFailed:
-      return "failed";
-    case StatusCode::kInvalidArgument:
-      return "invalid_argument";
-    case StatusCode::kBadInput:
-      return "bad_input";
-    case StatusCode::kMismatch:
-      return "mismatch";
-    case StatusCode::kCheckFailed:
-      return "check_failed";
-    case StatusCode::kCancelled:
-      return "cancelled";
-    case StatusCode::kOverBudget:
-      return "over_budget";
-    case StatusCode::kOutput:
-      return "output";
-  }
-  return "failed";
+  return EnumName(kStatusCodeNames, code);
 }
 
 }  // namespace dispex

@@ -2,30 +2,31 @@
 
 #include <fmt/format.h>
 
+#include "core/enum_names.h"
+
 namespace dispex {
 
+namespace {
+
+constexpr auto kOutputNames = EnumTable<ExtractPlan::Output>({
+    {ExtractPlan::Output::kMap, "map"},
+    {ExtractPlan::Output::kShardPart, "shard part"},
+    {ExtractPlan::Output::kUpToDate, "up to date"},
+});
+constexpr auto kTracerNames = EnumTable<ExtractPlan::Tracer>({
+    {ExtractPlan::Tracer::kNone, "none"},
+    {ExtractPlan::Tracer::kWholeSculpt, "whole sculpt"},
+    {ExtractPlan::Tracer::kWithinReach, "within reach"},
+});
+
+}  // namespace
+
 std::string_view ExtractPlanOutputName(ExtractPlan::Output output) {
-  switch (output) {
-    case ExtractPlan::Output::kMap:
-      return "map";
-    case ExtractPlan::Output::kShardPart:
-      return "shard part";
-    case ExtractPlan::Output::kUpToDate:
-      return "up to date";
-  }
-  return "map";
+  return EnumName(kOutputNames, output);
 }
 
 std::string_view ExtractPlanTracerName(ExtractPlan::Tracer tracer) {
-  switch (tracer) {
-    case ExtractPlan::Tracer::kNone:
-      return "none";
-    case ExtractPlan::Tracer::kWholeSculpt:
-      return "whole sculpt";
-    case ExtractPlan::Tracer::kWithinReach:
-      return "within reach";
-  }
-  return "whole sculpt";
+  return EnumName(kTracerNames, tracer);
 }
 
 std::string ExtractPlanSummary(const ExtractPlan& plan) {

@@ -6,30 +6,38 @@
 #include <nlohmann/json.hpp>
 #include <unordered_set>
 
+#include "core/enum_names.h"
+
 namespace dispex {
 
 namespace {
 constexpr float kInfiniteSharpness = 10.0f;  // Sdc::Crease::SHARPNESS_INFINITE
+
+constexpr auto kBoundaryInterpolationNames = EnumTable<BoundaryInterpolation>({
+    {BoundaryInterpolation::kNone, "none"},
+    {BoundaryInterpolation::kEdgeOnly, "edge_only"},
+    {BoundaryInterpolation::kEdgeAndCorner, "edge_and_corner"},
+});
+constexpr auto kCreaseMethodNames = EnumTable<CreaseMethod>({
+    {CreaseMethod::kUniform, "uniform"},
+    {CreaseMethod::kChaikin, "chaikin"},
+});
+constexpr auto kTriangleSubdivisionNames = EnumTable<TriangleSubdivision>({
+    {TriangleSubdivision::kCatmark, "catmark"},
+    {TriangleSubdivision::kSmooth, "smooth"},
+});
 }  // namespace
 
 std::string_view BoundaryInterpolationName(BoundaryInterpolation boundary) {
-  switch (boundary) {
-    case BoundaryInterpolation::kNone:
-      return "none";
-    case BoundaryInterpolation::kEdgeOnly:
-      return "edge_only";
-    case BoundaryInterpolation::kEdgeAndCorner:
-      return "edge_and_corner";
-  }
-  return "?";
+  return EnumName(kBoundaryInterpolationNames, boundary);
 }
 
 std::string_view CreaseMethodName(CreaseMethod method) {
-  return method == CreaseMethod::kChaikin ? "chaikin" : "uniform";
+  return EnumName(kCreaseMethodNames, method);
 }
 
 std::string_view TriangleSubdivisionName(TriangleSubdivision triangles) {
-  return triangles == TriangleSubdivision::kSmooth ? "smooth" : "catmark";
+  return EnumName(kTriangleSubdivisionNames, triangles);
 }
 
 std::vector<std::string> DistinctNames(const std::vector<std::string>& names) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "ptex/format.h"
 
 namespace dispex::ptex {
@@ -42,18 +43,15 @@ std::string TexelText(const std::uint8_t* p, int channels, PtexDataType type) {
   return s + ")";
 }
 
+constexpr auto kEncodingNames = EnumTable<PtexBlockInfo::Encoding>({
+    {PtexBlockInfo::Encoding::kConstant, "constant"},
+    {PtexBlockInfo::Encoding::kZipped, "zipped"},
+    {PtexBlockInfo::Encoding::kDiffZipped, "diffzipped"},
+    {PtexBlockInfo::Encoding::kTiled, "tiled"},
+});
+
 std::string_view EncodingName(PtexBlockInfo::Encoding e) {
-  switch (e) {
-    case PtexBlockInfo::Encoding::kConstant:
-      return "constant";
-    case PtexBlockInfo::Encoding::kZipped:
-      return "zipped";
-    case PtexBlockInfo::Encoding::kDiffZipped:
-      return "diffzipped";
-    case PtexBlockInfo::Encoding::kTiled:
-      return "tiled";
-  }
-  return "?";
+  return EnumName(kEncodingNames, e);
 }
 
 }  // namespace

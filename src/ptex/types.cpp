@@ -1,6 +1,7 @@
 // Names, sizes and meta data value accessors of the public Ptex types.
 #include <cstring>
 
+#include "core/enum_names.h"
 #include "dispex/ptex.h"
 #include "ptex/meta_data.h"
 
@@ -19,56 +20,56 @@ int PtexDataSize(PtexDataType type) {
   return 1;
 }
 
+namespace {
+
+constexpr auto kDataTypeNames = EnumTable<PtexDataType>({
+    {PtexDataType::kUint8, "uint8"},
+    {PtexDataType::kUint16, "uint16"},
+    {PtexDataType::kHalf, "half"},
+    {PtexDataType::kFloat, "float32"},
+});
+constexpr auto kMeshTypeNames = EnumTable<PtexMeshType>({
+    {PtexMeshType::kTriangle, "triangle"},
+    {PtexMeshType::kQuad, "quad"},
+});
+constexpr auto kBorderModeNames = EnumTable<PtexBorderMode>({
+    {PtexBorderMode::kClamp, "clamp"},
+    {PtexBorderMode::kBlack, "black"},
+    {PtexBorderMode::kPeriodic, "periodic"},
+});
+constexpr auto kEdgeFilterModeNames = EnumTable<PtexEdgeFilterMode>({
+    {PtexEdgeFilterMode::kNone, "none"},
+    {PtexEdgeFilterMode::kTangentVector, "tanvec"},
+});
+constexpr auto kMetaTypeNames = EnumTable<PtexMetaType>({
+    {PtexMetaType::kString, "string"},
+    {PtexMetaType::kInt8, "int8"},
+    {PtexMetaType::kInt16, "int16"},
+    {PtexMetaType::kInt32, "int32"},
+    {PtexMetaType::kFloat, "float"},
+    {PtexMetaType::kDouble, "double"},
+});
+
+}  // namespace
+
 std::string_view PtexDataTypeName(PtexDataType type) {
-  switch (type) {
-    case PtexDataType::kUint8:
-      return "uint8";
-    case PtexDataType::kUint16:
-      return "uint16";
-    case PtexDataType::kHalf:
-      return "half";
-    case PtexDataType::kFloat:
-      return "float32";
-  }
-  return "?";
+  return EnumName(kDataTypeNames, type);
 }
 
 std::string_view PtexMeshTypeName(PtexMeshType type) {
-  return type == PtexMeshType::kTriangle ? "triangle" : "quad";
+  return EnumName(kMeshTypeNames, type);
 }
 
 std::string_view PtexBorderModeName(PtexBorderMode mode) {
-  switch (mode) {
-    case PtexBorderMode::kClamp:
-      return "clamp";
-    case PtexBorderMode::kBlack:
-      return "black";
-    case PtexBorderMode::kPeriodic:
-      return "periodic";
-  }
-  return "?";
+  return EnumName(kBorderModeNames, mode);
 }
 
 std::string_view PtexEdgeFilterModeName(PtexEdgeFilterMode mode) {
-  return mode == PtexEdgeFilterMode::kTangentVector ? "tanvec" : "none";
+  return EnumName(kEdgeFilterModeNames, mode);
 }
 
 std::string_view PtexMetaTypeName(PtexMetaType type) {
-  switch (type) {
-    case PtexMetaType::kString:
-      return "string";
-    case PtexMetaType::kInt8:
-      return "int8";
-    case PtexMetaType::kInt16:
-      return "int16";
-    case PtexMetaType::kInt32:
-      return "int32";
-    case PtexMetaType::kFloat:
-      return "float";
-    case PtexMetaType::kDouble:
-      return "double";
-  }
-  return "?";
+  return EnumName(kMetaTypeNames, type);
 }
 
 namespace {

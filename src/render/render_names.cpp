@@ -3,65 +3,59 @@
 
 #include <charconv>
 
+#include "core/enum_names.h"
 #include "dispex/render.h"
 
 namespace dispex {
 
+namespace {
+
+constexpr auto kAtlasModeNames = EnumTable<AtlasMode>({
+    {AtlasMode::kGrey, "grey"},
+    {AtlasMode::kSigned, "signed"},
+    {AtlasMode::kVector, "vector"},
+    {AtlasMode::kGrey, "gray", kEnumAlias},
+});
+
+constexpr auto kViewNames = EnumTable<ViewPreset>({
+    {ViewPreset::kFront, "front"},
+    {ViewPreset::kBack, "back"},
+    {ViewPreset::kLeft, "left"},
+    {ViewPreset::kRight, "right"},
+    {ViewPreset::kTop, "top"},
+    {ViewPreset::kIso, "iso"},
+});
+
+constexpr auto kProjectionNames = EnumTable<Projection>({
+    {Projection::kPerspective, "perspective"},
+    {Projection::kOrthographic, "ortho"},
+    {Projection::kOrthographic, "orthographic", kEnumAlias},
+});
+
+}  // namespace
+
 std::string_view AtlasModeName(AtlasMode mode) {
-  switch (mode) {
-    case AtlasMode::kGrey:
-      return "grey";
-    case AtlasMode::kSigned:
-      return "signed";
-    case AtlasMode::kVector:
-      return "vector";
-  }
-  return "?";
+  return EnumName(kAtlasModeNames, mode);
 }
 
 StatusOr<AtlasMode> ParseAtlasMode(std::string_view name) {
-  if (name == "grey" || name == "gray") return AtlasMode::kGrey;
-  if (name == "signed") return AtlasMode::kSigned;
-  if (name == "vector") return AtlasMode::kVector;
-  return Status::Error(fmt::format("unknown mode '{}' (expected grey, signed or vector)", name));
+  return ParseEnum(kAtlasModeNames, "mode", name);
 }
 
 std::string_view ViewName(ViewPreset view) {
-  switch (view) {
-    case ViewPreset::kFront:
-      return "front";
-    case ViewPreset::kBack:
-      return "back";
-    case ViewPreset::kLeft:
-      return "left";
-    case ViewPreset::kRight:
-      return "right";
-    case ViewPreset::kTop:
-      return "top";
-    case ViewPreset::kIso:
-      return "iso";
-  }
-  return "iso";
+  return EnumName(kViewNames, view);
 }
 
 StatusOr<ViewPreset> ParseView(std::string_view name) {
-  for (ViewPreset v : {ViewPreset::kFront, ViewPreset::kBack, ViewPreset::kLeft, ViewPreset::kRight,
-                       ViewPreset::kTop, ViewPreset::kIso}) {
-    if (name == ViewName(v)) return v;
-  }
-  return Status::Error(
-      fmt::format("unknown view '{}' (expected front, back, left, right, top or iso)", name));
+  return ParseEnum(kViewNames, "view", name);
 }
 
 std::string_view ProjectionName(Projection projection) {
-  return projection == Projection::kPerspective ? "perspective" : "ortho";
+  return EnumName(kProjectionNames, projection);
 }
 
 StatusOr<Projection> ParseProjection(std::string_view name) {
-  if (name == "perspective") return Projection::kPerspective;
-  if (name == "ortho" || name == "orthographic") return Projection::kOrthographic;
-  return Status::Error(
-      fmt::format("unknown projection '{}' (expected perspective or ortho)", name));
+  return ParseEnum(kProjectionNames, "projection", name);
 }
 
 StatusOr<std::array<int, 2>> ParseImageSize(std::string_view text) {

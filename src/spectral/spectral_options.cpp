@@ -4,29 +4,27 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/enum_names.h"
 #include "dispex/spectral.h"
 
 namespace dispex {
 
+namespace {
+
+constexpr auto kResolutionRuleNames = EnumTable<ResolutionRule>({
+    {ResolutionRule::kErrorBound, "bound"},
+    {ResolutionRule::kNonzero, "nonzero"},
+    {ResolutionRule::kFixed, "fixed"},
+});
+
+}  // namespace
+
 std::string_view ResolutionRuleName(ResolutionRule rule) {
-  switch (rule) {
-    case ResolutionRule::kErrorBound:
-      return "bound";
-    case ResolutionRule::kNonzero:
-      return "nonzero";
-    case ResolutionRule::kFixed:
-      return "fixed";
-  }
-  return "unknown";
+  return EnumName(kResolutionRuleNames, rule);
 }
 
 StatusOr<ResolutionRule> ParseResolutionRule(std::string_view name) {
-  for (ResolutionRule rule :
-       {ResolutionRule::kErrorBound, ResolutionRule::kNonzero, ResolutionRule::kFixed}) {
-    if (name == ResolutionRuleName(rule)) return rule;
-  }
-  return Status::Error(
-      fmt::format("unknown resolution rule '{}' (expected bound, nonzero or fixed)", name));
+  return ParseEnum(kResolutionRuleNames, "resolution rule", name);
 }
 
 Status ValidateSpectralOptions(const SpectralOptions& options) {
@@ -36,8 +34,8 @@ Status ValidateSpectralOptions(const SpectralOptions& options) {
     case ResolutionRule::kFixed:
       break;
     default:
-      return Status::Error(fmt::format("rule = {}: not one of bound, nonzero, fixed",
-                                       static_cast<int>(options.rule)));
+      return Status::Error(fmt::format("rule = {}: not one of {}", static_cast<int>(options.rule),
+                                       EnumNameList(kResolutionRuleNames)));
   }
   if (!std::isfinite(options.tolerance) || options.tolerance < 0) {
     return Status::Error(

@@ -3,20 +3,19 @@
 
 #include <fmt/format.h>
 
-#include <array>
 #include <cmath>
-#include <utility>
 
+#include "core/enum_names.h"
 #include "core/vec3.h"
 
 namespace dispex {
 namespace {
 
-constexpr std::array<std::pair<VectorSpace, std::string_view>, 3> kSpaces{{
+constexpr auto kSpaces = EnumTable<VectorSpace>({
     {VectorSpace::kTangent, "tangent"},
     {VectorSpace::kParametric, "parametric"},
     {VectorSpace::kObject, "object"},
-}};
+});
 
 // T = normalize(dP/du); where dP/du vanishes or is parallel to N, any unit vector orthogonal
 // to N (the axis least aligned with it, projected).
@@ -33,18 +32,11 @@ Vec3d TangentAxis(const Vec3d& du, const Vec3d& n) {
 }  // namespace
 
 std::string_view VectorSpaceName(VectorSpace space) {
-  for (const auto& [s, name] : kSpaces) {
-    if (s == space) return name;
-  }
-  return "?";
+  return EnumName(kSpaces, space);
 }
 
 StatusOr<VectorSpace> ParseVectorSpace(std::string_view name) {
-  for (const auto& [s, n] : kSpaces) {
-    if (n == name) return s;
-  }
-  return Status::Error(
-      fmt::format("unknown vector space '{}' (valid: tangent, parametric, object)", name));
+  return ParseEnum(kSpaces, "vector space", name);
 }
 
 std::string_view VectorSpaceFrame(VectorSpace space) {

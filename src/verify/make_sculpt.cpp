@@ -17,6 +17,7 @@
 #include <unordered_map>
 
 #include "core/atomic_output.h"
+#include "core/enum_names.h"
 #include "core/system.h"
 #include "dispex/mesh.h"
 #include "dispex/subdiv.h"
@@ -488,16 +489,19 @@ std::vector<float> LocalErrors(const Mesh& mesh, const std::vector<float>& face_
   return local;
 }
 
+constexpr auto kSculptLayoutNames = EnumTable<SculptLayout>({
+    {SculptLayout::kRefined, "refined"},
+    {SculptLayout::kJittered, "jittered"},
+});
+
 }  // namespace
 
 std::string_view SculptLayoutName(SculptLayout layout) {
-  return layout == SculptLayout::kJittered ? "jittered" : "refined";
+  return EnumName(kSculptLayoutNames, layout);
 }
 
 StatusOr<SculptLayout> ParseSculptLayout(std::string_view name) {
-  if (name == "refined") return SculptLayout::kRefined;
-  if (name == "jittered") return SculptLayout::kJittered;
-  return Status::Error(fmt::format("unknown layout '{}' (refined, jittered)", name));
+  return ParseEnum(kSculptLayoutNames, "layout", name);
 }
 
 namespace {

@@ -10,11 +10,25 @@
 #include <limits>
 #include <random>
 
+#include "core/enum_names.h"
 #include "dispex/verify.h"
 
 namespace dispex {
 
 namespace {
+
+// "image" alone is refused (ParsePattern): the pattern needs a file, image:FILE.png
+// (ParsePatternArgument).
+constexpr auto kPatternNames = EnumTable<Pattern>({
+    {Pattern::kSmooth, "smooth"},
+    {Pattern::kDetail, "detail"},
+    {Pattern::kRidges, "ridges"},
+    {Pattern::kNoise, "noise"},
+    {Pattern::kNone, "none"},
+    {Pattern::kSideways, "sideways"},
+    {Pattern::kOverhang, "overhang"},
+    {Pattern::kImage, "image"},
+});
 
 constexpr double kTwoPi = 6.283185307179586;
 
@@ -88,39 +102,15 @@ OverhangWave Overhang(const double p[3], const PatternFrame& f) {
 }  // namespace
 
 std::string_view PatternName(Pattern pattern) {
-  switch (pattern) {
-    case Pattern::kSmooth:
-      return "smooth";
-    case Pattern::kDetail:
-      return "detail";
-    case Pattern::kRidges:
-      return "ridges";
-    case Pattern::kNoise:
-      return "noise";
-    case Pattern::kNone:
-      return "none";
-    case Pattern::kSideways:
-      return "sideways";
-    case Pattern::kOverhang:
-      return "overhang";
-    case Pattern::kImage:
-      return "image";
-  }
-  return "smooth";
+  return EnumName(kPatternNames, pattern);
 }
 
 StatusOr<Pattern> ParsePattern(std::string_view name) {
-  for (Pattern p : {Pattern::kSmooth, Pattern::kDetail, Pattern::kRidges, Pattern::kNoise,
-                    Pattern::kNone, Pattern::kSideways, Pattern::kOverhang}) {
-    if (name == PatternName(p)) return p;
-  }
-  if (name == "image") {
+  DISPEX_ASSIGN_OR_RETURN(const Pattern pattern, ParseEnum(kPatternNames, "pattern", name));
+  if (pattern == Pattern::kImage) {
     return Status::Error("pattern 'image' needs a height image: image:FILE.png");
   }
-  return Status::Error(
-      fmt::format("unknown pattern '{}' (expected smooth, detail, ridges, noise, none, sideways, "
-                  "overhang or image:FILE.png)",
-                  name));
+  return pattern;
 }
 
 bool IsVectorPattern(Pattern pattern) {

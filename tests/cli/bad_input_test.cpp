@@ -286,7 +286,8 @@ TEST_F(BadInput, MatchRefusesWithTheReasonAndAcceptsTheRefinedBase) {
 TEST_F(BadInput, VectorMaps) {
   const std::string spot = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
   ExpectFailure(Extract(cage_, sculpt_, "--vector world"),
-                "--vector: unknown vector space 'world' (valid: tangent, parametric, object)", 2);
+                "--vector: unknown vector space 'world' (expected tangent, parametric or object)",
+                2);
   ExpectFailure(Extract(spot, sculpt_, "--vector object"),
                 "vector displacement reads the sculpt through its correspondence with the base, "
                 "and there is none");

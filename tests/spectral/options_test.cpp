@@ -32,7 +32,7 @@ TEST(SpectralOptionsTest, ErrorsNameTheFieldAndValue) {
             "fixed_ulog2 x fixed_vlog2 = 6 x 12: 12 is outside 0..9");
   o = {};
   o.rule = static_cast<ResolutionRule>(7);
-  EXPECT_EQ(ValidateSpectralOptions(o).message(), "rule = 7: not one of bound, nonzero, fixed");
+  EXPECT_EQ(ValidateSpectralOptions(o).message(), "rule = 7: not one of bound, nonzero or fixed");
 }
 
 TEST(SpectralOptionsTest, RuleNamesRoundTrip) {

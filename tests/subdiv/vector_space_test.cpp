@@ -84,7 +84,7 @@ TEST(VectorSpaceTest, Names) {
   EXPECT_EQ(VectorSpaceChannels(VectorSpace::kTangent), "T,B,N");
   EXPECT_EQ(ParseVectorSpace("object").value(), VectorSpace::kObject);
   EXPECT_EQ(ParseVectorSpace("world").status().message(),
-            "unknown vector space 'world' (valid: tangent, parametric, object)");
+            "unknown vector space 'world' (expected tangent, parametric or object)");
 }
 
 // What a map holds, from its channels and meta data: each rule of DisplacementMapSpace, with
@@ -113,8 +113,8 @@ TEST(VectorSpaceTest, DisplacementMapSpace) {
             "dispex:vector_space)");
   const std::string world = "world";
   EXPECT_EQ(DisplacementMapSpace("m.ptx", 3, -1, &world, nullptr).status().message(),
-            "m.ptx: dispex:vector_space: unknown vector space 'world' (valid: tangent, "
-            "parametric, object)");
+            "m.ptx: dispex:vector_space: unknown vector space 'world' (expected tangent, "
+            "parametric or object)");
   EXPECT_EQ(DisplacementMapSpace("m.ptx", 3, -1, &tangent, &bad).status().message(),
             "m.ptx: dispex:channels 'x,y,z' does not match dispex:vector_space 'tangent' "
             "(expected 'T,B,N')");

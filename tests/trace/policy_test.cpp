@@ -270,7 +270,7 @@ TEST(PolicyTest, Names) {
   const auto bad = ParseHitPolicy("closest");
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.status().message(),
-            "unknown hit policy 'closest' (valid: nearest, outside-first, inside-first)");
+            "unknown hit policy 'closest' (expected nearest, outside-first or inside-first)");
 }
 
 }  // namespace

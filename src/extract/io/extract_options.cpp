@@ -11,81 +11,40 @@
 #include "dispex/extract.h"
 #include "dispex/files.h"
 #include "dispex/vector_space.h"
+#include "extract/io/extract_names.h"
 
 namespace dispex {
 
 std::string_view HolePolicyName(HolePolicy policy) {
-  switch (policy) {
-    case HolePolicy::kFill:
-      return "fill";
-    case HolePolicy::kFail:
-      return "fail";
-    case HolePolicy::kZero:
-      return "zero";
-  }
-  return "fill";
+  return EnumName(extract::kHolePolicyNames, policy);
 }
 
 StatusOr<HolePolicy> ParseHolePolicy(std::string_view name) {
-  for (HolePolicy p : {HolePolicy::kFill, HolePolicy::kFail, HolePolicy::kZero}) {
-    if (name == HolePolicyName(p)) return p;
-  }
-  return Status::Error(fmt::format("unknown hole policy '{}' (expected fill, fail or zero)", name));
+  return ParseEnum(extract::kHolePolicyNames, "hole policy", name);
 }
 
 std::string_view WatertightEdgesName(WatertightEdges mode) {
-  switch (mode) {
-    case WatertightEdges::kAll:
-      return "all";
-    case WatertightEdges::kFilter:
-      return "filter";
-    case WatertightEdges::kOff:
-      return "off";
-  }
-  return "all";
+  return EnumName(extract::kWatertightEdgesNames, mode);
 }
 
 StatusOr<WatertightEdges> ParseWatertightEdges(std::string_view name) {
-  for (WatertightEdges m :
-       {WatertightEdges::kAll, WatertightEdges::kFilter, WatertightEdges::kOff}) {
-    if (name == WatertightEdgesName(m)) return m;
-  }
-  return Status::Error(
-      fmt::format("unknown watertight mode '{}' (expected all, filter or off)", name));
+  return ParseEnum(extract::kWatertightEdgesNames, "watertight mode", name);
 }
 
 std::string_view ExtractMethodName(ExtractMethod method) {
-  switch (method) {
-    case ExtractMethod::kAuto:
-      return "auto";
-    case ExtractMethod::kRays:
-      return "rays";
-    case ExtractMethod::kMapping:
-      return "mapping";
-    case ExtractMethod::kInterpolate:
-      return "interpolate";
-  }
-  return "auto";
+  return EnumName(extract::kExtractMethodNames, method);
 }
 
 StatusOr<ExtractMethod> ParseExtractMethod(std::string_view name) {
-  for (ExtractMethod m : {ExtractMethod::kAuto, ExtractMethod::kRays, ExtractMethod::kMapping,
-                          ExtractMethod::kInterpolate}) {
-    if (name == ExtractMethodName(m)) return m;
-  }
-  return Status::Error(
-      fmt::format("unknown method '{}' (expected auto, rays, mapping or interpolate)", name));
+  return ParseEnum(extract::kExtractMethodNames, "method", name);
 }
 
 std::string_view ShardSculptName(ShardSculpt s) {
-  return s == ShardSculpt::kPart ? "part" : "whole";
+  return EnumName(extract::kShardSculptNames, s);
 }
 
 StatusOr<ShardSculpt> ParseShardSculpt(std::string_view name) {
-  for (ShardSculpt s : {ShardSculpt::kWhole, ShardSculpt::kPart}) {
-    if (name == ShardSculptName(s)) return s;
-  }
-  return Status::Error(fmt::format("unknown shard sculpt '{}' (expected whole or part)", name));
+  return ParseEnum(extract::kShardSculptNames, "shard sculpt", name);
 }
 
 namespace {

@@ -15,6 +15,7 @@
 
 #include "dispex/extract.h"
 #include "extract/io/extract_meta.h"
+#include "extract/io/extract_names.h"
 #include "extract/io/manifest_fields.h"
 
 namespace dispex {
@@ -67,17 +68,22 @@ struct Entry {
 #define DISPEX_SETTER(...) [](ExtractOptions & o, const json& v) -> Status __VA_ARGS__
 #define DISPEX_RECORD(...) [](const ExtractOptions& o, json& j) __VA_ARGS__
 
-std::string_view SearchKindName(SearchDistanceSpec::Kind kind) {
-  switch (kind) {
-    case SearchDistanceSpec::Kind::kAuto:
-      return "auto";
-    case SearchDistanceSpec::Kind::kAbsolute:
-      return "absolute";
-    case SearchDistanceSpec::Kind::kRelative:
-      return "relative";
-  }
-  return "auto";
-}
+constexpr auto kSearchKindNames = EnumTable<SearchDistanceSpec::Kind>({
+    {SearchDistanceSpec::Kind::kAuto, "auto"},
+    {SearchDistanceSpec::Kind::kAbsolute, "absolute"},
+    {SearchDistanceSpec::Kind::kRelative, "relative"},
+});
+
+// data_type as the command line and manifests spell it.
+constexpr auto kDataTypeNames = EnumTable<PtexDataType>({
+    {PtexDataType::kFloat, "float"},
+    {PtexDataType::kHalf, "half"},
+});
+// data_type as maps record it: the names PtexDataTypeName gives.
+constexpr auto kRecordedDataTypeNames = EnumTable<PtexDataType>({
+    {PtexDataType::kFloat, "float32"},
+    {PtexDataType::kHalf, "half"},
+});
 
 // In the order of `dispex extract --help`; last, those set for one run only (not in manifests).
 const Entry kEntries[] = {
@@ -137,17 +143,14 @@ const Entry kEntries[] = {
        return Status::Ok();
      }),
      DISPEX_RECORD({
-       j["search_distance"] = {{"kind", std::string(SearchKindName(o.search_distance.kind))},
-                               {"value", o.search_distance.value}};
+       j["search_distance"] = {
+           {"kind", std::string(EnumName(kSearchKindNames, o.search_distance.kind))},
+           {"value", o.search_distance.value}};
      }),
      DISPEX_SETTER({
        const std::string kind = v.is_object() ? v.value("kind", "") : "";
-       o.search_distance.kind = kind == "absolute"   ? SearchDistanceSpec::Kind::kAbsolute
-                                : kind == "relative" ? SearchDistanceSpec::Kind::kRelative
-                                                     : SearchDistanceSpec::Kind::kAuto;
-       if (kind != "auto" && kind != "absolute" && kind != "relative") {
-         return Status::Error("kind must be auto, absolute or relative");
-       }
+       DISPEX_ASSIGN_OR_RETURN(o.search_distance.kind,
+                               ParseEnum(kSearchKindNames, "search distance kind", kind));
        if (!v.contains("value") || !v["value"].is_number()) {
          return Status::Error("no numeric value");
        }
@@ -251,27 +254,20 @@ const Entry kEntries[] = {
     {{.name = "data_type",
       .flag = "--data-type",
       .kind = OptionKind::kChoice,
-      .values = "float or half",
+      .values = EnumNameListConstant<kDataTypeNames>(),
       .in_manifest = true,
       .help = "texel type: float or half",
       .default_text = "float"},
      DISPEX_SETTER({
        DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
-       if (s != "float" && s != "half") {
-         return Status::Error(fmt::format("'{}': expected float or half", s));
-       }
-       o.data_type = s == "half" ? PtexDataType::kHalf : PtexDataType::kFloat;
+       DISPEX_ASSIGN_OR_RETURN(o.data_type, ParseEnum(kDataTypeNames, "data type", s));
        return Status::Ok();
      }),
      DISPEX_RECORD({ j["data_type"] = std::string(PtexDataTypeName(o.data_type)); }),
      DISPEX_SETTER({
-       for (PtexDataType type : {PtexDataType::kHalf, PtexDataType::kFloat}) {
-         if (v == PtexDataTypeName(type)) {
-           o.data_type = type;
-           return Status::Ok();
-         }
-       }
-       return Status::Error("float32 or half");
+       DISPEX_ASSIGN_OR_RETURN(std::string s, TextValue(v));
+       DISPEX_ASSIGN_OR_RETURN(o.data_type, ParseEnum(kRecordedDataTypeNames, "data type", s));
+       return Status::Ok();
      })},
     {{.name = "compression_level",
       .flag = "--compression-level",
@@ -288,7 +284,7 @@ const Entry kEntries[] = {
     {{.name = "holes",
       .flag = "--holes",
       .kind = OptionKind::kChoice,
-      .values = "fill, fail or zero",
+      .values = EnumNameListConstant<extract::kHolePolicyNames>(),
       .in_manifest = true,
       .help = "samples whose rays miss: fill (interpolate), fail (error), zero",
       .default_text = "fill"},
@@ -297,7 +293,7 @@ const Entry kEntries[] = {
     {{.name = "watertight",
       .flag = "--watertight",
       .kind = OptionKind::kChoice,
-      .values = "all, filter or off",
+      .values = EnumNameListConstant<extract::kWatertightEdgesNames>(),
       .in_manifest = true,
       .help = "shared face edges meet within the tolerance for: filter (the Ptex library's "
               "filters), all (also readers that read each face on its own), off",
@@ -320,7 +316,7 @@ const Entry kEntries[] = {
     {{.name = "method",
       .flag = "--method",
       .kind = OptionKind::kChoice,
-      .values = "auto, rays, mapping or interpolate",
+      .values = EnumNameListConstant<extract::kExtractMethodNames>(),
       .in_manifest = true,
       .help = "where values come from: auto (interpolate when the sculpt is the base refined, "
               "else rays), interpolate (the sculpt's vertex displacements interpolated through "
@@ -493,7 +489,7 @@ const Entry kEntries[] = {
     {{.name = "shard_sculpt",
       .flag = "--shard-sculpt",
       .kind = OptionKind::kChoice,
-      .values = "whole or part",
+      .values = EnumNameListConstant<extract::kShardSculptNames>(),
       .in_manifest = false,
       .help = "what a shard keeps of the sculpt: whole, or part (only what its faces' rays "
               "reach: memory falls with N; needs --method rays and --search-distance)",
