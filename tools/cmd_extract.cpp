@@ -81,15 +81,14 @@ Status CheckOtherOutputs(const ExtractArgs& a) {
                        {"--out-dir", a.output_dir, /*folder=*/true}});
 }
 
-// --watch: one map re-extracted each round, re-using it (UV-space maps are not re-used: a full
-// extraction each round).
+// --watch: one map re-extracted each round, re-using it and its UV-space tiles.
 Status ResolveWatch(ExtractArgs& a) {
   if (!a.watch) return Status::Ok();
   if (a.asset()) return Status::Error("--watch re-extracts one map (-o), not --out-dir/--manifest");
   if (a.options.shard_count > 0) {
     return Status::Error("--watch re-extracts a whole map, not a --shard");
   }
-  if (a.options.uv_maps_dir.empty()) a.options.incremental = true;
+  a.options.incremental = true;
   return Status::Ok();
 }
 

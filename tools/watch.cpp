@@ -265,9 +265,7 @@ std::string WatchRoundLines(const std::vector<std::string>& changed, const Extra
     out = fmt::format("dispex: {}{} is up to date (made from the same inputs and options)\n", saved,
                       r.output.path);
   } else {
-    // Without incremental re-use (UV-space maps) every face is extracted each round.
-    const std::string reason = r.options.incremental ? r.incremental.redo_reason
-                                                     : "a full extraction with the UV-space maps";
+    const std::string& reason = r.incremental.redo_reason;
     const std::string tiles =
         r.uv.paths.empty() ? "" : fmt::format(" and {} UV tiles", r.uv.paths.size());
     out = fmt::format("dispex: {}{} of {} faces extracted{} ({}), {}{} written in {:.2f} s\n",

@@ -466,6 +466,8 @@ struct ExtractReport {
     std::vector<std::string> paths;
     std::int64_t texels_inside = 0, texels_missed = 0, overlap_texels = 0;
     std::vector<std::int32_t> overlap_faces, faces_outside_udim;
+    // Incremental: the faces whose texels were copied from the tiles of the run before.
+    std::int64_t faces_copied = 0;
   } uv;
 
   // A shard (ExtractOptions::shard_count > 0): the run [begin, end) of the shard order it

@@ -87,6 +87,20 @@ Status CommitPart(PtexWriter& writer, const ExtractInputs& inputs,
   return CommitMap(writer, inputs, keys, faces, report);
 }
 
+// What the previous run's UV-space tiles may give an incremental run: nothing (no same_key)
+// unless there is a previous map.
+UvPrevious PreviousUvTiles(const ExtractOptions& options, const PreviousMap& previous,
+                           const FaceKeys& keys) {
+  UvPrevious out;
+  if (options.uv_maps_dir.empty() || !options.incremental || !previous.usable()) return out;
+  out.inputs_key = previous.MetaString(kInputsKeyMetaKey);
+  out.same_key.resize(keys.keys.size());
+  for (std::size_t f = 0; f < keys.keys.size(); ++f) {
+    out.same_key[f] = previous.SameKey(f, keys.keys[f]);
+  }
+  return out;
+}
+
 // What changed since the previous map, in words.
 std::string RedoReason(const PreviousMap& previous, const ExtractReport& report) {
   if (!previous.usable()) return previous.notice().empty() ? "no previous map" : previous.notice();
@@ -156,14 +170,17 @@ StatusOr<PreviousMap> PlanOutput(const ExtractOptions& options, const ExtractInp
   if (!options.incremental) return previous;
   previous = PreviousMap::Open(options.output_path, num_faces, options.vector.has_value());
   const std::string stored = previous.usable() ? previous.MetaString(kInputsKeyMetaKey) : "";
-  if (stored == report.incremental.inputs_key) {
+  if (stored == report.incremental.inputs_key &&
+      (options.uv_maps_dir.empty() || UvTilesCurrent(options, stored))) {
     report.incremental.unchanged = true;
     plan.output = ExtractPlan::Output::kUpToDate;
     return previous;
   }
   previous.CheckFaceData();
   if (!previous.notice().empty()) report.warnings.push_back(previous.notice());
-  report.incremental.redo_reason = plan.redo_reason = RedoReason(previous, report);
+  report.incremental.redo_reason = plan.redo_reason =
+      stored == report.incremental.inputs_key ? "the UV-space tiles are missing or not of this map"
+                                              : RedoReason(previous, report);
   if (previous.usable()) plan.faces_from = options.output_path;
   return previous;
 }
@@ -243,7 +260,8 @@ Status WritePart(const ExtractOptions& options, const ExtractInputs& inputs,
 // made to meet, the totals -- then the map and its UV-space tiles.
 Status WriteMap(const ExtractOptions& options, ExtractInputs& inputs,
                 const ExtractSettings& settings, ProcessedFaces& faces, PtexWriter& writer,
-                const Stopwatch& faces_clock, ExtractReport& report) {
+                const Stopwatch& faces_clock, const UvPrevious* uv_previous,
+                ExtractReport& report) {
   report.incremental.faces_extracted = static_cast<std::int64_t>(inputs.surface.num_ptex_faces()) -
                                        faces.faces_copied - inputs.surface.stats().hole_ptex_faces;
   DISPEX_RETURN_IF_ERROR(FillMissedFaces(options, inputs, faces, writer, report));
@@ -267,7 +285,7 @@ Status WriteMap(const ExtractOptions& options, ExtractInputs& inputs,
   DISPEX_RETURN_IF_ERROR(AddFaceTotals(options, inputs, settings, faces, report));
   DISPEX_RETURN_IF_ERROR(CommitMap(writer, inputs, inputs.face_keys->keys, faces, report));
   if (!options.uv_maps_dir.empty()) {
-    DISPEX_RETURN_IF_ERROR(WriteUvMaps(options, inputs, settings, report));
+    DISPEX_RETURN_IF_ERROR(WriteUvMaps(options, inputs, settings, uv_previous, report));
   }
   return Status::Ok();
 }
@@ -383,7 +401,9 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
     report.times.sample_trace = faces_clock.seconds();
     DISPEX_RETURN_IF_ERROR(WritePart(options, inputs, in_shard, faces, writer, report));
   } else {
-    DISPEX_RETURN_IF_ERROR(WriteMap(options, inputs, settings, faces, writer, faces_clock, report));
+    const UvPrevious uv_previous = PreviousUvTiles(options, previous, face_keys);
+    DISPEX_RETURN_IF_ERROR(WriteMap(options, inputs, settings, faces, writer, faces_clock,
+                                    uv_previous.same_key.empty() ? nullptr : &uv_previous, report));
   }
   return Finished(std::move(report), total_clock);
 }

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <set>
 #include <span>
+#include <sstream>
 
 #include "core/check.h"
 #include "core/system.h"
@@ -68,8 +69,20 @@ std::string FaceList(const std::vector<std::int32_t>& faces) {
   return out;
 }
 
-std::vector<std::pair<std::string, std::string>> TileAttributes(const ExtractOptions& options,
-                                                                const ExtractReport& report) {
+// "dispex:inputs_key": the map's they were written with; "dispex:uv_missed_faces": the Ptex
+// faces whose texels missed the sculpt (dilated), which an incremental run extracts again;
+// "dispex:udims": the tiles of the set, so that a missing one is noticed.
+constexpr const char* kInputsKeyAttribute = "dispex:inputs_key";
+constexpr const char* kMissedFacesAttribute = "dispex:uv_missed_faces";
+constexpr const char* kTilesAttribute = "dispex:udims";  // the set's tiles, ascending
+
+std::vector<std::pair<std::string, std::string>> TileAttributes(
+    const ExtractOptions& options, const ExtractReport& report,
+    const std::vector<std::int64_t>& face_misses) {
+  std::string missed;
+  for (std::size_t f = 0; f < face_misses.size(); ++f) {
+    if (face_misses[f] > 0) missed += fmt::format("{}{}", missed.empty() ? "" : " ", f);
+  }
   const bool vector = options.vector.has_value();
   std::vector<std::pair<std::string, std::string>> attributes{
       {"dispex:version", DISPEX_VERSION_STRING},
@@ -91,6 +104,8 @@ std::vector<std::pair<std::string, std::string>> TileAttributes(const ExtractOpt
       // The Ptex map's tolerance, which verify's truth bounds scale with (the texels
       // themselves are samples, not fitted to it).
       {"dispex:tolerance", fmt::format("{}", report.settings.tolerance)},
+      {kInputsKeyAttribute, report.incremental.inputs_key},
+      {kMissedFacesAttribute, missed},
   };
   // A vector map's samples read the correspondence: no rays, no search distance.
   if (!vector) {
@@ -124,13 +139,18 @@ void RemoveStaleTiles(const std::string& dir, const std::string& shape,
   }
 }
 
-// Scalar maps traced by rays need the whole sculpt's tracer: build it unless the run's tracer
-// already is that.
+// Scalar maps traced by rays need the whole sculpt's tracer for `faces`: build it unless the
+// run's tracer already is that, or holds the sculpt within reach of every one of them.
 Status BuildTracerIfNeeded(const ExtractOptions& options, const ExtractSettings& settings,
-                           ExtractInputs& inputs, ExtractReport& report) {
-  const bool vector = options.vector.has_value();
-  if (!vector && !settings.interpolate &&
-      (inputs.mapping != nullptr || inputs.tracer == nullptr || !inputs.traced.empty())) {
+                           std::span<const int> faces, ExtractInputs& inputs,
+                           ExtractReport& report) {
+  if (options.vector.has_value() || settings.interpolate || faces.empty()) return Status::Ok();
+  const bool within_reach =
+      !inputs.traced.empty() && std::all_of(faces.begin(), faces.end(), [&](int f) {
+        return inputs.traced[static_cast<std::size_t>(f)] != 0;
+      });
+  if (inputs.mapping != nullptr || inputs.tracer == nullptr ||
+      (!inputs.traced.empty() && !within_reach)) {
     DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
   }
   return Status::Ok();
@@ -241,13 +261,12 @@ Status TraceTexels(PtexFaceId face, TexelSpan texels, const ExtractSettings& set
   return Status::Ok();
 }
 
-// Every face's texels, in parallel over the faces: interpolated, vector or traced. Counts
-// each face's misses in `face_misses` (num_faces long).
+// The texels of `faces`, in parallel over them: interpolated, vector or traced. Counts each
+// face's misses in `face_misses` (num_faces long).
 Status ExtractTexels(const ExtractSettings& settings, const ExtractInputs& inputs,
                      const SculptCorrespondence* correspondence, bool vector,
-                     const UvRaster& raster, const FaceTexels& by_face, UvTileValues& tiles,
-                     std::vector<std::int64_t>& face_misses) {
-  const std::vector<int> faces = FacesWithTexels(by_face, inputs.surface.num_ptex_faces());
+                     const UvRaster& raster, const FaceTexels& by_face, std::span<const int> faces,
+                     UvTileValues& tiles, std::vector<std::int64_t>& face_misses) {
   tbb::enumerable_thread_specific<UvScratch> scratches([&] { return UvScratch(inputs.surface); });
   const Status extracted = ForEachFace(
       static_cast<int>(faces.size()), [&](int k) { return faces[static_cast<std::size_t>(k)]; },
@@ -304,7 +323,8 @@ void ReportTexels(const ExtractOptions& options, const UvRaster& raster,
 // Dilates the tiles with a texel centre inside and writes them, all or none, then removes the
 // stale tiles of an earlier run. Moves the values out of `tiles`.
 Status WriteTiles(const ExtractOptions& options, const UvRaster& raster, int channels,
-                  UvTileValues& tiles, ExtractReport& report) {
+                  const std::vector<std::int64_t>& face_misses, UvTileValues& tiles,
+                  ExtractReport& report) {
   std::error_code ec;
   fs::create_directories(options.uv_maps_dir, ec);
   if (ec) {
@@ -313,7 +333,12 @@ Status WriteTiles(const ExtractOptions& options, const UvRaster& raster, int cha
   }
   const int n = raster.resolution;
   const std::string shape = fs::path(options.output_path).stem().string();
-  const auto attributes = TileAttributes(options, report);
+  auto attributes = TileAttributes(options, report, face_misses);
+  std::string udims;
+  for (const UvTile& tile : raster.tiles) {
+    if (tile.inside > 0) udims += fmt::format("{}{}", udims.empty() ? "" : " ", tile.udim);
+  }
+  attributes.emplace_back(kTilesAttribute, udims);
   std::vector<UvMapTile> out;
   std::vector<std::string> paths;
   for (std::size_t t = 0; t < raster.tiles.size(); ++t) {
@@ -337,10 +362,69 @@ Status WriteTiles(const ExtractOptions& options, const UvRaster& raster, int cha
   return Status::Ok();
 }
 
+std::string AttributeOf(const UvMapTile& tile, std::string_view name) {
+  for (const auto& [key, value] : tile.attributes) {
+    if (key == name) return value;
+  }
+  return {};
+}
+
+// The texels the previous tiles give: copied into `tiles` (marked filled) for the faces whose
+// key is unchanged and whose texels all hit then, when every tile the raster needs was written
+// with the previous map at this resolution. Returns which faces were copied (empty: none).
+std::vector<std::uint8_t> CopyPreviousTexels(const ExtractOptions& options, const UvRaster& raster,
+                                             int channels, const FaceTexels& by_face,
+                                             const UvPrevious& previous, UvTileValues& tiles) {
+  const std::string shape = fs::path(options.output_path).stem().string();
+  std::vector<std::uint8_t> copied = previous.same_key;
+  std::vector<std::vector<float>> before(raster.tiles.size());
+  for (std::size_t t = 0; t < raster.tiles.size(); ++t) {
+    if (raster.tiles[t].inside == 0) continue;
+    StatusOr<UvMapTile> tile =
+        ReadUvMapTile(UvMapTilePath(options.uv_maps_dir, shape, raster.tiles[t].udim));
+    if (!tile.ok() || tile->resolution != raster.resolution || tile->channels != channels ||
+        AttributeOf(*tile, kInputsKeyAttribute) != previous.inputs_key) {
+      return {};
+    }
+    std::istringstream missed(AttributeOf(*tile, kMissedFacesAttribute));
+    for (std::size_t f; missed >> f;) {
+      if (f < copied.size()) copied[f] = 0;
+    }
+    before[t] = std::move(tile->values);
+  }
+  const auto c = static_cast<std::size_t>(channels);
+  for (std::size_t f = 0; f < copied.size(); ++f) {
+    if (!copied[f]) continue;
+    for (std::size_t k = by_face.offsets[f]; k < by_face.offsets[f + 1]; ++k) {
+      const auto [tile, texel] = by_face.texels[k];
+      std::copy_n(&before[tile][c * texel], c, &tiles.values[tile][c * texel]);
+      tiles.filled[tile][texel] = 1;
+    }
+  }
+  return copied;
+}
+
 }  // namespace
 
+bool UvTilesCurrent(const ExtractOptions& options, const std::string& inputs_key) {
+  const std::string shape = fs::path(options.output_path).stem().string();
+  StatusOr<UvMap> tiles =
+      UvMap::Open((fs::path(options.uv_maps_dir) / (shape + ".<UDIM>.exr")).string());
+  if (!tiles.ok() || tiles->resolution() != options.uv_resolution) return false;
+  std::string udims;
+  for (const UvMapTile& tile : tiles->tiles()) {
+    udims += fmt::format("{}{}", udims.empty() ? "" : " ", tile.udim);
+  }
+  return std::all_of(tiles->tiles().begin(), tiles->tiles().end(), [&](const UvMapTile& tile) {
+    return AttributeOf(tile, kInputsKeyAttribute) == inputs_key &&
+           AttributeOf(tile, kTilesAttribute) == udims &&
+           AttributeOf(tile, "dispex:padding") == fmt::format("{}", options.uv_padding);
+  });
+}
+
 Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
-                   const ExtractSettings& settings, ExtractReport& report) {
+                   const ExtractSettings& settings, const UvPrevious* previous,
+                   ExtractReport& report) {
   Stopwatch clock;
   const SculptCorrespondence* correspondence = inputs.correspondence.get();
   const bool vector = options.vector.has_value();
@@ -349,15 +433,26 @@ Status WriteUvMaps(const ExtractOptions& options, ExtractInputs& inputs,
   DISPEX_ASSIGN_OR_RETURN(PtexUvCharts charts, PtexUvCharts::Build(inputs.base, inputs.surface));
   DISPEX_ASSIGN_OR_RETURN(UvRaster raster,
                           RasterizeUvCharts(charts, inputs.surface, options.uv_resolution));
-  DISPEX_RETURN_IF_ERROR(BuildTracerIfNeeded(options, settings, inputs, report));
   const int num_faces = inputs.surface.num_ptex_faces();
   const FaceTexels by_face = GroupByFace(raster, num_faces);
   UvTileValues tiles(raster, channels);
+  // Half tiles hold their texels rounded, and dilation reads them at full precision: those
+  // are extracted again.
+  const std::vector<std::uint8_t> copied =
+      previous != nullptr && options.data_type != PtexDataType::kHalf
+          ? CopyPreviousTexels(options, raster, channels, by_face, *previous, tiles)
+          : std::vector<std::uint8_t>();
+  std::vector<int> faces = FacesWithTexels(by_face, num_faces);
+  if (!copied.empty()) {
+    report.uv.faces_copied = static_cast<std::int64_t>(
+        std::erase_if(faces, [&](int f) { return copied[static_cast<std::size_t>(f)] != 0; }));
+  }
+  DISPEX_RETURN_IF_ERROR(BuildTracerIfNeeded(options, settings, faces, inputs, report));
   std::vector<std::int64_t> face_misses(static_cast<std::size_t>(num_faces), 0);
-  DISPEX_RETURN_IF_ERROR(
-      ExtractTexels(settings, inputs, correspondence, vector, raster, by_face, tiles, face_misses));
+  DISPEX_RETURN_IF_ERROR(ExtractTexels(settings, inputs, correspondence, vector, raster, by_face,
+                                       faces, tiles, face_misses));
   ReportTexels(options, raster, face_misses, report);
-  DISPEX_RETURN_IF_ERROR(WriteTiles(options, raster, channels, tiles, report));
+  DISPEX_RETURN_IF_ERROR(WriteTiles(options, raster, channels, face_misses, tiles, report));
   report.times.uv_maps = clock.seconds();
   return Status::Ok();
 }

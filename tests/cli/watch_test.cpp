@@ -350,11 +350,6 @@ TEST(Watch, RefusesWhatItCannotWatch) {
   r = RunDispex(run + "-o " + (dir / "map.ptx") + " --watch-settle 100", dir);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--watch"), std::string::npos) << r.err;
-  // UV-space maps are extracted in full each round: --incremental is refused as without --watch.
-  r = RunDispex(
-      run + "-o " + (dir / "map.ptx") + " --watch --incremental --uv-maps " + (dir / "uv"), dir);
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("not extracted incrementally"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "map.ptx"));
 }
 

@@ -38,6 +38,11 @@ class PreviousMap {
   // True when face f's key is `key` and its stored texels are what its first pass wrote (the
   // watertight edges did not raise its resolution afterwards).
   bool Reusable(std::size_t f, const Hash128& key) const;
+  // True when face f's key is `key`, whatever its stored texels: what else the run before made
+  // of the face (its UV-space texels) holds.
+  bool SameKey(std::size_t f, const Hash128& key) const {
+    return !files_.empty() && keys_[f] == key;
+  }
   const FaceRecord& record(std::size_t f) const { return records_[f]; }
   // The face's texels as KeptFace holds them (one value per channel for a constant face).
   Status ReadTexels(std::size_t f, KeptFace& out) const;

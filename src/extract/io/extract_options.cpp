@@ -160,9 +160,6 @@ Status CheckUvMaps(const ExtractOptions& o) {
         "reader shares: UV-space vector maps are object space only",
         VectorSpaceName(*o.vector)));
   }
-  if (o.incremental) {
-    return Status::Error("uv_maps_dir: UV-space maps are not extracted incrementally");
-  }
   if (o.shard_count > 0) {
     return Status::Error("uv_maps_dir: UV-space maps are not made in shards (docs/FARM.md)");
   }

@@ -86,6 +86,7 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
                     {"overlap_texels", r.uv.overlap_texels},
                     {"overlap_faces", r.uv.overlap_faces},
                     {"faces_outside_udim", r.uv.faces_outside_udim},
+                    {"faces_copied", r.uv.faces_copied},
                     {"seconds", r.times.uv_maps}};
   }
   j["peak_rss_bytes"] = r.peak_rss_bytes;
