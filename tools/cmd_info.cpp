@@ -20,6 +20,9 @@ void SetupInfo(CLI::App& app, int& exit_code) {
   cmd->add_flag("--faces", options->faces, "Ptex: one line per face");
   cmd->add_option("--dump", options->dump_face, "Ptex: print the texels of this face id");
   cmd->add_flag("--strict", options->strict, "mesh: treat validation warnings as errors");
+  cmd->add_flag("--fingerprint", options->fingerprint,
+                "mesh: print only its fingerprint, as a map records the meshes it was made from "
+                "(dispex:base_fingerprint, dispex:sculpt_fingerprint)");
   cmd->callback([options, &exit_code] {
     if (options->path.find("<UDIM>") != std::string::npos) {
       exit_code = UvMapInfo(*options);

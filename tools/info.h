@@ -8,10 +8,11 @@ namespace dispex::cli {
 
 struct InfoOptions {
   std::string path;
-  bool json = false;    // machine-readable summary on stdout
-  bool faces = false;   // Ptex: one line per face
-  int dump_face = -1;   // Ptex: print the texels of this face
-  bool strict = false;  // mesh: validation warnings are errors
+  bool json = false;         // machine-readable summary on stdout
+  bool faces = false;        // Ptex: one line per face
+  int dump_face = -1;        // Ptex: print the texels of this face
+  bool strict = false;       // mesh: validation warnings are errors
+  bool fingerprint = false;  // mesh: print its fingerprint only
 };
 
 // Each returns the process exit code and prints to stdout (errors on stderr).

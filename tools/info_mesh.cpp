@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "command.h"
+#include "dispex/extract.h"
 #include "dispex/mesh.h"
 #include "dispex/mesh_summary.h"
 #include "info.h"
@@ -97,6 +98,10 @@ int MeshInfo(const InfoOptions& options) {
   StatusOr<Mesh> read = ReadMesh(options.path);
   if (!read.ok()) return ReportFailure(read.status());
   const Mesh& mesh = *read;
+  if (options.fingerprint) {
+    std::fputs((MeshFingerprint(mesh) + "\n").c_str(), stdout);
+    return 0;
+  }
 
   const MeshSummary s = SummarizeMesh(mesh, DetectMeshFormat(options.path));
   if (options.json) {

@@ -184,6 +184,27 @@ TEST(ConvertCli, ObjToPlyAndBackKeepsTheMesh) {
   std::remove(back.c_str());
 }
 
+// --fingerprint prints what a map records of the mesh (dispex:sculpt_fingerprint): the same for
+// the mesh as OBJ and as binary PLY (UVs are not part of it), another for a moved vertex.
+TEST(InfoCli, FingerprintIsTheMeshsNotTheFiles) {
+  const std::string obj = Data("meshes/keenan_spot/spot_control_mesh.obj");
+  const std::string ply =
+      ::testing::TempDir() + "/dispex_fingerprint_" + std::to_string(::getpid()) + ".ply";
+  ASSERT_EQ(Dispex("convert -q " + obj + " " + ply).exit_code, 0);
+  const CliRun from_obj = Dispex("info --fingerprint " + obj);
+  EXPECT_EQ(from_obj.exit_code, 0) << from_obj.err;
+  ASSERT_EQ(from_obj.out.size(), std::string("xxh3-128:").size() + 32 + 1) << from_obj.out;
+  EXPECT_EQ(from_obj.out.rfind("xxh3-128:", 0), 0u) << from_obj.out;
+  EXPECT_EQ(Dispex("info --fingerprint " + ply).out, from_obj.out);
+  const std::string moved = ply + ".obj";
+  std::string text = Slurp(obj);
+  text[text.find("\nv ") + 3] = '9';  // the second vertex's x: 0.38... becomes 9.38...
+  std::ofstream(moved) << text;
+  EXPECT_NE(Dispex("info --fingerprint " + moved).out, from_obj.out);
+  std::remove(ply.c_str());
+  std::remove(moved.c_str());
+}
+
 TEST(ConvertCli, AnOutputOfNeitherFormatIsRefused) {
   const std::string out =
       ::testing::TempDir() + "/dispex_convert_" + std::to_string(::getpid()) + ".stl";
