@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "dispex/ids.h"
@@ -43,6 +44,10 @@ struct MatchOptions {
   // is that of the sculpt after ReverseWinding, which the caller applies to it before using
   // the two together. Otherwise such a sculpt fails, saying so.
   bool accept_reversed = false;
+  // A folder where the sculpt's half-edge adjacency, which depends on its faces only and is
+  // most of the match's time, is kept for the next match of a sculpt with the same faces (an
+  // incremental run after its vertices moved); "": none. The result is the same either way.
+  std::string cache_dir;
 };
 
 struct SculptCorrespondence {
@@ -75,7 +80,8 @@ struct SculptCorrespondence {
   // face there + its face_rotation.
   std::vector<std::uint32_t> cell_labels;
 
-  std::size_t components = 0;  // connected components matched (edge-connected)
+  std::size_t components = 0;         // connected components matched (edge-connected)
+  bool adjacency_from_cache = false;  // read from MatchOptions::cache_dir, not built
 
   // The position check: |sculpt vertex - limit point at its home| over the vertices checked,
   // each once, at its home: every vertex of grids up to 8 x 8; on larger grids those on the

@@ -150,6 +150,11 @@ struct ExtractOptions {
   // same file a full extraction writes. A map that is missing, unreadable, or written by
   // another version is not re-used (a warning says why).
   bool incremental = false;
+  // Where incremental runs keep what the next run after an edit can re-use: the sculpt's
+  // half-edge adjacency, which depends on its faces only (MatchOptions::cache_dir). "":
+  // $XDG_CACHE_HOME/dispex, else $HOME/.cache/dispex; "off": nothing kept. Only speed depends
+  // on it.
+  std::string cache_dir;
 
   // Stop once the plan is made (ExtractReport::plan: which faces would run, from where the
   // others come, the method and tracer): the inputs are read, matched and keyed, no face is
@@ -379,6 +384,8 @@ struct ExtractReport {
     // Samples the mapping could not decide, answered by a BVH of the sculpt within their
     // reach, and the Ptex faces they are in (of the faces extracted in this run).
     std::int64_t fallback_samples = 0, fallback_faces = 0;
+    // The sculpt's adjacency was read from the cache folder (ExtractOptions::cache_dir).
+    bool adjacency_cached = false;
   } method;
 
   // Sampling and rays.

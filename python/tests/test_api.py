@@ -115,6 +115,7 @@ OPTION_VALUES = {
     "check_inputs": (False, ["--no-input-checks"]),
     "threads": (np.int32(1), ["--threads", "1"]),
     "incremental": (None, None),  # test_extract.py: incremental runs of array meshes
+    "cache_dir": ("off", ["--cache-dir", "off"]),
     "shard": (None, None),  # test_shards.py
     "shard_sculpt": (None, None),
     "plan_only": (None, None),  # test_the_plan_says_what_a_run_will_do_and_writes_nothing
@@ -144,7 +145,7 @@ def test_each_option_gives_the_command_lines_map(tmp_path, sculpts, name):
     assert py_map.read_bytes() == cli_map.read_bytes()
     if name not in ("threads", "max_memory", "embree_isa", "check_inputs", "bvh_quality",
                     "max_miss_fraction", "holes", "ray_policy", "nonzero_threshold",
-                    "max_oversample", "min_oversample", "search_distance"):
+                    "max_oversample", "min_oversample", "search_distance", "cache_dir"):
         assert py_map.read_bytes() != default.read_bytes(), f"{name} had no effect"
 
 

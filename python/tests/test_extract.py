@@ -103,7 +103,7 @@ def test_incremental_run_of_an_unchanged_array_mesh_leaves_the_map(tmp_path, scu
     ({"holes": "maybe"}, "holes"),
     ({"compression_level": 99}, "compression_level = 99"),
     ({"colour": 1}, "colour: unknown option"),
-    ({"colour": 1}, "uv_maps_dir, .*threads, incremental, shard, .*shard_sculpt"),
+    ({"colour": 1}, "uv_maps_dir, .*threads, incremental, cache_dir, shard, .*shard_sculpt"),
     ({"uv_maps": "uv", "uv_maps_dir": "uv"}, "given twice"),
 ])
 def test_bad_values_raise_value_error_naming_them(tmp_path, sculpts, options, message):

@@ -112,7 +112,7 @@ Status MatchVectorSculpt(const ExtractOptions& options, ExtractInputs& inputs,
   MatchOptions match;
   match.threads = report.settings.threads;
   DISPEX_ASSIGN_OR_RETURN(match.max_offset, OffsetBound(options, report.inputs.base_diagonal));
-  auto correspondence = MatchSculpt(match, inputs, report);
+  auto correspondence = MatchSculpt(options, match, inputs, report);
   if (!correspondence.ok()) {
     return Status::Error(fmt::format(
         "vector displacement reads the sculpt through its correspondence with the base, and "

@@ -1,6 +1,7 @@
 // MatchRefinedSculpt (dispex/correspondence.h). The steps, in the order Run calls them:
 //  1. the sculpt's faces are quads, and its face and vertex counts name the level;
-//  2. its half-edge adjacency (quad_adjacency.h) and components, which must match the base's
+//  2. its half-edge adjacency (quad_adjacency.h; or the one MatchOptions::cache_dir keeps,
+//     adjacency_cache.h) and components, which must match the base's
 //     (the Ptex faces with a surface, connected through their edges) by size; against a base
 //     of one component they are compared only when a later step fails, since step 5 proves
 //     a sculpt that passes it connected;
@@ -36,6 +37,7 @@
 #include "core/check.h"
 #include "core/parallel.h"
 #include "core/system.h"
+#include "subdiv/adjacency_cache.h"
 #include "subdiv/correspondence_matcher.h"
 
 namespace dispex::subdiv::matching {
@@ -67,7 +69,8 @@ StatusOr<SculptCorrespondence> Matcher::Run() {
 Status Matcher::RunSteps() {
   DISPEX_RETURN_IF_ERROR(CheckInputs());
   DISPEX_RETURN_IF_ERROR(FindLevel());
-  DISPEX_ASSIGN_OR_RETURN(adjacency_, subdiv::BuildQuadAdjacency(sculpt_));
+  DISPEX_ASSIGN_OR_RETURN(adjacency_, subdiv::CachedQuadAdjacency(sculpt_, options_.cache_dir,
+                                                                  out_.adjacency_from_cache));
   DISPEX_RETURN_IF_ERROR(MatchComponents());
   DISPEX_RETURN_IF_ERROR(EvaluateBaseVertices());
   IndexSculptVertexClasses();

@@ -130,6 +130,7 @@ class Incremental : public ::testing::TestWithParam<Variant> {
     if (GetParam().local_tracer) o.method = ExtractMethod::kRays;
     o.vector = GetParam().vector;
     o.uv_resolution = 256;
+    o.cache_dir = dir_ / "cache";
     return o;
   }
 
@@ -268,6 +269,9 @@ TEST_P(Incremental, EveryStepEqualsAFullExtraction) {
     if (GetParam().local_tracer) {
       EXPECT_NE(r.tracer.find(" sculpt faces"), std::string::npos) << r.tracer;
     }
+    // The sculpt's faces did not change: its adjacency comes from the cache (the ray path
+    // does not match the sculpt).
+    EXPECT_EQ(r.method.adjacency_cached, r.method.used != ExtractMethod::kRays);
     if (GetParam().uv_maps) {  // half tiles are extracted whole (uv_maps.h)
       EXPECT_EQ(r.uv.faces_copied > 0, GetParam().data_type == PtexDataType::kFloat)
           << r.uv.faces_copied << " faces' UV texels copied";

@@ -2,14 +2,19 @@
 #include "subdiv/quad_adjacency.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <numeric>
 #include <random>
 #include <utility>
 #include <vector>
+
+#include "subdiv/adjacency_cache.h"
 
 namespace dispex::subdiv {
 namespace {
@@ -150,6 +155,59 @@ TEST(QuadAdjacency, AgreesWithAMapOfEdgesOnAShuffledGridWithHoles) {
     EXPECT_EQ(passes->boundary, boundary);
     EXPECT_EQ(passes->first_half_edge, first);
   }
+}
+
+// The cache gives back what BuildQuadAdjacency builds: the first call builds and writes it, the
+// second reads it; a damaged file (one byte of the opposites flipped, which would misguide the
+// match) and a mesh of other faces are built again. A cache that returned a stale or damaged
+// adjacency fails the comparisons.
+TEST(QuadAdjacencyCache, ReadBackEqualsBuiltAndDamageIsRebuilt) {
+  namespace fs = std::filesystem;
+  const fs::path folder =
+      fs::path(::testing::TempDir()) / ("dispex_adjacency_" + std::to_string(::getpid()));
+  fs::remove_all(folder);
+  const Mesh mesh = Quads(9, kGrid);
+  const auto built = BuildQuadAdjacency(mesh);
+  ASSERT_TRUE(built.ok());
+  const auto same = [&](const QuadAdjacency& a) {
+    return std::equal(a.opposite.begin(), a.opposite.end(), built->opposite.begin(),
+                      built->opposite.end()) &&
+           a.first_half_edge == built->first_half_edge && a.valence == built->valence &&
+           a.boundary == built->boundary;
+  };
+  bool from_cache = true;
+  auto first = CachedQuadAdjacency(mesh, folder.string(), from_cache);
+  ASSERT_TRUE(first.ok());
+  EXPECT_FALSE(from_cache);
+  EXPECT_TRUE(same(*first));
+  auto second = CachedQuadAdjacency(mesh, folder.string(), from_cache);
+  ASSERT_TRUE(second.ok());
+  EXPECT_TRUE(from_cache);
+  EXPECT_TRUE(same(*second));
+
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(folder)) files.push_back(entry.path());
+  ASSERT_EQ(files.size(), 1u);
+  {
+    std::fstream file(files[0], std::ios::in | std::ios::out | std::ios::binary);
+    file.seekg(8 + 16 + 16 + 4);  // magic, key, counts: the opposite of half-edge 1
+    const char byte = static_cast<char>(file.get() ^ 1);
+    file.seekp(8 + 16 + 16 + 4);
+    file.put(byte);
+  }
+  auto damaged = CachedQuadAdjacency(mesh, folder.string(), from_cache);
+  ASSERT_TRUE(damaged.ok());
+  EXPECT_FALSE(from_cache);
+  EXPECT_TRUE(same(*damaged));
+
+  // The same vertices, one quad wound from another corner: other faces, another file.
+  std::vector<std::int32_t> turned = kGrid;
+  std::rotate(turned.begin(), turned.begin() + 1, turned.begin() + 4);
+  auto other = CachedQuadAdjacency(Quads(9, turned), folder.string(), from_cache);
+  ASSERT_TRUE(other.ok());
+  EXPECT_FALSE(from_cache);
+  EXPECT_EQ(std::distance(fs::directory_iterator(folder), fs::directory_iterator()), 2);
+  fs::remove_all(folder);
 }
 
 }  // namespace

@@ -475,6 +475,17 @@ const Entry kEntries[] = {
        DISPEX_ASSIGN_OR_RETURN(o.incremental, BoolValue(v));
        return Status::Ok();
      })},
+    {{.name = "cache_dir",
+      .flag = "--cache-dir",
+      .kind = OptionKind::kText,
+      .values = "a folder, or off",
+      .in_manifest = true,
+      .help = "where --incremental keeps the sculpt's adjacency for the next run after an edit "
+              "(default: $XDG_CACHE_HOME/dispex, else ~/.cache/dispex; off: nothing kept)"},
+     DISPEX_SETTER({
+       DISPEX_ASSIGN_OR_RETURN(o.cache_dir, TextValue(v));
+       return Status::Ok();
+     })},
     {{.name = "shard",
       .flag = "--shard",
       .kind = OptionKind::kText,

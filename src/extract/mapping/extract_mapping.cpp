@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <utility>
 #include <vector>
 
@@ -17,11 +19,13 @@
 
 namespace dispex::extract {
 
-StatusOr<SculptCorrespondence> MatchSculpt(MatchOptions match, ExtractInputs& inputs,
-                                           ExtractReport& report) {
+StatusOr<SculptCorrespondence> MatchSculpt(const ExtractOptions& options, MatchOptions match,
+                                           ExtractInputs& inputs, ExtractReport& report) {
   match.accept_reversed = true;
+  if (options.incremental) match.cache_dir = CacheFolder(options);
   StatusOr<SculptCorrespondence> correspondence =
       MatchRefinedSculpt(inputs.surface, inputs.sculpt, match);
+  if (correspondence.ok()) report.method.adjacency_cached = correspondence->adjacency_from_cache;
   if (correspondence.ok() && correspondence->reversed) {
     ReverseWinding(inputs.sculpt);
     report.warnings.push_back(fmt::format(
@@ -30,6 +34,18 @@ StatusOr<SculptCorrespondence> MatchSculpt(MatchOptions match, ExtractInputs& in
         inputs.sculpt.source));
   }
   return correspondence;
+}
+
+std::string CacheFolder(const ExtractOptions& options) {
+  if (options.cache_dir == "off") return {};
+  if (!options.cache_dir.empty()) return options.cache_dir;
+  const char* xdg = std::getenv("XDG_CACHE_HOME");
+  if (xdg != nullptr && *xdg == '/') return (std::filesystem::path(xdg) / "dispex").string();
+  const char* home = std::getenv("HOME");
+  if (home != nullptr && *home != 0) {
+    return (std::filesystem::path(home) / ".cache" / "dispex").string();
+  }
+  return {};
 }
 
 StatusOr<double> OffsetBound(const ExtractOptions& options, double base_diagonal) {
@@ -48,7 +64,7 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   if (interpolate) {          // the bound vector maps take too
     DISPEX_ASSIGN_OR_RETURN(match.max_offset, OffsetBound(options, report.inputs.base_diagonal));
   }
-  StatusOr<SculptCorrespondence> correspondence = MatchSculpt(match, inputs, report);
+  StatusOr<SculptCorrespondence> correspondence = MatchSculpt(options, match, inputs, report);
   if (!correspondence.ok()) {
     report.times.match = clock.seconds();
     report.method.reason = correspondence.status().message();

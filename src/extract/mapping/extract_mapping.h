@@ -17,9 +17,14 @@ namespace dispex::extract {
 
 // MatchRefinedSculpt of inputs.sculpt to the base, a sculpt wound the other way accepted: it is
 // then reversed in place (ReverseWinding), with a warning in the report, so that everything
-// after the match sees it wound as the base is.
-StatusOr<SculptCorrespondence> MatchSculpt(MatchOptions match, ExtractInputs& inputs,
-                                           ExtractReport& report);
+// after the match sees it wound as the base is. An incremental run keeps the sculpt's
+// adjacency in CacheFolder for the next (MatchOptions::cache_dir).
+StatusOr<SculptCorrespondence> MatchSculpt(const ExtractOptions& options, MatchOptions match,
+                                           ExtractInputs& inputs, ExtractReport& report);
+
+// ExtractOptions::cache_dir resolved: the folder given, $XDG_CACHE_HOME/dispex, or
+// $HOME/.cache/dispex; "" for "off" or when neither variable is set.
+std::string CacheFolder(const ExtractOptions& options);
 
 // What a given search distance bounds when the map reads the sculpt through its
 // correspondence alone (interpolated or vector maps): how far a sculpt vertex may lie from its
