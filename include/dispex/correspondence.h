@@ -45,7 +45,7 @@ struct MatchOptions {
   // the two together. Otherwise such a sculpt fails, saying so.
   bool accept_reversed = false;
   // A folder where the sculpt's half-edge adjacency, which depends on its faces only and is
-  // most of the match's time, is kept for the next match of a sculpt with the same faces (an
+  // the match's largest step, is kept for the next match of a sculpt with the same faces (an
   // incremental run after its vertices moved); "": none. The result is the same either way.
   std::string cache_dir;
 };

@@ -46,6 +46,8 @@ Status WriteUvMapTiles(std::span<const std::string> paths, std::span<const UvMap
 // channel, or "R", "G" and "B"); `udim` from the file name (…​.<UDIM>.exr), 0 when it has none.
 // Errors name the file and what is wrong.
 StatusOr<UvMapTile> ReadUvMapTile(const std::string& path);
+// The same without the texels (`values` empty): the header's size, channels and attributes.
+StatusOr<UvMapTile> ReadUvMapTileHeader(const std::string& path);
 
 // A map's tiles: `pattern` is DIR/<shape>.<UDIM>.exr with the literal "<UDIM>" (as Blender and
 // Mari name tiles), or the path of one tile of the set (every DIR/<shape>.NNNN.exr beside it is

@@ -104,6 +104,10 @@ UvPrevious PreviousUvTiles(const ExtractOptions& options, const PreviousMap& pre
 // What changed since the previous map, in words.
 std::string RedoReason(const PreviousMap& previous, const ExtractReport& report) {
   if (!previous.usable()) return previous.notice().empty() ? "no previous map" : previous.notice();
+  // The map is of these inputs (PlanOutput ran on because of its tiles).
+  if (previous.MetaString(kInputsKeyMetaKey) == report.incremental.inputs_key) {
+    return "the UV-space tiles are missing or not of this map";
+  }
   std::vector<std::string> changed;
   if (previous.MetaString("dispex:base_fingerprint") != report.inputs.base_fingerprint) {
     changed.push_back("base");
@@ -178,9 +182,7 @@ StatusOr<PreviousMap> PlanOutput(const ExtractOptions& options, const ExtractInp
   }
   previous.CheckFaceData();
   if (!previous.notice().empty()) report.warnings.push_back(previous.notice());
-  report.incremental.redo_reason = plan.redo_reason =
-      stored == report.incremental.inputs_key ? "the UV-space tiles are missing or not of this map"
-                                              : RedoReason(previous, report);
+  report.incremental.redo_reason = plan.redo_reason = RedoReason(previous, report);
   if (previous.usable()) plan.faces_from = options.output_path;
   return previous;
 }

@@ -2,9 +2,11 @@
 #include "extract/uv_maps.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <set>
 #include <span>
 #include <sstream>
@@ -79,9 +81,9 @@ constexpr const char* kTilesAttribute = "dispex:udims";  // the set's tiles, asc
 std::vector<std::pair<std::string, std::string>> TileAttributes(
     const ExtractOptions& options, const ExtractReport& report,
     const std::vector<std::int64_t>& face_misses) {
-  std::string missed;
+  std::vector<std::size_t> missed;
   for (std::size_t f = 0; f < face_misses.size(); ++f) {
-    if (face_misses[f] > 0) missed += fmt::format("{}{}", missed.empty() ? "" : " ", f);
+    if (face_misses[f] > 0) missed.push_back(f);
   }
   const bool vector = options.vector.has_value();
   std::vector<std::pair<std::string, std::string>> attributes{
@@ -105,7 +107,7 @@ std::vector<std::pair<std::string, std::string>> TileAttributes(
       // themselves are samples, not fitted to it).
       {"dispex:tolerance", fmt::format("{}", report.settings.tolerance)},
       {kInputsKeyAttribute, report.incremental.inputs_key},
-      {kMissedFacesAttribute, missed},
+      {kMissedFacesAttribute, fmt::format("{}", fmt::join(missed, " "))},
   };
   // A vector map's samples read the correspondence: no rays, no search distance.
   if (!vector) {
@@ -115,9 +117,9 @@ std::vector<std::pair<std::string, std::string>> TileAttributes(
   return attributes;
 }
 
-// Tiles of `shape` in `dir` that this run did not write.
-void RemoveStaleTiles(const std::string& dir, const std::string& shape,
-                      const std::set<std::string>& written, ExtractReport& report) {
+// The tiles of `shape` in `dir`: its <shape>.NNNN.exr files, by UDIM.
+std::map<int, fs::path> ShapeTiles(const std::string& dir, const std::string& shape) {
+  std::map<int, fs::path> tiles;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const std::string name = entry.path().filename().string();
@@ -126,15 +128,22 @@ void RemoveStaleTiles(const std::string& dir, const std::string& shape,
       continue;
     }
     const std::string digits = name.substr(shape.size() + 1, 4);
-    if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
-        written.count(entry.path().string()) != 0) {
-      continue;
+    if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+      tiles.emplace(std::stoi(digits), entry.path());
     }
+  }
+  return tiles;
+}
+
+// Tiles of `shape` in `dir` that this run did not write.
+void RemoveStaleTiles(const std::string& dir, const std::string& shape,
+                      const std::set<std::string>& written, ExtractReport& report) {
+  for (const auto& [udim, path] : ShapeTiles(dir, shape)) {
+    if (written.count(path.string()) != 0) continue;
     std::error_code remove_error;
-    if (fs::remove(entry.path(), remove_error)) {
-      report.warnings.push_back(
-          fmt::format("{}: removed, a tile of an earlier run that these UVs no longer touch",
-                      entry.path().string()));
+    if (fs::remove(path, remove_error)) {
+      report.warnings.push_back(fmt::format(
+          "{}: removed, a tile of an earlier run that these UVs no longer touch", path.string()));
     }
   }
 }
@@ -334,11 +343,11 @@ Status WriteTiles(const ExtractOptions& options, const UvRaster& raster, int cha
   const int n = raster.resolution;
   const std::string shape = fs::path(options.output_path).stem().string();
   auto attributes = TileAttributes(options, report, face_misses);
-  std::string udims;
+  std::vector<int> udims;
   for (const UvTile& tile : raster.tiles) {
-    if (tile.inside > 0) udims += fmt::format("{}{}", udims.empty() ? "" : " ", tile.udim);
+    if (tile.inside > 0) udims.push_back(tile.udim);
   }
-  attributes.emplace_back(kTilesAttribute, udims);
+  attributes.emplace_back(kTilesAttribute, fmt::format("{}", fmt::join(udims, " ")));
   std::vector<UvMapTile> out;
   std::vector<std::string> paths;
   for (std::size_t t = 0; t < raster.tiles.size(); ++t) {
@@ -407,18 +416,17 @@ std::vector<std::uint8_t> CopyPreviousTexels(const ExtractOptions& options, cons
 }  // namespace
 
 bool UvTilesCurrent(const ExtractOptions& options, const std::string& inputs_key) {
-  const std::string shape = fs::path(options.output_path).stem().string();
-  StatusOr<UvMap> tiles =
-      UvMap::Open((fs::path(options.uv_maps_dir) / (shape + ".<UDIM>.exr")).string());
-  if (!tiles.ok() || tiles->resolution() != options.uv_resolution) return false;
-  std::string udims;
-  for (const UvMapTile& tile : tiles->tiles()) {
-    udims += fmt::format("{}{}", udims.empty() ? "" : " ", tile.udim);
-  }
-  return std::all_of(tiles->tiles().begin(), tiles->tiles().end(), [&](const UvMapTile& tile) {
-    return AttributeOf(tile, kInputsKeyAttribute) == inputs_key &&
-           AttributeOf(tile, kTilesAttribute) == udims &&
-           AttributeOf(tile, "dispex:padding") == fmt::format("{}", options.uv_padding);
+  const auto tiles = ShapeTiles(options.uv_maps_dir, fs::path(options.output_path).stem().string());
+  std::vector<int> udims;
+  for (const auto& [udim, path] : tiles) udims.push_back(udim);
+  const std::string listed = fmt::format("{}", fmt::join(udims, " "));
+  // Headers only: the texels are not read.
+  return !tiles.empty() && std::all_of(tiles.begin(), tiles.end(), [&](const auto& tile) {
+    const StatusOr<UvMapTile> header = ReadUvMapTileHeader(tile.second.string());
+    return header.ok() && header->resolution == options.uv_resolution &&
+           AttributeOf(*header, kInputsKeyAttribute) == inputs_key &&
+           AttributeOf(*header, kTilesAttribute) == listed &&
+           AttributeOf(*header, "dispex:padding") == fmt::format("{}", options.uv_padding);
   });
 }
 

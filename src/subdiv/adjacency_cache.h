@@ -1,6 +1,6 @@
 // The sculpt's half-edge adjacency kept in a cache folder between matches of sculpts with the
 // same faces (an incremental run after an edit of positions only): the adjacency depends on the
-// faces alone, and building it is most of what matching a large sculpt costs. A file is keyed
+// faces alone, and building it is the largest step of matching a large sculpt. A file is keyed
 // by a hash of the faces and vertex count and checked whole by a hash of its content; one that
 // is missing, damaged or of other faces is built again. The folder's cache files are kept
 // under kAdjacencyCacheBytes, the least recently used removed first.

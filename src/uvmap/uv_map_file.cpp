@@ -152,7 +152,7 @@ Status WriteUvMapTiles(std::span<const std::string> paths, std::span<const UvMap
 
 namespace {
 
-StatusOr<UvMapTile> ReadTileFile(const std::string& path) {
+StatusOr<UvMapTile> ReadTileFile(const std::string& path, bool texels) {
   DISPEX_RETURN_IF_ERROR(CheckReadableFile(path));
   try {
     Imf::InputFile file(path.c_str(), /*numThreads=*/0);
@@ -177,6 +177,12 @@ StatusOr<UvMapTile> ReadTileFile(const std::string& path) {
     tile.udim = UdimFromName(path);
     tile.resolution = width;
     tile.channels = channels;
+    for (auto it = header.begin(); it != header.end(); ++it) {
+      if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) {
+        tile.attributes.emplace_back(it.name(), s->value());
+      }
+    }
+    if (!texels) return tile;
     const std::size_t n = static_cast<std::size_t>(width);
     const std::size_t row = n * static_cast<std::size_t>(channels);
     std::vector<float> rows(row * n);
@@ -197,11 +203,6 @@ StatusOr<UvMapTile> ReadTileFile(const std::string& path) {
       std::copy_n(rows.begin() + static_cast<std::ptrdiff_t>(j * row), row,
                   tile.values.begin() + static_cast<std::ptrdiff_t>((n - 1 - j) * row));
     }
-    for (auto it = header.begin(); it != header.end(); ++it) {
-      if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) {
-        tile.attributes.emplace_back(it.name(), s->value());
-      }
-    }
     return tile;
   } catch (const std::exception& e) {
     return Status::Error(fmt::format("{}: not a readable OpenEXR file: {}", path, e.what()));
@@ -211,7 +212,13 @@ StatusOr<UvMapTile> ReadTileFile(const std::string& path) {
 }  // namespace
 
 StatusOr<UvMapTile> ReadUvMapTile(const std::string& path) {
-  StatusOr<UvMapTile> tile = ReadTileFile(path);
+  StatusOr<UvMapTile> tile = ReadTileFile(path, /*texels=*/true);
+  if (!tile.ok()) return tile.status().WithCode(StatusCode::kBadInput).WithPath(path);
+  return tile;
+}
+
+StatusOr<UvMapTile> ReadUvMapTileHeader(const std::string& path) {
+  StatusOr<UvMapTile> tile = ReadTileFile(path, /*texels=*/false);
   if (!tile.ok()) return tile.status().WithCode(StatusCode::kBadInput).WithPath(path);
   return tile;
 }
