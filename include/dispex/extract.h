@@ -303,6 +303,9 @@ struct ExtractPlan {
     kNone,         // no BVH: the sculpt read through its correspondence (mapping, interpolate)
     kWholeSculpt,  // a BVH of the whole sculpt
     kWithinReach,  // a BVH of the sculpt within reach of the faces that run (and their rings)
+    // A BVH of the sculpt within reach of one run of the faces at a time, sculpt_parts runs:
+    // the whole sculpt's does not fit in max_memory (the map is the same).
+    kInParts,
   };
   Output output = Output::kMap;
   int channels = 1;                             // 3: a vector map
@@ -316,11 +319,15 @@ struct ExtractPlan {
   // shard's (a shard part); holes of the base (no surface, written as 0). -1: not planned yet.
   std::int64_t faces = 0, faces_run = -1, faces_copied = -1, faces_elsewhere = 0, hole_faces = 0;
   bool uv_maps = false;  // UV-space tiles written after the map
+  // The memory the plan is made to fit (max_memory, or what the machine has available) and
+  // what it is estimated to need at its peak (bytes); the runs of kInParts (0 otherwise).
+  std::uint64_t memory_limit = 0, memory_estimate = 0;
+  int sculpt_parts = 0;
 };
 std::string_view ExtractPlanOutputName(
     ExtractPlan::Output output);  // "map", "shard part", "up to date"
 std::string_view ExtractPlanTracerName(
-    ExtractPlan::Tracer tracer);  // "none", "whole sculpt", "within reach"
+    ExtractPlan::Tracer tracer);  // "none", "whole sculpt", "within reach", "in parts"
 // The plan in a few lines for people ("plan: a map (scalar), method mapping, BVH: none ...").
 std::string ExtractPlanSummary(const ExtractPlan& plan);
 

@@ -107,6 +107,8 @@ StatusOr<RayMode> ParseRayMode(std::string_view name);
 struct NormalQuery {
   float distance = 0;  // the search distance d (> 0): each ray has tnear = 0, tfar = d
   HitPolicy policy = HitPolicy::kNearest;
+  // TracerOptions::verify_hits for this query even when the tracer was built without it.
+  bool verify_hits = false;
 };
 
 // Bits of NormalHits::flags. A miss has flags == 0.
@@ -319,6 +321,16 @@ StatusOr<SearchDistanceEstimate> EstimateSearchDistance(const Tracer& tracer,
                                                         std::span<const Float3> normals,
                                                         double base_diagonal,
                                                         const SearchDistanceOptions& options = {});
+
+// EstimateSearchDistance's long rays, `length` long, against `tracer`: lowers
+// nearest_abs_t[i] to |t| of query i's hit where it hits nearer (nearest policy, hits
+// verified: a long ray that slipped through a vertex would find the far side of the model).
+// Parallel (TBB), deterministic. Over parts of a sculpt, one tracer each, from infinity: |t| of
+// each query's hit on the whole sculpt, when every face that shares a vertex with a face of a
+// part is in a part with it (so that a hit's neighbourhood is whole in some part).
+void LowerNearestHits(const Tracer& tracer, std::span<const Float3> origins,
+                      std::span<const Float3> normals, float length,
+                      std::span<float> nearest_abs_t);
 
 // EstimateSearchDistance's rule over hits found another way (the same long rays answered
 // without this tracer): `abs_t`, |t| of the hits among `samples` queries. Same errors.

@@ -11,9 +11,12 @@ namespace dispex {
 
 // Peak resident set size of this process so far, in bytes (VmHWM), or 0 if unknown.
 std::uint64_t PeakResidentBytes();
-// Memory the machine can give without swapping (MemAvailable, bounded by a cgroup limit when
-// one is set), in bytes, or 0 if unknown.
-std::uint64_t AvailableMemoryBytes();
+// Memory the machine can give without swapping (MemAvailable), bounded by this process's
+// cgroup limit when one is set and by what an address-space limit (RLIMIT_AS, `ulimit -v`)
+// leaves beyond what the process has mapped already (VmSize) and will reserve unused (Embree's
+// device, the stacks and heaps of `threads` threads, 0: one per core); in bytes, or 0 if
+// unknown.
+std::uint64_t AvailableMemoryBytes(int threads = 0);
 
 // Wall-clock stopwatch.
 class Stopwatch {

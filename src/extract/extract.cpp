@@ -148,6 +148,30 @@ Status BuildLocalTracer(const ExtractOptions& options, std::vector<std::uint8_t>
   return BuildPartTracer(std::move(part), std::move(traced), inputs, report);
 }
 
+// Rays over the whole sculpt: one BVH of it when that fits in the memory limit, else the faces
+// traced in runs, a BVH of the sculpt within reach of one at a time (kInParts: the same map,
+// built again for each run); refused before any ray when not even that fits.
+Status PlanSculptParts(const ExtractOptions& options, ExtractInputs& inputs,
+                       ExtractReport& report) {
+  ExtractPlan& plan = report.plan;
+  DISPEX_ASSIGN_OR_RETURN(
+      const SculptParts parts,
+      SculptPartsWithin(inputs.memory, report.inputs.sculpt_faces, inputs.memory_limit,
+                        options.max_memory > 0, &plan.memory_estimate));
+  if (parts.parts == 1) return Status::Ok();
+  inputs.sculpt_parts = parts.parts;
+  inputs.part_faces = parts.part_faces;
+  plan.tracer = ExtractPlan::Tracer::kInParts;
+  plan.sculpt_parts = inputs.sculpt_parts;
+  report.warnings.push_back(fmt::format(
+      "{}: a BVH of the whole sculpt is estimated to need more than the {:.2f} GiB memory limit: "
+      "traced in {} parts, one at a time (the same map, slower){}",
+      options.sculpt_path, static_cast<double>(inputs.memory_limit) / double(1u << 30),
+      inputs.sculpt_parts,
+      options.check_inputs ? "; the sculpt's placement against the base is not checked" : ""));
+  return Status::Ok();
+}
+
 // The output, the inputs key and, for an incremental run or a merge, the previous map or the
 // parts the faces that do not run are copied from.
 StatusOr<PreviousMap> PlanOutput(const ExtractOptions& options, const ExtractInputs& inputs,
@@ -282,7 +306,13 @@ Status WriteMap(const ExtractOptions& options, ExtractInputs& inputs,
     DISPEX_RETURN_IF_ERROR(WriteKeptFaces(writer, inputs, faces));
   }
   ListDiscontinuousFaces(inputs, faces, report);
-  report.times.sample_trace = faces_clock.seconds();
+  // The runs' BVHs (a sculpt in parts) are built among the faces, but counted apart.
+  report.times.sample_trace = faces_clock.seconds() - inputs.run_bvh_seconds;
+  if (inputs.sculpt_parts > 1) {
+    report.times.bvh += inputs.run_bvh_seconds;
+    report.tracer = fmt::format("{}; {} BVHs, each of the sculpt within reach of a run of faces",
+                                inputs.run_backend, inputs.runs_traced);
+  }
   if (inputs.mapping != nullptr) ReportMapping(inputs, faces, report);
   DISPEX_RETURN_IF_ERROR(AddFaceTotals(options, inputs, settings, faces, report));
   DISPEX_RETURN_IF_ERROR(CommitMap(writer, inputs, inputs.face_keys->keys, faces, report));
@@ -325,7 +355,7 @@ StatusOr<ExtractReport> ExtractInArena(const ExtractOptions& options, int thread
 }  // namespace
 
 std::uint64_t MemoryLimit(const ExtractOptions& options) {
-  return options.max_memory > 0 ? options.max_memory : AvailableMemoryBytes();
+  return options.max_memory > 0 ? options.max_memory : AvailableMemoryBytes(options.threads);
 }
 
 ExtractReport StartReport(const ExtractOptions& options, int threads) {
@@ -365,7 +395,10 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   plan.tracer = !traced        ? ExtractPlan::Tracer::kNone
                 : within_reach ? ExtractPlan::Tracer::kWithinReach
                                : ExtractPlan::Tracer::kWholeSculpt;
-  if (plan.tracer == ExtractPlan::Tracer::kNone) SetTracerOptions(options, inputs);
+  if (plan.tracer == ExtractPlan::Tracer::kWholeSculpt) {
+    DISPEX_RETURN_IF_ERROR(PlanSculptParts(options, inputs, report));
+  }
+  if (plan.tracer != ExtractPlan::Tracer::kWholeSculpt) SetTracerOptions(options, inputs);
   if (plan.tracer == ExtractPlan::Tracer::kWholeSculpt) {
     DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
   }
@@ -384,13 +417,14 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
     // For a run that is not a shard, the whole sculpt when that is most of it.
     if (!shard && 2 * std::count(reach.begin(), reach.end(), 1) > plan.faces) {
       plan.tracer = ExtractPlan::Tracer::kWholeSculpt;
+      DISPEX_RETURN_IF_ERROR(PlanSculptParts(options, inputs, report));
     }
   }
   if (options.plan_only) return Finished(std::move(report), total_clock);
 
   if (plan.tracer == ExtractPlan::Tracer::kWithinReach) {
     DISPEX_RETURN_IF_ERROR(BuildLocalTracer(options, std::move(reach), shard, inputs, report));
-  } else if (within_reach) {
+  } else if (within_reach && plan.tracer == ExtractPlan::Tracer::kWholeSculpt) {
     DISPEX_RETURN_IF_ERROR(BuildTracer(options, inputs, report));
   }
   DISPEX_ASSIGN_OR_RETURN(PtexWriter writer, CreateMap(options, inputs));

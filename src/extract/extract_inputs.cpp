@@ -1,10 +1,14 @@
 #include "extract/extract_inputs.h"
 
 #include <fmt/format.h>
+#include <malloc.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -13,6 +17,7 @@
 #include "core/system.h"
 #include "dispex/cancel.h"
 #include "extract/incremental/face_keys.h"
+#include "extract/incremental/shard_plan.h"
 #include "extract/memory_check.h"
 #include "extract/parallel_errors.h"
 
@@ -100,35 +105,32 @@ void ReportMeshes(const ExtractOptions& options, const MeshesRead& meshes, Extra
   report.inputs.base_diagonal = ComputeBounds(meshes.base).diagonal();
 }
 
-Status CheckMemoryForInputs(const ExtractOptions& options, const MeshesRead& meshes,
-                            std::uint64_t memory_limit) {
+MemoryNeed MemoryNeedOf(const ExtractOptions& options, const MeshesRead& meshes) {
   // Texels the output can hold at most: every face at the largest oversampling.
   const std::uint64_t max_texels = static_cast<std::uint64_t>(meshes.surface.num_ptex_faces()) *
                                    static_cast<std::uint64_t>(options.max_oversample) *
                                    static_cast<std::uint64_t>(options.max_oversample);
   const Mesh& sculpt = meshes.sculpt;
-  return CheckMemoryForSculpt(sculpt.num_vertices(), sculpt.num_faces(), sculpt.face_indices.size(),
-                              std::min<std::uint64_t>(max_texels, 1ull << 31), memory_limit);
+  return EstimateMemory(sculpt.num_vertices(), sculpt.num_faces(), sculpt.face_indices.size(),
+                        std::min<std::uint64_t>(max_texels, 1ull << 31),
+                        options.vector.has_value() || options.method != ExtractMethod::kRays);
 }
 
 StatusOr<ExtractInputs> FinishInputs(const ExtractOptions& options, MeshesRead meshes,
                                      std::uint64_t memory_limit, ExtractReport& report) {
   ReportMeshes(options, meshes, report);
-  DISPEX_RETURN_IF_ERROR(CheckMemoryForInputs(options, meshes, memory_limit));
+  const MemoryNeed need = MemoryNeedOf(options, meshes);
+  DISPEX_RETURN_IF_ERROR(
+      CheckMemoryForSculpt(need, meshes.sculpt.num_faces(), memory_limit, options.max_memory > 0));
+  report.plan.memory_limit = memory_limit;
+  report.plan.memory_estimate = need.arrays + need.match + need.output;
   std::vector<PtexFaceInfo> faces = PtexFaceTable(meshes.surface);
-  return ExtractInputs{std::move(meshes.base),
-                       std::move(meshes.sculpt),
-                       std::move(meshes.surface),
-                       std::move(faces),
-                       nullptr,
-                       {},
-                       {},
-                       false,
-                       {},
-                       nullptr,
-                       false,
-                       nullptr,
-                       0};
+  return ExtractInputs{.base = std::move(meshes.base),
+                       .sculpt = std::move(meshes.sculpt),
+                       .surface = std::move(meshes.surface),
+                       .faces = std::move(faces),
+                       .memory_limit = memory_limit,
+                       .memory = need};
 }
 
 }  // namespace
@@ -229,12 +231,12 @@ void AddRings(const std::vector<PtexFaceInfo>& faces, int rings, std::vector<int
 
 Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces) {
   if (inputs.traced.empty()) return Status::Ok();
-  DISPEX_CHECK(inputs.sculpt.num_faces() > 0);  // not after ReleaseSculpt
   std::vector<int> beyond;
   for (int f : faces) {
     if (!inputs.traced[static_cast<std::size_t>(f)]) beyond.push_back(f);
   }
   if (beyond.empty()) return Status::Ok();
+  DISPEX_CHECK(inputs.sculpt.num_faces() > 0);  // not after ReleaseSculpt
   std::vector<std::uint8_t> traced = std::move(inputs.traced);
   for (int f : beyond) traced[static_cast<std::size_t>(f)] = 1;
   AddRings(inputs.faces, kLocalRings, std::move(beyond), traced);
@@ -253,6 +255,108 @@ Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces) {
       MakeEmbreeTracer(inputs.traced_part.num_faces() > 0 ? inputs.traced_part : inputs.sculpt,
                        inputs.tracer_options));
   return Status::Ok();
+}
+
+StatusOr<std::vector<std::vector<int>>> TracedRuns(const ExtractInputs& inputs,
+                                                   std::span<const int> faces) {
+  if (inputs.sculpt_parts <= 1 || faces.empty()) {
+    return std::vector<std::vector<int>>{std::vector<int>(faces.begin(), faces.end())};
+  }
+  const std::vector<std::int32_t> order = ShardOrder(inputs.base, inputs.surface);
+  std::vector<std::int32_t> rank(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    rank[static_cast<std::size_t>(order[i])] = static_cast<std::int32_t>(i);
+  }
+  std::vector<int> sorted(faces.begin(), faces.end());
+  std::sort(sorted.begin(), sorted.end(), [&](int a, int b) {
+    return rank[static_cast<std::size_t>(a)] < rank[static_cast<std::size_t>(b)];
+  });
+  ReachRuns cut =
+      RunsWithinReach(inputs, *inputs.face_keys, sorted, kLocalRings, inputs.part_faces);
+  // A face whose own reach passes what a part may hold: the limit cannot be kept (a search
+  // distance long against the faces), and one BVH per face would not save it.
+  if (cut.largest_single > static_cast<std::int64_t>(inputs.part_faces)) {
+    return Status::Error(
+        StatusCode::kOverBudget,
+        fmt::format("{}: the sculpt within reach of Ptex face {} and the faces around it holds "
+                    "{} sculpt faces, more than the {} a BVH may hold within the {:.2f} GiB "
+                    "memory limit; raise the limit (max_memory), or give a shorter "
+                    "search_distance",
+                    inputs.sculpt.source, cut.largest_face, cut.largest_single, inputs.part_faces,
+                    double(inputs.memory_limit) / double(1u << 30)));
+  }
+  return std::move(cut.runs);
+}
+
+Status TraceRun(ExtractInputs& inputs, std::span<const int> run) {
+  if (inputs.sculpt_parts <= 1) return EnsureTraced(inputs, run);
+  inputs.tracer.reset();  // before the part it reads
+  inputs.traced_part = Mesh{};
+  inputs.traced.clear();
+  // The freed BVH back to the system: the heap would keep it and the next run's on top of it.
+  malloc_trim(0);
+  if (run.empty()) return Status::Ok();
+  Stopwatch clock;
+  // With the rings around the run, every sculpt face beside one its rays can hit is in the
+  // part too, so that the tie rule and the vertex guard (dispex/trace.h) find the faces around
+  // a hit that the whole sculpt has there.
+  std::vector<std::uint8_t> traced(inputs.faces.size(), 0);
+  for (int f : run) traced[static_cast<std::size_t>(f)] = 1;
+  AddRings(inputs.faces, kLocalRings, std::vector<int>(run.begin(), run.end()), traced);
+  Mesh part = SculptWithinReach(inputs, *inputs.face_keys, traced);
+  if (part.num_faces() == 0) {
+    // No sculpt within reach: the run's rays miss whatever the BVH holds, so one face of it.
+    std::vector<std::uint8_t> keep(inputs.sculpt.num_faces(), 0);
+    keep[0] = 1;
+    part = SculptPart(inputs.sculpt, keep);
+  }
+  inputs.traced_part = std::move(part);
+  inputs.traced = std::move(traced);
+  DISPEX_ASSIGN_OR_RETURN(inputs.tracer,
+                          MakeEmbreeTracer(inputs.traced_part, inputs.tracer_options));
+  inputs.run_bvh_seconds += clock.seconds();
+  inputs.run_backend = inputs.tracer->stats().backend;
+  return CancelRequested() ? Cancelled() : Status::Ok();
+}
+
+StatusOr<std::vector<float>> NearestHitsInParts(const ExtractInputs& inputs,
+                                                std::span<const Float3> origins,
+                                                std::span<const Float3> normals, float length) {
+  // Each query's nearest hit over the whole sculpt is the nearest of its parts' when each part
+  // is a run of the sculpt's faces (a long ray may reach anywhere) with every face that shares
+  // a vertex with them: around a hit on a face of the run the part holds what the whole sculpt
+  // does, so the tie rule and the vertex guard (dispex/trace.h) answer as they would there; a
+  // hit on one of the faces around is answered as well by the part whose run holds it.
+  const Mesh& sculpt = inputs.sculpt;
+  const auto parts = static_cast<std::size_t>(inputs.sculpt_parts);
+  std::vector<float> nearest(origins.size(), std::numeric_limits<float>::infinity());
+  std::vector<std::uint8_t> near_run(sculpt.num_vertices());
+  for (std::size_t p = 0; p < parts; ++p) {
+    const std::size_t begin = sculpt.num_faces() * p / parts;
+    const std::size_t end = sculpt.num_faces() * (p + 1) / parts;
+    if (begin == end) continue;
+    std::fill(near_run.begin(), near_run.end(), 0);
+    for (std::size_t s = begin; s < end; ++s) {
+      for (std::int32_t v : sculpt.face(s)) near_run[static_cast<std::size_t>(v)] = 1;
+    }
+    std::vector<std::uint8_t> keep(sculpt.num_faces(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sculpt.num_faces(), 1 << 14),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t s = range.begin(); s != range.end(); ++s) {
+                          for (std::int32_t v : sculpt.face(s)) {
+                            if (near_run[static_cast<std::size_t>(v)]) keep[s] = 1;
+                          }
+                        }
+                      });
+    const Mesh part = SculptPart(sculpt, keep);
+    keep = {};
+    DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer,
+                            MakeEmbreeTracer(part, inputs.tracer_options));
+    LowerNearestHits(*tracer, origins, normals, length, nearest);
+    DISPEX_RETURN_IF_ERROR(tracer->status());
+    if (CancelRequested()) return Cancelled();
+  }
+  return nearest;
 }
 
 }  // namespace dispex::extract

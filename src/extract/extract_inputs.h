@@ -15,6 +15,7 @@
 #include "dispex/trace.h"
 #include "extract/mapping/mapping_trace.h"
 #include "extract/mapping/vertex_displacements.h"
+#include "extract/memory_check.h"
 
 namespace dispex::extract {
 
@@ -23,32 +24,41 @@ struct FaceKeys;
 struct ExtractInputs {
   Mesh base;
   Mesh sculpt;
-  LimitSurface surface;             // of the base
-  std::vector<PtexFaceInfo> faces;  // the map's face table, from `surface`
-  std::unique_ptr<Tracer> tracer;   // the sculpt's BVH; reads the sculpt's arrays
+  LimitSurface surface;              // of the base
+  std::vector<PtexFaceInfo> faces;   // the map's face table, from `surface`
+  std::unique_ptr<Tracer> tracer{};  // the sculpt's BVH; reads the sculpt's arrays
   // An incremental run may trace against only the part of the sculpt that the faces it
   // extracts can reach (BuildLocalTracer): `traced` flags those Ptex faces, and EnsureTraced
   // swaps in the whole sculpt's tracer before any other face is extracted. Empty: the tracer
   // holds the whole sculpt.
-  std::vector<std::uint8_t> traced;
-  Mesh traced_part;      // the part of the sculpt that tracer reads, when it reads a part
+  std::vector<std::uint8_t> traced{};
+  Mesh traced_part{};    // the part of the sculpt that tracer reads, when it reads a part
   bool widened = false;  // EnsureTraced replaced a part's tracer by a larger one
-  TracerOptions tracer_options;
+  TracerOptions tracer_options{};
   // The sculpt as the base refined (ExtractMethod, extract_mapping.h): samples are traced
   // through it, and `tracer` is built only for those it leaves undecided (TraceFallback), over
   // the sculpt within reach of their faces (`face_keys`, the run's).
-  std::unique_ptr<SculptMapping> mapping;
+  std::unique_ptr<SculptMapping> mapping{};
   // With `mapping`: the sculpt's vertex displacements are interpolated (vertex_displacements.h)
   // instead of traced; no tracer, no search distance.
   bool interpolate = false;
   // A vector map's sculpt as the base refined (MatchVectorSculpt, vector_faces.h): every face
   // reads the sculpt through it.
-  std::unique_ptr<SculptCorrespondence> correspondence;
+  std::unique_ptr<SculptCorrespondence> correspondence{};
   // With `interpolate`: the grids the displacements are read from, over `mapping` or, for
   // vector maps, `correspondence`.
-  std::unique_ptr<GridSource> grids;
+  std::unique_ptr<GridSource> grids{};
   const FaceKeys* face_keys = nullptr;
   double fallback_bvh_seconds = 0;  // building those tracers
+  // The memory limit the plan keeps within (bytes; 0: none), the estimate it is made from, and
+  // the runs the faces are traced in when the whole sculpt's BVH does not fit (ForEachTracedRun).
+  std::uint64_t memory_limit = 0;
+  MemoryNeed memory;
+  int sculpt_parts = 1;
+  std::size_t part_faces = 0;  // with sculpt_parts > 1: the sculpt faces a run's BVH may hold
+  double run_bvh_seconds = 0;  // building the runs' BVHs (TraceRun) ...
+  int runs_traced = 0;         // ... of this many runs
+  std::string run_backend{};   // their TracerStats::backend
 };
 
 // Reads the sculpt while the base is read and its limit surface built, fingerprints both
@@ -91,6 +101,41 @@ void AddRings(const std::vector<PtexFaceInfo>& faces, int rings, std::vector<int
 // reach beyond, a tracer of the part within reach of them, kLocalRings around them and the
 // faces it already served (the whole sculpt's when that is more than half the faces).
 Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces);
+
+// The faces' runs when the sculpt is traced in parts (ExtractInputs::sculpt_parts): `faces` in
+// shard order (ShardOrder, so that a run's faces lie together), cut where the sculpt within
+// reach of a run's faces and their rings would pass part_faces (RunsWithinReach). One run of
+// `faces` otherwise.
+// A kOverBudget error when one face's reach alone passes part_faces.
+StatusOr<std::vector<std::vector<int>>> TracedRuns(const ExtractInputs& inputs,
+                                                   std::span<const int> faces);
+
+// Before a run of TracedRuns is extracted, with the sculpt in parts: the BVH of the sculpt
+// within reach of exactly those faces, the previous run's freed first. `run` empty: frees it.
+// Otherwise EnsureTraced.
+Status TraceRun(ExtractInputs& inputs, std::span<const int> run);
+
+// Calls `work(run)` for each run of TracedRuns(faces) once TraceRun has built its BVH; the last
+// BVH of a sculpt in parts is freed afterwards. The hits, so the map, are those of the whole
+// sculpt's BVH: a run's part holds every sculpt face its rays can reach.
+template <typename Work>
+Status ForEachTracedRun(ExtractInputs& inputs, std::span<const int> faces, Work work) {
+  DISPEX_ASSIGN_OR_RETURN(const std::vector<std::vector<int>> runs, TracedRuns(inputs, faces));
+  if (inputs.sculpt_parts > 1) inputs.runs_traced += static_cast<int>(runs.size());
+  for (const std::vector<int>& run : runs) {
+    DISPEX_RETURN_IF_ERROR(TraceRun(inputs, run));
+    DISPEX_RETURN_IF_ERROR(work(std::span<const int>(run)));
+    if (inputs.sculpt_parts > 1 && inputs.tracer) DISPEX_RETURN_IF_ERROR(inputs.tracer->status());
+  }
+  if (inputs.sculpt_parts > 1) return TraceRun(inputs, {});
+  return Status::Ok();
+}
+
+// The long rays of the automatic search distance (EstimateSearchDistance) against the sculpt
+// in sculpt_parts parts, one BVH at a time: per query, |t| of its nearest hit, or infinity.
+StatusOr<std::vector<float>> NearestHitsInParts(const ExtractInputs& inputs,
+                                                std::span<const Float3> origins,
+                                                std::span<const Float3> normals, float length);
 
 // Frees the sculpt's arrays (its source stays) once a part's tracer holds all a run needs: a
 // shard's, whose faces' keys, settings and BVH are made. EnsureTraced must not be called then.

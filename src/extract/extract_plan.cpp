@@ -17,7 +17,12 @@ constexpr auto kTracerNames = EnumTable<ExtractPlan::Tracer>({
     {ExtractPlan::Tracer::kNone, "none"},
     {ExtractPlan::Tracer::kWholeSculpt, "whole sculpt"},
     {ExtractPlan::Tracer::kWithinReach, "within reach"},
+    {ExtractPlan::Tracer::kInParts, "in parts"},
 });
+
+std::string Bytes(std::uint64_t bytes) {
+  return fmt::format("{:.2f} GiB", static_cast<double>(bytes) / double(1u << 30));
+}
 
 }  // namespace
 
@@ -45,6 +50,12 @@ std::string ExtractPlanSummary(const ExtractPlan& plan) {
     if (plan.faces_elsewhere > 0) out += fmt::format(", {} another shard's", plan.faces_elsewhere);
     if (plan.hole_faces > 0) out += fmt::format(", {} holes", plan.hole_faces);
     out += "\n";
+  }
+  if (plan.tracer == ExtractPlan::Tracer::kInParts) {
+    out += fmt::format(
+        "  the sculpt's BVH in {} parts, one at a time: the whole is estimated at "
+        "more than the {} memory limit\n",
+        plan.sculpt_parts, Bytes(plan.memory_limit));
   }
   if (!plan.redo_reason.empty()) out += fmt::format("  why: {}\n", plan.redo_reason);
   if (plan.uv_maps) out += "  then the UV-space tiles\n";
@@ -102,6 +113,9 @@ nlohmann::json ExtractPlanJson(const ExtractPlan& plan) {
                 {"another_shards", plan.faces_elsewhere},
                 {"holes", plan.hole_faces}};
   j["uv_maps"] = plan.uv_maps;
+  j["memory"] = {{"limit_bytes", plan.memory_limit},
+                 {"estimate_bytes", plan.memory_estimate},
+                 {"sculpt_parts", plan.sculpt_parts}};
   return j;
 }
 

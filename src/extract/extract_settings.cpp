@@ -54,15 +54,30 @@ Status ResolveTolerance(const ExtractOptions& options, const Mesh& sculpt, Extra
   return Status::Ok();
 }
 
+// EstimateSearchDistance over the sculpt in parts, one BVH at a time (NearestHitsInParts).
+StatusOr<SearchDistanceEstimate> EstimateInParts(const ExtractInputs& inputs,
+                                                 const CoarseSampling& coarse, double diagonal) {
+  const SearchDistanceOptions options;
+  DISPEX_ASSIGN_OR_RETURN(std::vector<float> nearest,
+                          NearestHitsInParts(inputs, coarse.points, coarse.normals,
+                                             static_cast<float>(options.ray_fraction * diagonal)));
+  std::vector<double> abs_t;
+  for (float t : nearest) {
+    if (std::isfinite(t)) abs_t.push_back(static_cast<double>(t));
+  }
+  return SearchDistanceFromHits(std::move(abs_t), nearest.size(), diagonal, options);
+}
+
 Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs& inputs,
                               const CoarseSampling& coarse, ExtractReport& report) {
   report.settings.search_distance_auto =
       options.search_distance.kind == SearchDistanceSpec::Kind::kAuto;
   if (report.settings.search_distance_auto) {
-    auto estimate = inputs.mapping
-                        ? EstimateSearchDistanceMapped(inputs, coarse, report.inputs.base_diagonal)
-                        : EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals,
-                                                 report.inputs.base_diagonal);
+    auto estimate =
+        inputs.mapping  ? EstimateSearchDistanceMapped(inputs, coarse, report.inputs.base_diagonal)
+        : inputs.tracer ? EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals,
+                                                 report.inputs.base_diagonal)
+                        : EstimateInParts(inputs, coarse, report.inputs.base_diagonal);
     if (!estimate.ok()) {
       return Status::Error(StatusCode::kMismatch,
                            fmt::format("{} and {} do not overlap: {}", options.base_path,

@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "dispex/extract.h"
@@ -17,6 +19,11 @@ constexpr double kArraysPerFileByte = 0.5;
 constexpr double kReadPeakFactor = 1.5;
 // Embree's BVH over quads at medium quality, per primitive (incl. its build scratch).
 constexpr double kBvhBytesPerPrimitive = 80;
+// MatchRefinedSculpt's peak per sculpt face, its half-edge adjacency (dispex/correspondence.h).
+constexpr std::uint64_t kMatchBytesPerFace = 40;
+// The parts a sculpt is planned in against how many faces one holds: the search distance's
+// margin around each, and uneven runs.
+constexpr double kPartShareFactor = 2;
 
 std::string Gib(std::uint64_t bytes) {
   const double b = double(bytes);
@@ -25,11 +32,20 @@ std::string Gib(std::uint64_t bytes) {
   return fmt::format("{:.1f} KiB", b / 1024.0);
 }
 
-Status TooBig(std::uint64_t need, std::uint64_t limit, const std::string& what) {
+// `given`: the limit is max_memory's, else what the machine has available.
+Status TooBig(std::uint64_t need, std::uint64_t limit, bool given, const std::string& what) {
+  if (given) {
+    return Status::Error(
+        StatusCode::kOverBudget,
+        fmt::format("{} needs an estimated {} but the limit is {} (max_memory); free memory, use "
+                    "a machine with more, or raise max_memory if the estimate is too high",
+                    what, Gib(need), Gib(limit)));
+  }
   return Status::Error(
       StatusCode::kOverBudget,
-      fmt::format("{} needs an estimated {} but the limit is {} (max_memory); free memory, use a "
-                  "machine with more, or raise max_memory if the estimate is too high",
+      fmt::format("{} needs an estimated {} but only {} is available (free memory, within the "
+                  "process's cgroup and address-space limits); free memory or use a machine with "
+                  "more (max_memory sets the limit instead)",
                   what, Gib(need), Gib(limit)));
 }
 
@@ -45,25 +61,61 @@ Status CheckMemoryBeforeReading(const ExtractOptions& options, std::uint64_t lim
   if (ec) sculpt = 0;
   auto need =
       static_cast<std::uint64_t>(double(base + sculpt) * kArraysPerFileByte * kReadPeakFactor);
-  if (need > limit) return TooBig(need, limit, "reading " + options.sculpt_path);
+  if (need > limit) {
+    return TooBig(need, limit, options.max_memory > 0, "reading " + options.sculpt_path);
+  }
   return Status::Ok();
 }
 
-Status CheckMemoryForSculpt(std::size_t sculpt_vertices, std::size_t sculpt_faces,
-                            std::size_t sculpt_indices, std::uint64_t base_texels,
-                            std::uint64_t limit) {
-  if (limit == 0) return Status::Ok();
-  const double arrays = 12.0 * double(sculpt_vertices) + 4.0 * double(sculpt_faces + 1) +
-                        4.0 * double(sculpt_indices);
+MemoryNeed EstimateMemory(std::size_t sculpt_vertices, std::size_t sculpt_faces,
+                          std::size_t sculpt_indices, std::uint64_t max_texels, bool matches) {
+  MemoryNeed need;
+  need.arrays = 12 * std::uint64_t{sculpt_vertices} + 4 * std::uint64_t{sculpt_faces + 1} +
+                4 * std::uint64_t{sculpt_indices};
+  need.vertex_map = 5 * std::uint64_t{sculpt_vertices} + std::uint64_t{sculpt_faces};
+  // MatchRefinedSculpt's peak (dispex/correspondence.h), then the mapping it leaves.
+  if (matches) need.match = kMatchBytesPerFace * std::uint64_t{sculpt_faces};
   const double primitives = double(sculpt_indices) / 4.0 + double(sculpt_faces);  // upper bound
-  const double bvh = kBvhBytesPerPrimitive * primitives;
-  const double output = 4.0 * double(base_texels);  // compressed blocks, at most raw floats
-  auto need = static_cast<std::uint64_t>(arrays + bvh + output);
-  if (need > limit) {
-    return TooBig(need, limit,
-                  fmt::format("a sculpt of {} faces (arrays, BVH and output)", sculpt_faces));
+  need.bvh = static_cast<std::uint64_t>(kBvhBytesPerPrimitive * primitives);
+  // The map's texels as floats (kept for the edges, then compressed): the oversampling reads
+  // a sculpt's detail at about 4 samples per sculpt face, up to every face at the largest.
+  need.output = 4 * std::min<std::uint64_t>(max_texels, 4 * std::uint64_t{sculpt_faces});
+  return need;
+}
+
+Status CheckMemoryForSculpt(const MemoryNeed& need, std::size_t sculpt_faces, std::uint64_t limit,
+                            bool given) {
+  const std::uint64_t floor = need.arrays + need.match + need.output;
+  if (limit == 0 || floor <= limit) return Status::Ok();
+  return TooBig(floor, limit, given,
+                fmt::format("a sculpt of {} faces ({}arrays and output)", sculpt_faces,
+                            need.match > 0 ? "its correspondence, " : ""));
+}
+
+StatusOr<SculptParts> SculptPartsWithin(const MemoryNeed& need, std::size_t sculpt_faces,
+                                        std::uint64_t limit, bool given, std::uint64_t* estimate) {
+  const std::uint64_t whole = need.arrays + need.bvh + need.output;
+  *estimate = whole;
+  if (limit == 0 || whole <= limit || sculpt_faces == 0) return SculptParts{1, sculpt_faces};
+  // A part: sculpt faces with their arrays and BVH, besides the whole sculpt's arrays.
+  const std::uint64_t floor = need.arrays + need.vertex_map + need.output;
+  const double per_face = double(need.arrays + need.bvh) / double(sculpt_faces);
+  SculptParts parts;
+  if (limit > floor) {
+    parts.part_faces = static_cast<std::size_t>(double(limit - floor) / per_face);
+    parts.parts = static_cast<int>(std::ceil(kPartShareFactor * double(sculpt_faces) /
+                                             double(std::max<std::size_t>(1, parts.part_faces))));
   }
-  return Status::Ok();
+  if (limit > floor && parts.parts <= kMaxSculptParts) {
+    *estimate = floor + static_cast<std::uint64_t>(per_face * double(parts.part_faces));
+    return parts;
+  }
+  *estimate = floor + static_cast<std::uint64_t>(kPartShareFactor * per_face *
+                                                 double(sculpt_faces) / kMaxSculptParts);
+  return TooBig(*estimate, limit, given,
+                fmt::format("tracing a sculpt of {} faces in {} parts (arrays, a part's BVH and "
+                            "output)",
+                            sculpt_faces, kMaxSculptParts));
 }
 
 }  // namespace dispex::extract

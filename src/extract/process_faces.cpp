@@ -148,8 +148,18 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
     if (result.kind == FaceResult::Kind::kAnalysed) w.cpu_write += step.seconds();
     return written;
   };
-  Status status = ForEachFace(
-      num_faces, [](int k) { return k; }, scratches, &bar, process);
+  // The faces that trace, in runs when the sculpt is in parts (ForEachTracedRun), after the rest.
+  std::vector<int> traced, untraced;
+  for (int f = 0; f < num_faces; ++f) {
+    (sources[static_cast<std::size_t>(f)] == FaceSource::kRun ? traced : untraced).push_back(f);
+  }
+  auto each = [&](std::span<const int> faces) {
+    return ForEachFace(
+        static_cast<int>(faces.size()), [&](int k) { return faces[static_cast<std::size_t>(k)]; },
+        scratches, &bar, process);
+  };
+  Status status = each(untraced);
+  if (status.ok()) status = ForEachTracedRun(inputs, traced, each);
   std::vector<int> waiting;
   for (int f = 0; f < num_faces; ++f) {
     if (deferred[static_cast<std::size_t>(f)]) waiting.push_back(f);
@@ -183,7 +193,6 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
 Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
                       std::span<const int> faces, std::span<const std::array<int, 2>> least_log2,
                       ProcessedFaces& processed) {
-  if (!inputs.mapping) DISPEX_RETURN_IF_ERROR(EnsureTraced(inputs, faces));
   tbb::enumerable_thread_specific<FaceScratch> scratches(
       [&] { return FaceScratch(inputs.surface); });
   const auto num_faces = static_cast<std::size_t>(inputs.surface.num_ptex_faces());
@@ -202,9 +211,12 @@ Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
     processed.kept[f] = Keep(result, settings.data_type, processed.channels);
     return Status::Ok();
   };
-  DISPEX_RETURN_IF_ERROR(ForEachFace(
-      static_cast<int>(faces.size()), [&](int k) { return faces[static_cast<std::size_t>(k)]; },
-      scratches, nullptr, process));
+  auto each = [&](std::span<const int> run) {
+    return ForEachFace(
+        static_cast<int>(run.size()), [&](int k) { return run[static_cast<std::size_t>(k)]; },
+        scratches, nullptr, process);
+  };
+  DISPEX_RETURN_IF_ERROR(inputs.mapping ? each(faces) : ForEachTracedRun(inputs, faces, each));
   std::vector<int> waiting;
   for (int f : faces) {
     if (deferred[static_cast<std::size_t>(f)]) waiting.push_back(f);

@@ -67,8 +67,8 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
 // Runs ProcessFace again for `faces` with their least resolutions (`least_log2`, per Ptex
 // face), replacing their kept texels and statistics; the rays cast count in the totals. Swaps
 // in the whole sculpt's tracer first when the current one does not hold their reach
-// (EnsureTraced); through the mapping, a tracer only for the faces that need one, afterwards
-// (TraceFallback).
+// (EnsureTraced), or traces them in runs when the sculpt is in parts (ForEachTracedRun);
+// through the mapping, a tracer only for the faces that need one, afterwards (TraceFallback).
 Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
                       std::span<const int> faces, std::span<const std::array<int, 2>> least_log2,
                       ProcessedFaces& processed);

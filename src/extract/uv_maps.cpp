@@ -153,7 +153,10 @@ void RemoveStaleTiles(const std::string& dir, const std::string& shape,
 Status BuildTracerIfNeeded(const ExtractOptions& options, const ExtractSettings& settings,
                            std::span<const int> faces, ExtractInputs& inputs,
                            ExtractReport& report) {
-  if (options.vector.has_value() || settings.interpolate || faces.empty()) return Status::Ok();
+  if (options.vector.has_value() || settings.interpolate || faces.empty() ||
+      inputs.sculpt_parts > 1) {  // in parts: each run builds its own (ForEachTracedRun)
+    return Status::Ok();
+  }
   const bool within_reach =
       !inputs.traced.empty() && std::all_of(faces.begin(), faces.end(), [&](int f) {
         return inputs.traced[static_cast<std::size_t>(f)] != 0;
@@ -272,26 +275,28 @@ Status TraceTexels(PtexFaceId face, TexelSpan texels, const ExtractSettings& set
 
 // The texels of `faces`, in parallel over them: interpolated, vector or traced. Counts each
 // face's misses in `face_misses` (num_faces long).
-Status ExtractTexels(const ExtractSettings& settings, const ExtractInputs& inputs,
+Status ExtractTexels(const ExtractSettings& settings, ExtractInputs& inputs,
                      const SculptCorrespondence* correspondence, bool vector,
                      const UvRaster& raster, const FaceTexels& by_face, std::span<const int> faces,
                      UvTileValues& tiles, std::vector<std::int64_t>& face_misses) {
   tbb::enumerable_thread_specific<UvScratch> scratches([&] { return UvScratch(inputs.surface); });
-  const Status extracted = ForEachFace(
-      static_cast<int>(faces.size()), [&](int k) { return faces[static_cast<std::size_t>(k)]; },
-      scratches, nullptr,
-      [&](PtexFaceId face, UvScratch& w) {
-        const auto f = static_cast<std::size_t>(face.value);
-        const std::size_t begin = by_face.offsets[f], count = by_face.offsets[f + 1] - begin;
-        const TexelSpan texels = TexelSpan(by_face.texels).subspan(begin, count);
-        GatherTexelUvs(raster, texels, w.uv);
-        if (settings.interpolate) return InterpolateTexels(face, texels, vector, inputs, w, tiles);
-        if (vector) return ReadVectorTexels(face, texels, *correspondence, inputs, w, tiles);
-        return TraceTexels(face, texels, settings, inputs, w, tiles, face_misses[f]);
-      });
-  DISPEX_RETURN_IF_ERROR(extracted);
-  if (!vector && !settings.interpolate) DISPEX_RETURN_IF_ERROR(inputs.tracer->status());
-  return Status::Ok();
+  auto extract = [&](PtexFaceId face, UvScratch& w) {
+    const auto f = static_cast<std::size_t>(face.value);
+    const std::size_t begin = by_face.offsets[f], count = by_face.offsets[f + 1] - begin;
+    const TexelSpan texels = TexelSpan(by_face.texels).subspan(begin, count);
+    GatherTexelUvs(raster, texels, w.uv);
+    if (settings.interpolate) return InterpolateTexels(face, texels, vector, inputs, w, tiles);
+    if (vector) return ReadVectorTexels(face, texels, *correspondence, inputs, w, tiles);
+    return TraceTexels(face, texels, settings, inputs, w, tiles, face_misses[f]);
+  };
+  auto each = [&](std::span<const int> run) {
+    return ForEachFace(
+        static_cast<int>(run.size()), [&](int k) { return run[static_cast<std::size_t>(k)]; },
+        scratches, nullptr, extract);
+  };
+  if (vector || settings.interpolate) return each(faces);
+  DISPEX_RETURN_IF_ERROR(ForEachTracedRun(inputs, faces, each));
+  return inputs.tracer ? inputs.tracer->status() : Status::Ok();
 }
 
 // The raster's and the misses' part of the report, and their warnings.

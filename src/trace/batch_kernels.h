@@ -368,7 +368,7 @@ class NormalBlock {
       }
       Resolve(suspects_, misses, true);
     }
-    if (scene_.verify_hits()) Verify(count);
+    if (scene_.verify_hits() || query_.verify_hits) Verify(count);
     ResolveTies(count);
     counters.rays_cast += rays_ + repair_rays_;
     counters.repair_rays += repair_rays_;

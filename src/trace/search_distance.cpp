@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "dispex/trace.h"
@@ -124,6 +125,26 @@ StatusOr<SearchDistanceEstimate> SearchDistanceFromHits(std::vector<double> abs_
   return estimate;
 }
 
+void LowerNearestHits(const Tracer& tracer, std::span<const Float3> origins,
+                      std::span<const Float3> normals, float length,
+                      std::span<float> nearest_abs_t) {
+  const NormalQuery query{length, HitPolicy::kNearest, /*verify_hits=*/true};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      const std::size_t b = r.begin(), n = r.size();
+                      std::vector<float> t(n);
+                      std::vector<std::uint8_t> flags(n);
+                      TraceCounters counters;
+                      tracer.TraceNormals(origins.subspan(b, n), normals.subspan(b, n), query,
+                                          NormalHits{t, {}, flags}, counters);
+                      for (std::size_t i = 0; i < n; ++i) {
+                        if (!(flags[i] & HitFlags::kHit)) continue;
+                        float& kept = nearest_abs_t[b + i];
+                        kept = std::min(kept, std::fabs(t[i]));
+                      }
+                    });
+}
+
 StatusOr<SearchDistanceEstimate> EstimateSearchDistance(const Tracer& tracer,
                                                         std::span<const Float3> origins,
                                                         std::span<const Float3> normals,
@@ -136,25 +157,15 @@ StatusOr<SearchDistanceEstimate> EstimateSearchDistance(const Tracer& tracer,
   if (origins.empty()) return Status::Error("search distance estimate: no sample points");
   DISPEX_RETURN_IF_ERROR(CheckEstimateOptions(base_diagonal, options));
 
-  const NormalQuery query{static_cast<float>(options.ray_fraction * base_diagonal),
-                          HitPolicy::kNearest};
-  std::vector<float> t(origins.size());
-  std::vector<std::uint8_t> flags(origins.size());
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, origins.size(), 4096),
-      [&](const tbb::blocked_range<std::size_t>& r) {
-        TraceCounters counters;
-        const std::size_t b = r.begin(), n = r.size();
-        tracer.TraceNormals(
-            origins.subspan(b, n), normals.subspan(b, n), query,
-            NormalHits{std::span(t).subspan(b, n), {}, std::span(flags).subspan(b, n)}, counters);
-      });
+  std::vector<float> nearest(origins.size(), std::numeric_limits<float>::infinity());
+  LowerNearestHits(tracer, origins, normals,
+                   static_cast<float>(options.ray_fraction * base_diagonal), nearest);
   DISPEX_RETURN_IF_ERROR(tracer.status());
 
   std::vector<double> abs_t;
   abs_t.reserve(origins.size());
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    if (flags[i] & HitFlags::kHit) abs_t.push_back(std::fabs(static_cast<double>(t[i])));
+  for (float t : nearest) {
+    if (std::isfinite(t)) abs_t.push_back(static_cast<double>(t));
   }
   return SearchDistanceFromHits(std::move(abs_t), origins.size(), base_diagonal, options);
 }

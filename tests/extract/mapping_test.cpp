@@ -698,7 +698,7 @@ TEST(MappingFallback, FoldsGoToTheBvh) {
 // The automatic search distance through the mapping answers the coarse samples it leaves
 // undecided (near the folds) with a BVH, as the ray path answers every one: the same distance
 // and the same map, beyond rounding, at default sampling. Rejects an estimate over the decided
-// samples only, which gave 0.0469 here against the ray path's 0.0547, and maps that differed
+// samples only, which gave 0.0469 here against the ray path's 0.0508, and maps that differed
 // in a few texels.
 TEST(MappingFallback, AutomaticDistanceIsTheRayPaths) {
   TempDir dir;

@@ -413,4 +413,92 @@ Mesh SculptPart(const Mesh& sculpt, std::span<const std::uint8_t> keep) {
   return part;
 }
 
+ReachRuns RunsWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
+                          std::span<const int> faces, int rings, std::size_t part_faces) {
+  const LimitSurface& surface = inputs.surface;
+  const Mesh& sculpt = inputs.sculpt;
+  const std::vector<Box>& boxes = keys.reach_boxes;
+  const float half_extent = keys.sculpt_half_extent;
+  std::vector<std::uint8_t> skip(boxes.size());
+  for (std::size_t f = 0; f < boxes.size(); ++f) {
+    skip[f] = surface.is_hole(PtexFaceId(static_cast<int>(f)));
+  }
+  // SculptWithinReach's cells over every face, with the sculpt faces whose centre each holds.
+  const CellGrid grid(boxes, skip, /*per_side=*/6);
+  tbb::enumerable_thread_specific<std::vector<std::int64_t>> local(
+      [&] { return std::vector<std::int64_t>(grid.num_cells(), 0); });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sculpt.num_faces(), 1 << 14),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      std::vector<std::int64_t>& counts = local.local();
+                      Corners corners;
+                      for (std::size_t s = range.begin(); s != range.end(); ++s) {
+                        const std::array<float, 3> centre = Bounds(corners.Of(sculpt, s)).centre;
+                        if (grid.Near(centre, half_extent)) ++counts[grid.CellOf(centre)];
+                      }
+                    });
+  std::vector<std::int64_t> counts(grid.num_cells(), 0);
+  for (const std::vector<std::int64_t>& c : local) {
+    for (std::size_t i = 0; i < c.size(); ++i) counts[i] += c[i];
+  }
+
+  std::vector<std::uint8_t> in_run(boxes.size(), 0), marked(grid.num_cells(), 0);
+  std::vector<int> run_faces, added;  // the faces and rings in the run; those f adds
+  std::vector<std::size_t> run_cells;
+  std::int64_t held = 0;
+  // Adds face f and its rings to the run; the sculpt faces that adds to the run's part.
+  auto add = [&](int f) {
+    added.clear();
+    std::vector<int> ring{f};
+    if (!in_run[static_cast<std::size_t>(f)]) added.push_back(f);
+    in_run[static_cast<std::size_t>(f)] = 1;
+    for (int step = 0; step < rings; ++step) {
+      std::vector<int> next;
+      for (int g : ring) {
+        for (std::int32_t h : inputs.faces[static_cast<std::size_t>(g)].adjfaces) {
+          if (h < 0 || in_run[static_cast<std::size_t>(h)]) continue;
+          in_run[static_cast<std::size_t>(h)] = 1;
+          added.push_back(h);
+          next.push_back(h);
+        }
+      }
+      ring = std::move(next);
+    }
+    std::int64_t more = 0;
+    for (int g : added) {
+      run_faces.push_back(g);
+      if (skip[static_cast<std::size_t>(g)]) continue;
+      grid.ForEachCell(boxes[static_cast<std::size_t>(g)], half_extent, [&](std::size_t c) {
+        if (marked[c]) return;
+        marked[c] = 1;
+        run_cells.push_back(c);
+        more += counts[c];
+      });
+    }
+    return more;
+  };
+  auto clear = [&] {
+    for (int g : run_faces) in_run[static_cast<std::size_t>(g)] = 0;
+    for (std::size_t c : run_cells) marked[c] = 0;
+    run_faces.clear();
+    run_cells.clear();
+    held = 0;
+  };
+  ReachRuns out;
+  out.runs.emplace_back();
+  for (int f : faces) {
+    held += add(f);
+    if (!out.runs.back().empty() && held > static_cast<std::int64_t>(part_faces)) {
+      clear();
+      out.runs.emplace_back();
+      held = add(f);
+    }
+    out.runs.back().push_back(f);
+    if (out.runs.back().size() == 1 && held > out.largest_single) {
+      out.largest_single = held;
+      out.largest_face = f;
+    }
+  }
+  return out;
+}
+
 }  // namespace dispex::extract

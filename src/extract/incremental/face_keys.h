@@ -65,6 +65,18 @@ FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& set
 Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
                        std::span<const std::uint8_t> faces);
 
+// `faces` cut, in their order, into runs whose sculpt within reach -- of the run's faces and
+// `rings` rings of Ptex faces around them, in SculptWithinReach's cells -- holds at most
+// `part_faces` sculpt faces (a face whose own reach holds more is a run alone: the largest
+// such is reported).
+struct ReachRuns {
+  std::vector<std::vector<int>> runs;
+  std::int64_t largest_single = 0;  // the sculpt faces within reach of a run's first face alone
+  int largest_face = -1;            // that face
+};
+ReachRuns RunsWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
+                          std::span<const int> faces, int rings, std::size_t part_faces);
+
 // The sculpt faces flagged in `keep` (one flag per sculpt face), in their order, their vertices
 // renumbered in ascending order.
 Mesh SculptPart(const Mesh& sculpt, std::span<const std::uint8_t> keep);

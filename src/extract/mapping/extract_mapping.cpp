@@ -167,8 +167,9 @@ StatusOr<SearchDistanceEstimate> EstimateSearchDistanceMapped(const ExtractInput
   constexpr int g = CoarseSampling::kGrid;
   constexpr std::int64_t per_face = g * g;
   const SearchDistanceOptions options;
+  // Verified as EstimateSearchDistance's (LowerNearestHits).
   const NormalQuery query{static_cast<float>(options.ray_fraction * base_diagonal),
-                          HitPolicy::kNearest};
+                          HitPolicy::kNearest, /*verify_hits=*/true};
   // The points of each face, which follow one another.
   std::vector<std::size_t> starts;
   for (std::size_t k = 0; k < coarse.ids.size(); ++k) {

@@ -1,0 +1,184 @@
+// A memory budget that is kept (ExtractOptions::max_memory): a rays extraction whose whole
+// sculpt's BVH is estimated over the limit is traced in runs, a BVH of the sculpt within reach
+// of one run of faces at a time, and must write the map, byte for byte, of the whole sculpt's
+// BVH -- with the automatic search distance (estimated over the sculpt in parts too) and a
+// given one, watertight edges on (the edge pass re-traces faces in runs) and off, half floats,
+// UV-space tiles. Below what any plan needs, nothing is done and nothing is written.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "dispex/extract.h"
+#include "dispex/mesh.h"
+#include "dispex/verify.h"
+#include "e2e_support.h"
+
+namespace dispex {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::DataPath;
+using testing::Slurp;
+using testing::TempDir;
+
+struct Variant {
+  const char* name;
+  bool auto_search_distance;
+  WatertightEdges watertight;
+  PtexDataType data_type;
+  bool uv_maps;
+};
+
+void PrintTo(const Variant& v, std::ostream* os) {
+  *os << v.name;
+}
+
+class MemoryBudget : public ::testing::TestWithParam<Variant> {
+ protected:
+  void SetUp() override {
+    base_ = DataPath("meshes/keenan_spot/spot_quadrangulated.obj");
+    sculpt_ = dir_ / "sculpt.ply";
+    auto made = MakeSculpt(testing::SculptOptions(base_, sculpt_, 3, Pattern::kDetail, 0.005));
+    ASSERT_TRUE(made.ok()) << made.status().message();
+  }
+
+  ExtractOptions Options(const std::string& name) const {
+    ExtractOptions o;
+    o.base_path = base_;
+    o.sculpt_path = sculpt_;
+    o.output_path = dir_ / (name + ".ptx");
+    o.method = ExtractMethod::kRays;
+    o.watertight = GetParam().watertight;
+    o.data_type = GetParam().data_type;
+    if (!GetParam().auto_search_distance) {
+      o.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.01};
+    }
+    if (GetParam().uv_maps) {
+      o.uv_maps_dir = dir_ / ("uv_" + name);
+      o.uv_resolution = 256;
+    }
+    return o;
+  }
+
+  // The UV-space tiles of the map `name`, by their names less the map's.
+  static std::map<std::string, std::string> Tiles(const std::string& folder,
+                                                  const std::string& name) {
+    std::map<std::string, std::string> out;
+    for (const auto& entry : fs::directory_iterator(folder)) {
+      const std::string file = entry.path().filename().string();
+      if (file.rfind(name + ".", 0) == 0) out[file.substr(name.size())] = Slurp(entry.path());
+    }
+    return out;
+  }
+
+  TempDir dir_;
+  std::string base_, sculpt_;
+};
+
+TEST_P(MemoryBudget, TracedInPartsIsTheMapOfTheWholeSculpt) {
+  const ExtractOptions whole = Options("whole");
+  auto expected = Extract(whole);
+  ASSERT_TRUE(expected.ok()) << expected.status().message();
+  EXPECT_EQ(expected->plan.tracer, ExtractPlan::Tracer::kWholeSculpt);
+  EXPECT_EQ(expected->plan.sculpt_parts, 0);
+  const std::uint64_t one_pass = expected->plan.memory_estimate;
+  ASSERT_GT(one_pass, 0u);
+  if (GetParam().watertight != WatertightEdges::kOff) {
+    EXPECT_GT(expected->edges.raised_faces, 0);  // the edge pass runs, in runs of faces
+  }
+
+  int last_parts = 1;
+  for (double fraction : {0.6, 0.4}) {
+    ExtractOptions limited = Options("parts");
+    limited.max_memory = static_cast<std::uint64_t>(fraction * double(one_pass));
+    auto report = Extract(limited);
+    ASSERT_TRUE(report.ok()) << report.status().message();
+    EXPECT_EQ(report->plan.tracer, ExtractPlan::Tracer::kInParts);
+    EXPECT_GT(report->plan.sculpt_parts, last_parts) << "a smaller budget, more parts";
+    last_parts = report->plan.sculpt_parts;
+    EXPECT_LE(report->plan.memory_estimate, limited.max_memory);
+    EXPECT_EQ(report->plan.memory_limit, limited.max_memory);
+    EXPECT_EQ(report->settings.search_distance, expected->settings.search_distance);
+    EXPECT_TRUE(Slurp(limited.output_path) == Slurp(whole.output_path))
+        << "in " << report->plan.sculpt_parts << " parts the map differs from the whole BVH's";
+    if (GetParam().uv_maps) {
+      const auto tiles = Tiles(limited.uv_maps_dir, "parts");
+      EXPECT_FALSE(tiles.empty());
+      EXPECT_TRUE(tiles == Tiles(whole.uv_maps_dir, "whole")) << "the UV-space tiles differ";
+    }
+    const std::string said = "traced in " + std::to_string(report->plan.sculpt_parts) + " parts";
+    EXPECT_TRUE(
+        std::any_of(report->warnings.begin(), report->warnings.end(),
+                    [&](const std::string& w) { return w.find(said) != std::string::npos; }))
+        << "no warning says: " << said;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Variants, MemoryBudget,
+    ::testing::Values(
+        Variant{"auto_distance", true, WatertightEdges::kFilter, PtexDataType::kFloat, false},
+        Variant{"given_distance_edges_off", false, WatertightEdges::kOff, PtexDataType::kFloat,
+                false},
+        Variant{"auto_distance_half", true, WatertightEdges::kFilter, PtexDataType::kHalf, false},
+        Variant{"auto_distance_uv_maps", true, WatertightEdges::kFilter, PtexDataType::kFloat,
+                true}),
+    [](const ::testing::TestParamInfo<Variant>& param) { return std::string(param.param.name); });
+
+// Spot's cage with a level-3 sculpt of it in `dir`, through rays.
+ExtractOptions RaysOnSpot(const TempDir& dir) {
+  ExtractOptions o;
+  o.base_path = DataPath("meshes/keenan_spot/spot_quadrangulated.obj");
+  o.sculpt_path = dir / "sculpt.ply";
+  o.output_path = dir / "map.ptx";
+  o.method = ExtractMethod::kRays;
+  auto made =
+      MakeSculpt(testing::SculptOptions(o.base_path, o.sculpt_path, 3, Pattern::kDetail, 0.005));
+  EXPECT_TRUE(made.ok()) << made.status().message();
+  return o;
+}
+
+TEST(MemoryBudgetRefusal, BelowWhatEveryPlanNeedsNothingIsDoneAndNothingWritten) {
+  TempDir dir;
+  ExtractOptions o = RaysOnSpot(dir);
+  auto whole = Extract(o);
+  ASSERT_TRUE(whole.ok()) << whole.status().message();
+  fs::remove(o.output_path);
+  // The sculpt's arrays and the output are needed whatever the parts: a tenth of the one-pass
+  // need is below them.
+  o.max_memory = whole->plan.memory_estimate / 10;
+  auto refused = Extract(o);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kOverBudget);
+  EXPECT_NE(refused.status().message().find("max_memory"), std::string::npos)
+      << refused.status().message();
+  EXPECT_FALSE(fs::exists(o.output_path));
+}
+
+// A search distance so long that one face's rays reach most of the sculpt: no run of faces
+// keeps within the budget, so the extraction is refused once the reach is known, before any
+// face is traced, naming the face and what to change.
+TEST(MemoryBudgetRefusal, AReachLargerThanAPartIsRefusedBeforeTracing) {
+  TempDir dir;
+  ExtractOptions o = RaysOnSpot(dir);
+  o.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.3};
+  o.plan_only = true;
+  auto planned = Extract(o);
+  ASSERT_TRUE(planned.ok()) << planned.status().message();
+  o.plan_only = false;
+  o.max_memory = planned->plan.memory_estimate / 2;
+  auto refused = Extract(o);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kOverBudget);
+  EXPECT_NE(refused.status().message().find("within reach of Ptex face"), std::string::npos)
+      << refused.status().message();
+  EXPECT_NE(refused.status().message().find("search_distance"), std::string::npos);
+  EXPECT_FALSE(fs::exists(o.output_path));
+}
+
+}  // namespace
+}  // namespace dispex
