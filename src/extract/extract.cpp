@@ -164,10 +164,9 @@ Status PlanSculptParts(const ExtractOptions& options, ExtractInputs& inputs,
   plan.tracer = ExtractPlan::Tracer::kInParts;
   plan.sculpt_parts = inputs.sculpt_parts;
   report.warnings.push_back(fmt::format(
-      "{}: a BVH of the whole sculpt is estimated to need more than the {:.2f} GiB memory limit: "
+      "{}: a BVH of the whole sculpt is estimated to need more than the {} memory limit: "
       "traced in {} parts, one at a time (the same map, slower){}",
-      options.sculpt_path, static_cast<double>(inputs.memory_limit) / double(1u << 30),
-      inputs.sculpt_parts,
+      options.sculpt_path, MemorySize(inputs.memory_limit), inputs.sculpt_parts,
       options.check_inputs ? "; the sculpt's placement against the base is not checked" : ""));
   return Status::Ok();
 }

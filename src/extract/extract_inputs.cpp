@@ -279,11 +279,10 @@ StatusOr<std::vector<std::vector<int>>> TracedRuns(const ExtractInputs& inputs,
     return Status::Error(
         StatusCode::kOverBudget,
         fmt::format("{}: the sculpt within reach of Ptex face {} and the faces around it holds "
-                    "{} sculpt faces, more than the {} a BVH may hold within the {:.2f} GiB "
-                    "memory limit; raise the limit (max_memory), or give a shorter "
-                    "search_distance",
+                    "{} sculpt faces, more than the {} a BVH may hold within the {} memory "
+                    "limit; raise the limit (max_memory), or give a shorter search_distance",
                     inputs.sculpt.source, cut.largest_face, cut.largest_single, inputs.part_faces,
-                    double(inputs.memory_limit) / double(1u << 30)));
+                    MemorySize(inputs.memory_limit)));
   }
   return std::move(cut.runs);
 }

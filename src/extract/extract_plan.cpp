@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "core/enum_names.h"
+#include "extract/memory_check.h"
 
 namespace dispex {
 
@@ -19,10 +20,6 @@ constexpr auto kTracerNames = EnumTable<ExtractPlan::Tracer>({
     {ExtractPlan::Tracer::kWithinReach, "within reach"},
     {ExtractPlan::Tracer::kInParts, "in parts"},
 });
-
-std::string Bytes(std::uint64_t bytes) {
-  return fmt::format("{:.2f} GiB", static_cast<double>(bytes) / double(1u << 30));
-}
 
 }  // namespace
 
@@ -55,7 +52,7 @@ std::string ExtractPlanSummary(const ExtractPlan& plan) {
     out += fmt::format(
         "  the sculpt's BVH in {} parts, one at a time: the whole is estimated at "
         "more than the {} memory limit\n",
-        plan.sculpt_parts, Bytes(plan.memory_limit));
+        plan.sculpt_parts, extract::MemorySize(plan.memory_limit));
   }
   if (!plan.redo_reason.empty()) out += fmt::format("  why: {}\n", plan.redo_reason);
   if (plan.uv_maps) out += "  then the UV-space tiles\n";

@@ -25,13 +25,6 @@ constexpr std::uint64_t kMatchBytesPerFace = 40;
 // margin around each, and uneven runs.
 constexpr double kPartShareFactor = 2;
 
-std::string Gib(std::uint64_t bytes) {
-  const double b = double(bytes);
-  if (b >= double(1u << 30)) return fmt::format("{:.2f} GiB", b / double(1u << 30));
-  if (b >= double(1u << 20)) return fmt::format("{:.1f} MiB", b / double(1u << 20));
-  return fmt::format("{:.1f} KiB", b / 1024.0);
-}
-
 // `given`: the limit is max_memory's, else what the machine has available.
 Status TooBig(std::uint64_t need, std::uint64_t limit, bool given, const std::string& what) {
   if (given) {
@@ -39,14 +32,14 @@ Status TooBig(std::uint64_t need, std::uint64_t limit, bool given, const std::st
         StatusCode::kOverBudget,
         fmt::format("{} needs an estimated {} but the limit is {} (max_memory); free memory, use "
                     "a machine with more, or raise max_memory if the estimate is too high",
-                    what, Gib(need), Gib(limit)));
+                    what, MemorySize(need), MemorySize(limit)));
   }
   return Status::Error(
       StatusCode::kOverBudget,
       fmt::format("{} needs an estimated {} but only {} is available (free memory, within the "
                   "process's cgroup and address-space limits); free memory or use a machine with "
                   "more (max_memory sets the limit instead)",
-                  what, Gib(need), Gib(limit)));
+                  what, MemorySize(need), MemorySize(limit)));
 }
 
 }  // namespace
@@ -65,6 +58,13 @@ Status CheckMemoryBeforeReading(const ExtractOptions& options, std::uint64_t lim
     return TooBig(need, limit, options.max_memory > 0, "reading " + options.sculpt_path);
   }
   return Status::Ok();
+}
+
+std::string MemorySize(std::uint64_t bytes) {
+  const double b = double(bytes);
+  if (b >= double(1u << 30)) return fmt::format("{:.2f} GiB", b / double(1u << 30));
+  if (b >= double(1u << 20)) return fmt::format("{:.1f} MiB", b / double(1u << 20));
+  return fmt::format("{:.1f} KiB", b / 1024.0);
 }
 
 MemoryNeed EstimateMemory(std::size_t sculpt_vertices, std::size_t sculpt_faces,

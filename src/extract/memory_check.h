@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
 #include "dispex/extract.h"
 #include "dispex/status.h"
@@ -16,6 +17,9 @@ namespace dispex::extract {
 // fails with a message giving the estimate and the limit; `given`: the limit is max_memory's,
 // else what the machine has available.
 Status CheckMemoryBeforeReading(const ExtractOptions& options, std::uint64_t limit);
+
+// "1.50 GiB", "20.0 MiB", "512.0 KiB": a size for messages.
+std::string MemorySize(std::uint64_t bytes);
 
 struct MemoryNeed {
   std::uint64_t arrays = 0;      // the sculpt's vertex and face arrays
