@@ -27,35 +27,46 @@ std::uint64_t ReadProcKb(const char* file, const std::string& key) {
   return 0;
 }
 
-// The memory limit of this process's own cgroup (v2 memory.max, v1 memory.limit_in_bytes),
-// found through /proc/self/cgroup, or of the mount's root when that path is not visible (a
-// container that shows its own cgroup at the root); 0 when none is set.
+// A limit file's value in bytes; 0 for "max", none or unreadable.
+std::uint64_t LimitIn(const std::string& file) {
+  std::ifstream in(file);
+  std::string value;
+  if (!(in >> value) || value == "max") return 0;
+  try {
+    return std::stoull(value);
+  } catch (...) {
+    return 0;
+  }
+}
+
+// The lowest memory limit of this process's cgroup and its ancestors (v2 memory.max, v1
+// memory.limit_in_bytes: a Slurm job's limit sits on the job's cgroup, its tasks' below it say
+// "max"), found through /proc/self/cgroup; or the mount's root's, where the path is not visible
+// (a container that shows its own cgroup at the root); 0 when none is set.
 std::uint64_t CgroupLimitBytes() {
   std::string v2_path, v1_path;
+  bool v2 = false, v1 = false;
   std::ifstream self("/proc/self/cgroup");
   std::string line;
   while (std::getline(self, line)) {  // "ID:CONTROLLERS:PATH"
     const std::size_t a = line.find(':'), b = line.find(':', a + 1);
     if (a == std::string::npos || b == std::string::npos) continue;
     const std::string controllers = line.substr(a + 1, b - a - 1), path = line.substr(b + 1);
-    if (line.compare(0, a, "0") == 0 && controllers.empty()) v2_path = path;
-    if ((',' + controllers + ',').find(",memory,") != std::string::npos) v1_path = path;
+    if (line.compare(0, a, "0") == 0 && controllers.empty()) v2 = true, v2_path = path;
+    if ((',' + controllers + ',').find(",memory,") != std::string::npos) v1 = true, v1_path = path;
   }
-  const std::string candidates[] = {"/sys/fs/cgroup" + v2_path + "/memory.max",
-                                    "/sys/fs/cgroup/memory" + v1_path + "/memory.limit_in_bytes",
-                                    "/sys/fs/cgroup/memory.max",
-                                    "/sys/fs/cgroup/memory/memory.limit_in_bytes"};
-  for (const std::string& file : candidates) {
-    std::ifstream in(file);
-    std::string value;
-    if (in >> value && value != "max") {
-      try {
-        return std::stoull(value);
-      } catch (...) {
-      }
+  std::uint64_t lowest = 0;
+  auto take = [&](const std::string& mount, std::string path, const char* file) {
+    for (;;) {  // the cgroup, then each ancestor up to the mount's root
+      const std::uint64_t limit = LimitIn(mount + path + "/" + file);
+      if (limit > 0 && (lowest == 0 || limit < lowest)) lowest = limit;
+      if (path.empty() || path == "/") return;
+      path.erase(path.find_last_of('/'));
     }
-  }
-  return 0;
+  };
+  if (v1) take("/sys/fs/cgroup/memory", v1_path, "memory.limit_in_bytes");
+  if (v2) take("/sys/fs/cgroup", v2_path, "memory.max");
+  return lowest;
 }
 }  // namespace
 
