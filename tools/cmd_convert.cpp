@@ -1,5 +1,6 @@
 // dispex convert IN OUT: a mesh from OBJ or PLY to OBJ or PLY (by OUT's name), e.g. a large
-// sculpt to binary PLY, which reads several times faster than OBJ (docs/BENCHMARKS.md).
+// sculpt to binary PLY, which reads several times faster than OBJ (docs/bench-notes/extract.md,
+// "Reading the sculpt").
 #include <fmt/format.h>
 
 #include <chrono>

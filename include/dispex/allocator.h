@@ -8,7 +8,7 @@ namespace dispex {
 // (M_ARENA_MAX 1: every thread's blocks re-use what any thread freed, instead of each worker
 // growing a heap of its own): an extraction's phases free large arrays and allocate others,
 // and every page the system hands out again costs a page fault on its first write
-// (docs/BENCHMARKS.md, "Memory"). Call it before any
+// (docs/bench-notes/extract.md, "Memory"). Call it before any
 // thread starts. Does nothing, and returns false, where the C library is not glibc, when
 // GLIBC_TUNABLES sets a malloc tunable (the user's own settings win) or when the environment
 // sets DISPEX_KEEP_FREED_MEMORY=0.

@@ -1,10 +1,10 @@
 // Growing a large array so that its fresh pages are first touched by every thread.
 //
 // The first write to a fresh page costs a page fault, and on the virtual machines the project
-// is measured on that fault is most of what clearing a large array costs (docs/BENCHMARKS.md,
-// "fresh pages first touched by every thread"). std::vector's resize and assign clear on the
-// calling thread alone; after ReserveTouched the clearing that follows runs over resident
-// pages, at memory speed. Uses the current TBB arena: include only where TBB is linked.
+// is measured on that fault is most of what clearing a large array costs
+// (docs/bench-notes/extract.md, "Memory"). std::vector's resize and assign clear on the calling
+// thread alone; after ReserveTouched the clearing that follows runs over resident pages, at memory
+// speed. Uses the current TBB arena: include only where TBB is linked.
 #pragma once
 
 #include <tbb/blocked_range.h>

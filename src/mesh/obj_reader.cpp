@@ -217,7 +217,7 @@ std::optional<ChunkCopy> CopyChunk(int fd, const char* file_begin, const Chunk& 
 // Both passes read a mapped file's chunks as copies, each with the two bytes before it that a
 // continued newline looks back at, into a buffer of its thread's (CopyChunk): the buffers'
 // pages are first touched once and reused chunk after chunk, where the mapping's pages were each
-// first touched by a pass (docs/BENCHMARKS.md, "Memory"). The file is the one mapped
+// first touched by a pass (docs/bench-notes/extract.md, "Memory"). The file is the one mapped
 // (MappedFile::fd), not whatever its path names now. A chunk that cannot be copied is read
 // through the mapping, its pages mapped in one call and dropped after it. A buffer in memory
 // (no file descriptor) is read in place.

@@ -21,7 +21,7 @@ std::string CheckCompressionLevel(PtexCompressor compressor, int level);
 
 // At libdeflate's fastest level (1, the default), data this short is stored (level 0): each call
 // at level 1 first clears the compressor's hash tables, about 5 us (libdeflate 1.14), which is
-// more than what deflating a few hundred bytes of float texels saves (docs/BENCHMARKS.md,
+// more than what deflating a few hundred bytes of float texels saves (docs/bench-notes/extract.md,
 // "Compression"). The small reductions of every face are such blocks.
 inline constexpr std::size_t kStoredBelow = 512;
 

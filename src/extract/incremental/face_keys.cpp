@@ -353,16 +353,28 @@ void AddFacePatchKey(Hasher& h, const LimitSurface& surface, std::span<const Bas
   h.Add(surface.sub_face(face)).Add(surface.is_hole(face)).Add(settings.plan.log2[f]);
 }
 
+namespace {
+
+// Per Ptex face: whether the reach grid leaves it out, a hole or one `faces` does not flag
+// (empty: every face flagged).
+std::vector<std::uint8_t> SkippedFaces(const LimitSurface& surface,
+                                       std::span<const std::uint8_t> faces) {
+  std::vector<std::uint8_t> skip(static_cast<std::size_t>(surface.num_ptex_faces()));
+  for (std::size_t f = 0; f < skip.size(); ++f) {
+    skip[f] = (!faces.empty() && !faces[f]) || surface.is_hole(PtexFaceId(static_cast<int>(f)));
+  }
+  return skip;
+}
+
+}  // namespace
+
 Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
                        std::span<const std::uint8_t> faces) {
   const LimitSurface& surface = inputs.surface;
   const Mesh& sculpt = inputs.sculpt;
   const std::vector<Box>& boxes = keys.reach_boxes;
   const float half_extent = keys.sculpt_half_extent;
-  std::vector<std::uint8_t> skip(boxes.size());
-  for (std::size_t f = 0; f < boxes.size(); ++f) {
-    skip[f] = !faces[f] || surface.is_hole(PtexFaceId(static_cast<int>(f)));
-  }
+  const std::vector<std::uint8_t> skip = SkippedFaces(surface, faces);
   Mesh part;
   part.source = sculpt.source;
   part.face_offsets.push_back(0);
@@ -419,10 +431,7 @@ ReachRuns RunsWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
   const Mesh& sculpt = inputs.sculpt;
   const std::vector<Box>& boxes = keys.reach_boxes;
   const float half_extent = keys.sculpt_half_extent;
-  std::vector<std::uint8_t> skip(boxes.size());
-  for (std::size_t f = 0; f < boxes.size(); ++f) {
-    skip[f] = surface.is_hole(PtexFaceId(static_cast<int>(f)));
-  }
+  const std::vector<std::uint8_t> skip = SkippedFaces(surface, {});
   // SculptWithinReach's cells over every face, with the sculpt faces whose centre each holds.
   const CellGrid grid(boxes, skip, /*per_side=*/6);
   tbb::enumerable_thread_specific<std::vector<std::int64_t>> local(
