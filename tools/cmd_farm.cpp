@@ -29,9 +29,18 @@ struct FarmArgs {
   std::string partition, time, mem;
   int cpus = 0;
   std::vector<std::string> sbatch_args;
-  std::string shard_sculpt = "whole";
+  std::string shard_sculpt = "auto";
   bool dry_run = false;
 };
+
+// Slurm's --mem: a number with K, M, G or T (megabytes without one); 0, all of a node's.
+StatusOr<std::uint64_t> SlurmMemoryBytes(const std::string& mem) {
+  if (mem.empty() || mem == "0") return std::uint64_t{0};
+  if (mem.find_first_not_of("0123456789") == std::string::npos) {
+    return ParseByteSize(mem + "M");
+  }
+  return ParseByteSize(mem);
+}
 
 // A word for bash, single-quoted.
 std::string Quote(const std::string& word) {
@@ -78,9 +87,10 @@ struct Scripts {
   std::vector<std::string> merges;  // per asset
 };
 
+// What each asset's shards keep of the sculpt (ShardSculptName), in the manifest's order.
 Scripts WriteScripts(const FarmArgs& a, const std::vector<BatchAsset>& assets,
-                     const std::string& dispex, const std::string& manifest,
-                     const std::string& work) {
+                     const std::vector<ShardSculpt>& sculpts, const std::string& dispex,
+                     const std::string& manifest, const std::string& work) {
   const std::string parts = (fs::path(work) / "parts").string();
   const std::string logs = (fs::path(work) / "logs").string();
   Scripts out;
@@ -95,13 +105,19 @@ Scripts WriteScripts(const FarmArgs& a, const std::vector<BatchAsset>& assets,
     if (k > 0) s += ' ';
     s += Quote(assets[k].name);
   }
+  s += ")\nsculpts=(";
+  for (std::size_t k = 0; k < assets.size(); ++k) {
+    if (k > 0) s += ' ';
+    s += ShardSculptName(sculpts[k]);
+  }
   s += fmt::format(")\nshards={}\n", a.shards);
   s += "asset=${assets[$((SLURM_ARRAY_TASK_ID / shards))]}\n";
+  s += "sculpt=${sculpts[$((SLURM_ARRAY_TASK_ID / shards))]}\n";
   s += "shard=$((SLURM_ARRAY_TASK_ID % shards + 1))\n";
   s += fmt::format(
       "exec {} batch {} --asset \"$asset\" --shard \"$shard/$shards\" --parts-dir {} "
-      "--shard-sculpt {} --threads \"${{SLURM_CPUS_PER_TASK:-0}}\" -q\n",
-      Quote(dispex), Quote(manifest), Quote(parts), a.shard_sculpt);
+      "--shard-sculpt \"$sculpt\" --threads \"${{SLURM_CPUS_PER_TASK:-0}}\" -q\n",
+      Quote(dispex), Quote(manifest), Quote(parts));
   out.shards = s;
   for (const BatchAsset& asset : assets) {
     std::string m =
@@ -152,24 +168,45 @@ StatusOr<std::string> Submit(const FarmArgs& a, const std::string& extra,
 
 int RunFarmSlurm(FarmArgs& a) {
   if (a.shards < 1) return ReportFailure(Status::Error("--shards: must be 1 or more"), 2);
-  auto shard_sculpt = ParseShardSculpt(a.shard_sculpt);
-  if (!shard_sculpt.ok())
-    return ReportFailure(shard_sculpt.status().WithPrefix("--shard-sculpt"), 2);
+  const bool auto_sculpt = a.shard_sculpt == "auto";
+  StatusOr<ShardSculpt> shard_sculpt = ShardSculpt::kWhole;
+  if (!auto_sculpt) shard_sculpt = ParseShardSculpt(a.shard_sculpt);
+  if (!shard_sculpt.ok()) {
+    return ReportFailure(Status::Error(fmt::format("--shard-sculpt: '{}': expected auto, whole "
+                                                   "or part",
+                                                   a.shard_sculpt)),
+                         2);
+  }
+  const StatusOr<std::uint64_t> node_memory = SlurmMemoryBytes(a.mem);
+  if (!node_memory.ok()) return ReportFailure(node_memory.status().WithPrefix("--mem"), 2);
   ExtractOptions defaults;
   auto assets = ReadBatchManifest(a.manifest, defaults);
   if (!assets.ok()) return ReportFailure(assets.status(), 2);
+  // Each asset's shards within a node's memory, checked before anything is written.
+  std::vector<ShardSculpt> sculpts;
   for (const BatchAsset& asset : *assets) {
-    if (*shard_sculpt == ShardSculpt::kWhole) break;
-    // A part needs options of its own: checked before anything is submitted.
+    const std::string where = fmt::format("{}: asset {}", a.manifest, asset.name);
+    ShardSculpt sculpt = *shard_sculpt;
+    if (*node_memory > 0) {
+      const StatusOr<ShardMemoryPlan> plan = PlanShardMemory(asset.options, *node_memory);
+      if (!plan.ok()) {
+        return ReportFailure(plan.status().WithPrefix(where + " (--mem " + a.mem + ")"), 2);
+      }
+      if (auto_sculpt) sculpt = plan->shard_sculpt;
+      if (auto_sculpt && sculpt == ShardSculpt::kPart) {
+        std::fprintf(stderr,
+                     "dispex: asset %s: one extraction is estimated at %s, more than --mem %s: "
+                     "its shards keep only their part of the sculpt (--shard-sculpt part)\n",
+                     asset.name.c_str(), MemorySize(plan->whole_bytes).c_str(), a.mem.c_str());
+      }
+    }
     ExtractOptions o = asset.options;
     o.shard_index = 1;
     o.shard_count = a.shards;
-    o.shard_sculpt = *shard_sculpt;
+    o.shard_sculpt = sculpt;
     Status valid = ValidateExtractOptions(o);
-    if (!valid.ok()) {
-      return ReportFailure(valid.WithPrefix(fmt::format("{}: asset {}", a.manifest, asset.name)),
-                           2);
-    }
+    if (!valid.ok()) return ReportFailure(valid.WithPrefix(where), 2);
+    sculpts.push_back(sculpt);
   }
   std::string dispex = a.dispex;
   if (dispex.empty()) {
@@ -189,7 +226,7 @@ int RunFarmSlurm(FarmArgs& a) {
       return ReportFailure(Status::Error(fmt::format("--work-dir {}: {}", work, ec.message())));
     }
   }
-  const Scripts scripts = WriteScripts(a, *assets, dispex, manifest, work);
+  const Scripts scripts = WriteScripts(a, *assets, sculpts, dispex, manifest, work);
   const std::string shards_script = (fs::path(work) / "shards.sbatch").string();
   Status written = WriteFileAtomically(shards_script, scripts.shards.data(), scripts.shards.size());
   std::vector<std::string> merge_scripts;
@@ -249,8 +286,9 @@ void SetupFarm(CLI::App& app, int& exit_code) {
                   "another #SBATCH line for every job, e.g. --sbatch-arg=--account=fx");
   cmd->add_option("--sbatch", args->sbatch, "the sbatch to run")->capture_default_str();
   cmd->add_option("--shard-sculpt", args->shard_sculpt,
-                  "what each shard keeps of the sculpt: whole, or part (memory falls with "
-                  "--shards; needs method rays and a given search_distance; docs/FARM.md)")
+                  "what each shard keeps of the sculpt: whole, part (its memory falls with "
+                  "--shards), or auto: part for an asset whose one extraction is estimated at "
+                  "more than --mem (docs/FARM.md)")
       ->capture_default_str();
   cmd->add_flag("--dry-run", args->dry_run, "write the scripts, print their paths, submit nothing");
   cmd->callback([args, &exit_code] { exit_code = RunFarmSlurm(*args); });

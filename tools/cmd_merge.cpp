@@ -16,11 +16,13 @@ namespace {
 constexpr FlagName kMergeFlags[] = {
     {"output_path", "-o"},
     {"threads", "--threads"},
+    {"max_memory", "--max-memory"},
 };
 
 struct MergeArgs {
   MergeOptions options;
   std::string report_path;
+  std::string max_memory;
   bool quiet = false;
 };
 
@@ -31,6 +33,11 @@ int RunMerge(MergeArgs& args) {
   }
   const Status outputs = CheckOutputs({{"--report", args.report_path}});
   if (!outputs.ok()) return ReportFailure(outputs, 2);
+  if (!args.max_memory.empty()) {
+    StatusOr<std::uint64_t> limit = ParseByteSize(args.max_memory);
+    if (!limit.ok()) return ReportFailure(limit.status().WithPrefix("--max-memory"), 2);
+    args.options.max_memory = *limit;
+  }
   InstallCancelSignalHandlers();
   StatusOr<ExtractReport> report = MergeShards(args.options);
   if (!report.ok()) {
@@ -57,6 +64,9 @@ void SetupMerge(CLI::App& app, int& exit_code) {
   cmd->add_option("-o,--output", args->options.output_path, "output Ptex file (.ptx)")->required();
   cmd->add_option("--threads", args->options.threads, "worker threads (0: all cores)")
       ->capture_default_str();
+  cmd->add_option("--max-memory", args->max_memory,
+                  "the memory to keep within, e.g. 8G (default: the memory available; as "
+                  "extract's --max-memory)");
   cmd->add_option("--report", args->report_path, "write a JSON report to this file");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress bar and no summary");
   cmd->callback([args, &exit_code] { exit_code = RunMerge(*args); });

@@ -191,10 +191,11 @@ struct ExtractOptions {
   int shard_index = 0;
   int shard_count = 0;
   // What a shard keeps of the sculpt. kWhole: all of it, read, matched and traced (its memory
-  // does not fall with shard_count). kPart: the sculpt within reach of its faces (its BVH's
-  // part; the rest is released once the faces' keys are made), so each shard's memory falls
-  // with shard_count; it needs method kRays and a given search_distance (the correspondence
-  // and the automatic search distance read the whole sculpt). Hits do not depend on the BVH's
+  // does not fall with shard_count). kPart: a shard that traces keeps the sculpt within reach
+  // of its faces (its BVH's part; the rest is released once the faces' keys are made) and
+  // estimates an automatic search distance over the sculpt in parts, one BVH at a time, so its
+  // memory falls with shard_count; through the correspondence (which matches the whole sculpt)
+  // it traces only within reach whatever this option says. Hits do not depend on the BVH's
   // extent at shared edges, vertices and folds (the tie rule, dispex/trace.h); only where two
   // sheets of the sculpt that share no vertex cross within float rounding of each other on a
   // sample's line may a part's hit differ from the whole's (docs/FARM.md). Not an option of
@@ -221,6 +222,8 @@ Status ValidateExtractOptions(const ExtractOptions& options);
 
 // A memory size: "8G", "512M", "300K" or a number of bytes (ExtractOptions::max_memory).
 StatusOr<std::uint64_t> ParseByteSize(const std::string& text);
+// "1.50 GiB", "20.0 MiB", "512.0 KiB": a size for messages.
+std::string MemorySize(std::uint64_t bytes);
 
 // A map's name whose extension says another format (map.exr, map.png, map.obj) is refused.
 Status CheckMapName(const std::string& path);
@@ -323,6 +326,9 @@ struct ExtractPlan {
   // what it is estimated to need at its peak (bytes); the runs of kInParts (0 otherwise).
   std::uint64_t memory_limit = 0, memory_estimate = 0;
   int sculpt_parts = 0;
+  // The parts the sculpt's automatic search distance is estimated in, one BVH at a time (0: by
+  // one BVH of the whole sculpt, or through the correspondence, or none to estimate).
+  int search_estimate_parts = 0;
 };
 std::string_view ExtractPlanOutputName(
     ExtractPlan::Output output);  // "map", "shard part", "up to date"
@@ -521,6 +527,20 @@ StatusOr<ExtractReport> MergeShards(const MergeOptions& options);
 
 // "I/N" (1 <= I <= N) as a shard's index and count.
 Status ParseShard(std::string_view text, int& index, int& count);
+
+// What a shard of `options` keeps of the sculpt within `node_memory` bytes (a farm node's), from
+// the sculpt file's counts (CountMeshElements) and the estimates max_memory plans with: kWhole
+// when one extraction fits (a BVH of the whole sculpt where it may trace -- method kRays, or
+// kAuto should the match fail -- else the correspondence), else kPart (each shard traces only
+// the sculpt within reach of its faces, in parts when even that does not fit). kOverBudget,
+// naming the sculpt, when not even reading it, its arrays, its correspondence (where matched)
+// and the output fit.
+struct ShardMemoryPlan {
+  ShardSculpt shard_sculpt = ShardSculpt::kWhole;
+  std::uint64_t whole_bytes = 0;  // one extraction at its peak
+  std::uint64_t floor_bytes = 0;  // any shard: reading, the arrays, the correspondence, output
+};
+StatusOr<ShardMemoryPlan> PlanShardMemory(const ExtractOptions& options, std::uint64_t node_memory);
 
 // ---- Batches of assets (docs/FARM.md) ----------------------------------------------------------
 

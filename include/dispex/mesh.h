@@ -122,6 +122,16 @@ MeshFormat DetectMeshFormat(const std::string& path);
 // nothing. WriteMesh writes it.
 MeshFormat MeshFormatOfName(const std::string& path);
 
+// What a mesh file holds, counted without reading the mesh (to plan memory before reading it):
+// a PLY file's header counts, its corners taken as 4 per face (they are in the body); an OBJ's
+// `v` and `f` lines and the corners on them, in one pass over the file. Not validated: a file
+// ReadMesh refuses may be counted.
+struct MeshSize {
+  std::uint64_t vertices = 0, faces = 0, corners = 0;
+  bool corners_counted = false;  // false: 4 per face assumed
+};
+StatusOr<MeshSize> CountMeshElements(const std::string& path);
+
 // Reads an OBJ or PLY file, chosen by DetectMeshFormat (an unknown format is an error).
 //
 // What every reader guarantees on success: at least one face; every face has at least 3

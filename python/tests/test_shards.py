@@ -9,6 +9,7 @@ from conftest import CUBE, run_cli
 @pytest.mark.parametrize("options", [
     {},
     {"method": "rays", "search_distance": "5%", "shard_sculpt": "part"},
+    {"method": "rays", "shard_sculpt": "part"},  # the automatic search distance in parts
 ])
 def test_merged_parts_are_one_extractions_bytes(tmp_path, sculpts, options):
     sculpt = sculpts(CUBE)
@@ -45,7 +46,6 @@ def test_a_missing_part_names_itself_and_writes_nothing(tmp_path, sculpts):
 @pytest.mark.parametrize("options, message", [
     ({"shard": "4/3"}, "shard: '4/3': expected I/N"),
     ({"shard": "1/2", "shard_sculpt": "half"}, "shard_sculpt: unknown shard sculpt 'half'"),
-    ({"shard": "1/2", "shard_sculpt": "part"}, "needs method rays and a given search_distance"),
 ])
 def test_bad_shard_options_raise_value_error(tmp_path, sculpts, options, message):
     with pytest.raises(ValueError, match=message):

@@ -380,22 +380,26 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
     return Finished(std::move(report), total_clock);
   // Through the subdivision correspondence no BVH is built (extract_mapping.h; a vector map
   // reads the sculpt through it only, vector_faces.h). Rays estimate the automatic search
-  // distance over the whole surface; a given one lets an incremental run, a merge or a shard
-  // of ShardSculpt::kPart trace only the sculpt within reach of the faces it extracts.
+  // distance over the whole surface; a given one lets an incremental run or a merge trace only
+  // the sculpt within reach of the faces it extracts. A shard of ShardSculpt::kPart traces
+  // only within reach of its own faces, and estimates the automatic distance in parts.
   DISPEX_RETURN_IF_ERROR(options.vector ? MatchVectorSculpt(options, inputs, report)
                                         : ChooseMethod(options, inputs, report));
   plan.method = report.method.used;
   const bool shard = options.shard_count > 0;
+  const bool part_shard = shard && options.shard_sculpt == ShardSculpt::kPart;
   const bool traced = !options.vector && inputs.mapping == nullptr;
-  const bool within_reach = traced &&
-                            options.search_distance.kind != SearchDistanceSpec::Kind::kAuto &&
-                            ((previous.usable() && (options.incremental || parts != nullptr)) ||
-                             (shard && options.shard_sculpt == ShardSculpt::kPart));
+  const bool within_reach =
+      traced && ((options.search_distance.kind != SearchDistanceSpec::Kind::kAuto &&
+                  previous.usable() && (options.incremental || parts != nullptr)) ||
+                 part_shard);
   plan.tracer = !traced        ? ExtractPlan::Tracer::kNone
                 : within_reach ? ExtractPlan::Tracer::kWithinReach
                                : ExtractPlan::Tracer::kWholeSculpt;
-  if (plan.tracer == ExtractPlan::Tracer::kWholeSculpt) {
-    DISPEX_RETURN_IF_ERROR(PlanSculptParts(options, inputs, report));
+  // Over the memory limit, any traced plan becomes kInParts.
+  if (traced) DISPEX_RETURN_IF_ERROR(PlanSculptParts(options, inputs, report));
+  if (part_shard) {
+    inputs.estimate_parts = std::clamp(options.shard_count, 1, kMaxSculptParts);
   }
   if (plan.tracer != ExtractPlan::Tracer::kWholeSculpt) SetTracerOptions(options, inputs);
   if (plan.tracer == ExtractPlan::Tracer::kWholeSculpt) {
@@ -414,9 +418,9 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   if (within_reach) {
     reach = FacesWithinReach(inputs, sources, shard ? 0 : kLocalRings);
     // For a run that is not a shard, the whole sculpt when that is most of it.
-    if (!shard && 2 * std::count(reach.begin(), reach.end(), 1) > plan.faces) {
+    if (!shard && plan.tracer == ExtractPlan::Tracer::kWithinReach &&
+        2 * std::count(reach.begin(), reach.end(), 1) > plan.faces) {
       plan.tracer = ExtractPlan::Tracer::kWholeSculpt;
-      DISPEX_RETURN_IF_ERROR(PlanSculptParts(options, inputs, report));
     }
   }
   if (options.plan_only) return Finished(std::move(report), total_clock);

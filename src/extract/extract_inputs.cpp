@@ -318,7 +318,7 @@ Status TraceRun(ExtractInputs& inputs, std::span<const int> run) {
   return CancelRequested() ? Cancelled() : Status::Ok();
 }
 
-StatusOr<std::vector<float>> NearestHitsInParts(const ExtractInputs& inputs,
+StatusOr<std::vector<float>> NearestHitsInParts(const ExtractInputs& inputs, int sculpt_parts,
                                                 std::span<const Float3> origins,
                                                 std::span<const Float3> normals, float length) {
   // Each query's nearest hit over the whole sculpt is the nearest of its parts' when each part
@@ -327,7 +327,7 @@ StatusOr<std::vector<float>> NearestHitsInParts(const ExtractInputs& inputs,
   // does, so the tie rule and the vertex guard (dispex/trace.h) answer as they would there; a
   // hit on one of the faces around is answered as well by the part whose run holds it.
   const Mesh& sculpt = inputs.sculpt;
-  const auto parts = static_cast<std::size_t>(inputs.sculpt_parts);
+  const auto parts = static_cast<std::size_t>(std::max(1, sculpt_parts));
   std::vector<float> nearest(origins.size(), std::numeric_limits<float>::infinity());
   std::vector<std::uint8_t> near_run(sculpt.num_vertices());
   for (std::size_t p = 0; p < parts; ++p) {

@@ -56,6 +56,9 @@ struct ExtractInputs {
   MemoryNeed memory;
   int sculpt_parts = 1;
   std::size_t part_faces = 0;  // with sculpt_parts > 1: the sculpt faces a run's BVH may hold
+  // Without a tracer of the whole sculpt: the parts its automatic search distance is estimated
+  // in (NearestHitsInParts), at least sculpt_parts.
+  int estimate_parts = 1;
   double run_bvh_seconds = 0;  // building the runs' BVHs (TraceRun) ...
   int runs_traced = 0;         // ... of this many runs
   std::string run_backend{};   // their TracerStats::backend
@@ -132,8 +135,9 @@ Status ForEachTracedRun(ExtractInputs& inputs, std::span<const int> faces, Work 
 }
 
 // The long rays of the automatic search distance (EstimateSearchDistance) against the sculpt
-// in sculpt_parts parts, one BVH at a time: per query, |t| of its nearest hit, or infinity.
-StatusOr<std::vector<float>> NearestHitsInParts(const ExtractInputs& inputs,
+// in `parts` parts, one BVH at a time: per query, |t| of its nearest hit, or infinity. The
+// same whatever `parts`.
+StatusOr<std::vector<float>> NearestHitsInParts(const ExtractInputs& inputs, int parts,
                                                 std::span<const Float3> origins,
                                                 std::span<const Float3> normals, float length);
 

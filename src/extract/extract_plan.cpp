@@ -52,7 +52,11 @@ std::string ExtractPlanSummary(const ExtractPlan& plan) {
     out += fmt::format(
         "  the sculpt's BVH in {} parts, one at a time: the whole is estimated at "
         "more than the {} memory limit\n",
-        plan.sculpt_parts, extract::MemorySize(plan.memory_limit));
+        plan.sculpt_parts, MemorySize(plan.memory_limit));
+  }
+  if (plan.search_estimate_parts > 0) {
+    out += fmt::format("  the automatic search distance estimated over the sculpt in {} parts\n",
+                       plan.search_estimate_parts);
   }
   if (!plan.redo_reason.empty()) out += fmt::format("  why: {}\n", plan.redo_reason);
   if (plan.uv_maps) out += "  then the UV-space tiles\n";
@@ -112,7 +116,8 @@ nlohmann::json ExtractPlanJson(const ExtractPlan& plan) {
   j["uv_maps"] = plan.uv_maps;
   j["memory"] = {{"limit_bytes", plan.memory_limit},
                  {"estimate_bytes", plan.memory_estimate},
-                 {"sculpt_parts", plan.sculpt_parts}};
+                 {"sculpt_parts", plan.sculpt_parts},
+                 {"search_estimate_parts", plan.search_estimate_parts}};
   return j;
 }
 

@@ -56,11 +56,14 @@ Status ResolveTolerance(const ExtractOptions& options, const Mesh& sculpt, Extra
 
 // EstimateSearchDistance over the sculpt in parts, one BVH at a time (NearestHitsInParts).
 StatusOr<SearchDistanceEstimate> EstimateInParts(const ExtractInputs& inputs,
-                                                 const CoarseSampling& coarse, double diagonal) {
+                                                 const CoarseSampling& coarse, double diagonal,
+                                                 ExtractPlan& plan) {
   const SearchDistanceOptions options;
-  DISPEX_ASSIGN_OR_RETURN(std::vector<float> nearest,
-                          NearestHitsInParts(inputs, coarse.points, coarse.normals,
-                                             static_cast<float>(options.ray_fraction * diagonal)));
+  plan.search_estimate_parts = std::max(inputs.sculpt_parts, inputs.estimate_parts);
+  DISPEX_ASSIGN_OR_RETURN(
+      std::vector<float> nearest,
+      NearestHitsInParts(inputs, plan.search_estimate_parts, coarse.points, coarse.normals,
+                         static_cast<float>(options.ray_fraction * diagonal)));
   std::vector<double> abs_t;
   for (float t : nearest) {
     if (std::isfinite(t)) abs_t.push_back(static_cast<double>(t));
@@ -77,7 +80,7 @@ Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs
         inputs.mapping  ? EstimateSearchDistanceMapped(inputs, coarse, report.inputs.base_diagonal)
         : inputs.tracer ? EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals,
                                                  report.inputs.base_diagonal)
-                        : EstimateInParts(inputs, coarse, report.inputs.base_diagonal);
+                        : EstimateInParts(inputs, coarse, report.inputs.base_diagonal, report.plan);
     if (!estimate.ok()) {
       return Status::Error(StatusCode::kMismatch,
                            fmt::format("{} and {} do not overlap: {}", options.base_path,

@@ -44,27 +44,23 @@ Status TooBig(std::uint64_t need, std::uint64_t limit, bool given, const std::st
 
 }  // namespace
 
-Status CheckMemoryBeforeReading(const ExtractOptions& options, std::uint64_t limit) {
-  if (limit == 0) return Status::Ok();
+std::uint64_t ReadPeakBytes(const ExtractOptions& options) {
   std::error_code ec;
   std::uint64_t base = options.base_mesh ? 0 : std::filesystem::file_size(options.base_path, ec);
   if (ec) base = 0;
   std::uint64_t sculpt =
       options.sculpt_mesh ? 0 : std::filesystem::file_size(options.sculpt_path, ec);
   if (ec) sculpt = 0;
-  auto need =
-      static_cast<std::uint64_t>(double(base + sculpt) * kArraysPerFileByte * kReadPeakFactor);
+  return static_cast<std::uint64_t>(double(base + sculpt) * kArraysPerFileByte * kReadPeakFactor);
+}
+
+Status CheckMemoryBeforeReading(const ExtractOptions& options, std::uint64_t limit) {
+  if (limit == 0) return Status::Ok();
+  const std::uint64_t need = ReadPeakBytes(options);
   if (need > limit) {
     return TooBig(need, limit, options.max_memory > 0, "reading " + options.sculpt_path);
   }
   return Status::Ok();
-}
-
-std::string MemorySize(std::uint64_t bytes) {
-  const double b = double(bytes);
-  if (b >= double(1u << 30)) return fmt::format("{:.2f} GiB", b / double(1u << 30));
-  if (b >= double(1u << 20)) return fmt::format("{:.1f} MiB", b / double(1u << 20));
-  return fmt::format("{:.1f} KiB", b / 1024.0);
 }
 
 MemoryNeed EstimateMemory(std::size_t sculpt_vertices, std::size_t sculpt_faces,
@@ -119,3 +115,14 @@ StatusOr<SculptParts> SculptPartsWithin(const MemoryNeed& need, std::size_t scul
 }
 
 }  // namespace dispex::extract
+
+namespace dispex {
+
+std::string MemorySize(std::uint64_t bytes) {
+  const double b = double(bytes);
+  if (b >= double(1u << 30)) return fmt::format("{:.2f} GiB", b / double(1u << 30));
+  if (b >= double(1u << 20)) return fmt::format("{:.1f} MiB", b / double(1u << 20));
+  return fmt::format("{:.1f} KiB", b / 1024.0);
+}
+
+}  // namespace dispex

@@ -17,9 +17,8 @@ namespace dispex::extract {
 // fails with a message giving the estimate and the limit; `given`: the limit is max_memory's,
 // else what the machine has available.
 Status CheckMemoryBeforeReading(const ExtractOptions& options, std::uint64_t limit);
-
-// "1.50 GiB", "20.0 MiB", "512.0 KiB": a size for messages.
-std::string MemorySize(std::uint64_t bytes);
+// Reading's peak as CheckMemoryBeforeReading estimates it, from the files' sizes.
+std::uint64_t ReadPeakBytes(const ExtractOptions& options);
 
 struct MemoryNeed {
   std::uint64_t arrays = 0;      // the sculpt's vertex and face arrays

@@ -147,7 +147,10 @@ TEST_F(Farm, ShardsThroughTheCommandLineMergeIntoTheMapExtractWrites) {
     EXPECT_NE(r.err.find("shard " + i + "/3"), std::string::npos) << r.err;
     parts.insert(0, part + " ");
   }
-  auto r = RunDispex("merge " + parts + "-o " + (dir_ / "merged.ptx"), dir_);
+  auto r = RunDispex("merge " + parts + "-o " + (dir_ / "merged.ptx") + " --max-memory 1x", dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "dispex: --max-memory: '1x': unknown unit 'x' (K, M, G, T)\n");
+  r = RunDispex("merge " + parts + "-o " + (dir_ / "merged.ptx") + " --max-memory 1G", dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("merged 3 parts"), std::string::npos) << r.err;
   EXPECT_TRUE(Slurp(dir_ / "merged.ptx") == Expected("spot", ""));
@@ -166,11 +169,6 @@ TEST_F(Farm, ShardsThroughTheCommandLineMergeIntoTheMapExtractWrites) {
   r = RunDispex(fmt("spot") + " --out-dir " + (dir_ / "d") + " --shard 1/2", dir_);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("not made in shards"), std::string::npos) << r.err;
-  r = RunDispex(fmt("spot") + " -o " + (dir_ / "x.ptx") + " --shard 1/2 --shard-sculpt part", dir_);
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("--shard-sculpt part: needs --method rays and a given --search-distance"),
-            std::string::npos)
-      << r.err;
 }
 
 // The scripts, run as Slurm runs them -- each array task with its SLURM_ARRAY_TASK_ID, then each
@@ -187,7 +185,8 @@ TEST_F(Farm, SlurmScriptsRunAsSlurmWouldMakeTheMaps) {
   for (const std::string line :
        {"#SBATCH --array=0-5\n", "#SBATCH --partition=render\n", "#SBATCH --cpus-per-task=2\n",
         "#SBATCH --mem=4G\n", "#SBATCH --time=1:00:00\n", "#SBATCH --account=fx\n",
-        "#SBATCH --requeue\n", "assets=('spot' 'blub')\n", "shards=3\n", " --shard-sculpt part "}) {
+        "#SBATCH --requeue\n", "assets=('spot' 'blub')\n", "sculpts=(part part)\n", "shards=3\n",
+        " --shard-sculpt \"$sculpt\" "}) {
     EXPECT_NE(shards.find(line), std::string::npos) << line << " not in\n" << shards;
   }
   EXPECT_NE(shards.find(std::string("'") + DISPEX_EXE), std::string::npos)
@@ -210,6 +209,45 @@ TEST_F(Farm, SlurmScriptsRunAsSlurmWouldMakeTheMaps) {
   }
   EXPECT_TRUE(Slurp(dir_ / "maps/spot.ptx") == Expected("spot", ""));
   EXPECT_TRUE(Slurp(dir_ / "maps/blub.ptx") == Expected("blub", "--data-type half"));
+}
+
+// By default an asset whose one extraction is estimated at more than --mem (Slurm's units:
+// megabytes without a suffix) is sharded in parts of its sculpt, and one that no shard can hold
+// is refused before anything is written. (Spot's sculpt: 2,928 quads, about 600 KiB through
+// rays; blub's: 1,776, about 370 KiB.)
+TEST_F(Farm, SlurmShardsKeepTheirPartOfTheSculptWhenANodeHasTooLittleMemory) {
+  const fs::path work = dir_ / "work";
+  const std::string farm = "farm slurm " + (dir_ / "batch.json") +
+                           " --shards 3 --dry-run --work-dir " + work.string() + " --mem ";
+  for (const auto& [mem, sculpts] :
+       {std::pair{"4000", "(whole whole)"}, std::pair{"500K", "(part whole)"},
+        std::pair{"300K", "(part part)"}}) {
+    auto r = RunDispex(farm + mem, dir_);
+    ASSERT_EQ(r.exit_code, 0) << mem << ": " << r.err;
+    EXPECT_NE(Slurp(work / "shards.sbatch").find(std::string("sculpts=") + sculpts + "\n"),
+              std::string::npos)
+        << mem << ":\n"
+        << Slurp(work / "shards.sbatch");
+    EXPECT_EQ(r.err.find("asset spot: one extraction is estimated at") != std::string::npos,
+              std::string(sculpts) != "(whole whole)")
+        << r.err;
+  }
+  // Told, the shards keep what they are told.
+  auto r = RunDispex(farm + "500K --shard-sculpt whole", dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(Slurp(work / "shards.sbatch").find("sculpts=(whole whole)\n"), std::string::npos);
+  fs::remove_all(work);
+  r = RunDispex(farm + "100K", dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("batch.json: asset spot (--mem 100K): "), std::string::npos) << r.err;
+  EXPECT_NE(
+      r.err.find("in any shard (reading it, its arrays, the output) but a node has 100.0 KiB"),
+      std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(work / "shards.sbatch"));
+  r = RunDispex(farm + "4X", dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "dispex: --mem: '4X': unknown unit 'X' (K, M, G, T)\n");
 }
 
 // Submission through a stand-in sbatch that records its arguments: the array job first, then

@@ -180,5 +180,38 @@ TEST(MemoryBudgetRefusal, AReachLargerThanAPartIsRefusedBeforeTracing) {
   EXPECT_FALSE(fs::exists(o.output_path));
 }
 
+// Shards of their part of the sculpt under a budget their part's BVH does not fit in trace it in
+// runs too, the automatic search distance estimated in as many parts; merged under the same
+// budget, the parts are the map of one extraction without any.
+TEST(MemoryBudgetShards, PartShardsWithinABudgetMergeIntoTheWholeMap) {
+  TempDir dir;
+  const ExtractOptions whole = RaysOnSpot(dir);
+  auto expected = Extract(whole);
+  ASSERT_TRUE(expected.ok()) << expected.status().message();
+  const std::uint64_t budget = expected->plan.memory_estimate / 2;
+  MergeOptions merge;
+  merge.output_path = dir / "merged.ptx";
+  merge.max_memory = budget;
+  for (int i = 1; i <= 2; ++i) {
+    ExtractOptions shard = whole;
+    shard.output_path = dir / ("part" + std::to_string(i) + ".ptx");
+    shard.shard_index = i;
+    shard.shard_count = 2;
+    shard.shard_sculpt = ShardSculpt::kPart;
+    shard.max_memory = budget;
+    auto report = Extract(shard);
+    ASSERT_TRUE(report.ok()) << report.status().message();
+    EXPECT_EQ(report->plan.tracer, ExtractPlan::Tracer::kInParts);
+    EXPECT_LE(report->plan.memory_estimate, budget);
+    EXPECT_EQ(report->plan.search_estimate_parts, report->plan.sculpt_parts);
+    merge.parts.push_back(shard.output_path);
+  }
+  auto merged = MergeShards(merge);
+  ASSERT_TRUE(merged.ok()) << merged.status().message();
+  EXPECT_EQ(merged->plan.tracer, ExtractPlan::Tracer::kInParts);
+  EXPECT_TRUE(Slurp(merge.output_path) == Slurp(whole.output_path))
+      << "merged part shards within a budget differ from the whole BVH's map";
+}
+
 }  // namespace
 }  // namespace dispex

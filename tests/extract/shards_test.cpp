@@ -1,7 +1,8 @@
 // Farm shards (docs/FARM.md): the parts of N shards, merged in any order, must be byte for byte
 // the map one extraction writes, for N = 1, 2, 3, 5 -- with automatic and given settings, rays
-// (shards of the whole sculpt, and of only their part of it) and the subdivision
-// correspondence, watertight edges (which cross shard boundaries) on and off. A shard is
+// (shards of the whole sculpt, and of only their part of it, the automatic search distance
+// then estimated in parts) and the subdivision correspondence, watertight edges (which cross
+// shard boundaries) on and off. A shard is
 // idempotent; a merge with a part missing, given twice or made from other inputs or options fails
 // naming it and writes nothing.
 #include <gtest/gtest.h>
@@ -36,6 +37,7 @@ struct Variant {
   WatertightEdges watertight;
   bool auto_search_distance;
   ExtractMethod method;
+  ShardSculpt shard_sculpt;
 };
 
 void PrintTo(const Variant& v, std::ostream* os) {
@@ -75,13 +77,10 @@ class Shards : public ::testing::TestWithParam<Variant> {
     o.output_path = dir_ / ("part_" + std::to_string(i) + "_of_" + std::to_string(n) + ".ptx");
     o.shard_index = i;
     o.shard_count = n;
-    if (TracesPart()) o.shard_sculpt = ShardSculpt::kPart;
+    o.shard_sculpt = GetParam().shard_sculpt;
     return Extract(o);
   }
-  // Through rays with a given search distance the shards keep only their part of the sculpt.
-  bool TracesPart() const {
-    return GetParam().method == ExtractMethod::kRays && !GetParam().auto_search_distance;
-  }
+  bool TracesPart() const { return GetParam().shard_sculpt == ShardSculpt::kPart; }
   std::string PartPath(int i, int n) const {
     return dir_ / ("part_" + std::to_string(i) + "_of_" + std::to_string(n) + ".ptx");
   }
@@ -137,6 +136,9 @@ TEST_P(Shards, MergedPartsEqualOneExtractionForAnyCountAndOrder) {
         if (n == 5) {
           EXPECT_LT(part->kept, part->total) << i << "/" << n << ": " << shard->tracer;
         }
+        // No BVH of the whole sculpt for the automatic search distance either.
+        EXPECT_EQ(shard->plan.search_estimate_parts, GetParam().auto_search_distance ? n : 0);
+        EXPECT_EQ(shard->settings.search_distance, expected->settings.search_distance);
       }
       next = shard->shard.end;
       extracted += shard->incremental.faces_extracted;
@@ -166,14 +168,17 @@ INSTANTIATE_TEST_SUITE_P(
         // Rays, a given search distance (the merge traces only the faces the edges raise); the
         // edge pass raises faces across shards.
         Variant{"spot_rays_given_distance_filter", "keenan_spot/spot_control_mesh.obj", 3,
-                PtexDataType::kFloat, WatertightEdges::kFilter, false, ExtractMethod::kRays},
+                PtexDataType::kFloat, WatertightEdges::kFilter, false, ExtractMethod::kRays,
+                ShardSculpt::kPart},
         // Automatic settings measured by every shard over the whole sculpt; the correspondence.
         // (Level 4: at level 3 the interpolated map meets at every edge with no face raised.)
         Variant{"spot_auto_half_all", "keenan_spot/spot_control_mesh.obj", 4, PtexDataType::kHalf,
-                WatertightEdges::kAll, true, ExtractMethod::kAuto},
-        // N-gons, boundaries, no edge pass.
-        Variant{"car_ngons_boundary_off", "opensubdiv/catmark_car.obj", 3, PtexDataType::kFloat,
-                WatertightEdges::kOff, true, ExtractMethod::kRays}),
+                WatertightEdges::kAll, true, ExtractMethod::kAuto, ShardSculpt::kWhole},
+        // N-gons, boundaries, no edge pass; rays from shards of their part of the sculpt, the
+        // automatic search distance estimated in parts.
+        Variant{"car_ngons_boundary_off_part", "opensubdiv/catmark_car.obj", 3,
+                PtexDataType::kFloat, WatertightEdges::kOff, true, ExtractMethod::kRays,
+                ShardSculpt::kPart}),
     [](const auto& param_info) { return std::string(param_info.param.name); });
 
 class ShardParts : public ::testing::Test {
@@ -335,13 +340,8 @@ TEST(ShardOptions, BadShardsAndVectorMapsAreRefused) {
   EXPECT_NE(ValidateExtractOptions(o).message().find("vector maps are not made in shards"),
             std::string::npos);
   o.vector.reset();
-  // A shard of part of the sculpt needs rays and a given search distance.
+  // A shard of part of the sculpt, with any method and search distance.
   o.shard_sculpt = ShardSculpt::kPart;
-  EXPECT_NE(ValidateExtractOptions(o).message().find("shard_sculpt part: needs method rays"),
-            std::string::npos);
-  o.method = ExtractMethod::kRays;
-  EXPECT_FALSE(ValidateExtractOptions(o).ok());
-  o.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.01};
   EXPECT_TRUE(ValidateExtractOptions(o).ok());
   o.shard_sculpt = ShardSculpt::kWhole;
   o.uv_maps_dir = "uv";

@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # The farm on a real Slurm (docs/FARM.md): a one-node cluster on localhost (munged, slurmctld,
-# slurmd; slurm_cluster.sh), a two-asset manifest submitted with `dispex farm slurm --shards 3`,
-# one shard killed mid-run and put back in the queue (scontrol requeue: what a pre-emption or a
-# failed node does), and the merged maps checked byte for byte against `dispex extract` on this
-# machine. Skips (exit 77) when not root or when Slurm or munge is missing; always stops the
+# slurmd; slurm_cluster.sh), a two-asset manifest submitted with `dispex farm slurm --shards 3
+# --mem 3M`, one shard killed mid-run and put back in the queue (scontrol requeue: what a
+# pre-emption or a failed node does), and the merged maps checked byte for byte against
+# `dispex extract` on this machine. Both assets take the automatic search distance; spot goes
+# through the subdivision correspondence with shards of the whole sculpt, blub through rays
+# and is estimated at more than 3M, so its shards -- the killed one among them -- keep only
+# their part of the sculpt. Skips (exit 77) when not root or when Slurm or munge is missing; always stops the
 # daemons it started.
 #   slurm_test.sh DISPEX DATA_DIR
 set -u
@@ -41,19 +44,19 @@ trap 'exit 130' INT TERM
 
 slurm_start "$tmp/slurm" || fail "the Slurm cluster did not start"
 
-# Two assets, their sculpts made here.
+# Two assets, their sculpts made here: spot's 2,928 quads, blub's 28,416.
 cd "$tmp" || fail "no $tmp"
-for asset in spot blub; do
-  cp "$data/meshes/keenan_$asset/${asset}_control_mesh.obj" "$asset.obj"
-  "$dispex" make-sculpt "$asset.obj" -o "${asset}_sculpt.obj" --levels 2 --amplitude 0.004 -q ||
-    fail "make-sculpt $asset"
+for asset in spot:2 blub:4; do
+  name=${asset%:*}
+  cp "$data/meshes/keenan_$name/${name}_control_mesh.obj" "$name.obj"
+  "$dispex" make-sculpt "$name.obj" -o "${name}_sculpt.obj" --levels "${asset#*:}" \
+    --amplitude 0.004 -q || fail "make-sculpt $name"
 done
 cat >manifest.json <<'JSON'
-{"options": {"search_distance": "1%", "method": "rays"},
- "assets": [
+{"assets": [
    {"name": "spot", "base": "spot.obj", "sculpt": "spot_sculpt.obj", "output_dir": "maps"},
    {"name": "blub", "base": "blub.obj", "sculpt": "blub_sculpt.obj", "output_dir": "maps",
-    "options": {"data_type": "half"}}]}
+    "options": {"method": "rays", "data_type": "half"}}]}
 JSON
 
 # The jobs run dispex through a wrapper that holds shard task 4 (blub, shard 2/3) on its first
@@ -68,9 +71,14 @@ exec "$dispex" "\$@"
 WRAP
 chmod +x slow-dispex
 
-ids=$("$dispex" farm slurm manifest.json --shards 3 --dispex "$tmp/slow-dispex" \
-  --work-dir "$tmp/jobs") || fail "dispex farm slurm: $ids"
+ids=$("$dispex" farm slurm manifest.json --shards 3 --mem 3M --dispex "$tmp/slow-dispex" \
+  --work-dir "$tmp/jobs" 2>farm.err) || fail "dispex farm slurm: $ids $(cat farm.err)"
 echo "$ids"
+cat farm.err
+grep -q "asset blub: one extraction is estimated at .* more than --mem 3M" farm.err ||
+  fail "the farm did not say that blub's shards keep their part"
+grep -qx "sculpts=(whole part)" "$tmp/jobs/shards.sbatch" ||
+  fail "shards.sbatch: expected spot's shards whole and blub's part: $(grep sculpts= "$tmp/jobs/shards.sbatch")"
 array=$(awk '$1 == "shards" {print $2}' <<<"$ids")
 merges=$(awk '$1 == "merge" {print $3}' <<<"$ids")
 [ -n "$array" ] && [ "$(wc -w <<<"$merges")" = 2 ] || fail "unexpected output: $ids"
@@ -110,14 +118,14 @@ restarts=$(scontrol show job "${array}_4" | grep -o 'Restarts=[0-9]*' | cut -d= 
 [ "${restarts:-0}" -ge 1 ] || fail "shard task ${array}_4 was not run again (restarts ${restarts:-0})"
 
 # The maps one extraction writes, byte for byte.
-"$dispex" extract spot.obj spot_sculpt.obj -o spot_expected.ptx --search-distance 1% \
-  --method rays -q || fail "extract spot"
-"$dispex" extract blub.obj blub_sculpt.obj -o blub_expected.ptx --search-distance 1% \
-  --method rays --data-type half -q || fail "extract blub"
+"$dispex" extract spot.obj spot_sculpt.obj -o spot_expected.ptx -q || fail "extract spot"
+"$dispex" extract blub.obj blub_sculpt.obj -o blub_expected.ptx --method rays --data-type half \
+  -q || fail "extract blub"
 for asset in spot blub; do
   cmp -s "maps/$asset.ptx" "${asset}_expected.ptx" ||
     fail "maps/$asset.ptx differs from a single-machine extraction"
 done
 ls "$tmp"/jobs/parts/*.ptx | wc -l | grep -qx 6 || fail "expected 6 parts"
-echo "PASS: 2 assets x 3 shards on Slurm, shard ${array}_4 killed mid-run and requeued" \
-  "(restarts $restarts); merged maps identical to single-machine extractions"
+echo "PASS: 2 assets x 3 shards on Slurm (blub's of part of its sculpt), shard ${array}_4" \
+  "killed mid-run and requeued (restarts $restarts); merged maps identical to single-machine" \
+  "extractions"

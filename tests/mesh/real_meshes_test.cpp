@@ -439,6 +439,16 @@ TEST_P(RealMesh, MatchesIndependentCounts) {
   std::map<int, std::size_t> sizes;
   for (std::size_t f = 0; f < mesh.num_faces(); ++f) ++sizes[mesh.face_size(f)];
   EXPECT_EQ(sizes, e.face_sizes);
+  // Counted without reading: the same counts, and an OBJ's corners.
+  StatusOr<MeshSize> counted = CountMeshElements(DataPath(std::string("meshes/") + e.path));
+  ASSERT_TRUE(counted.ok()) << counted.status().message();
+  EXPECT_EQ(counted->vertices, e.vertices);
+  EXPECT_EQ(counted->faces, e.faces);
+  std::size_t corners = 0;
+  for (const auto& [size, count] : e.face_sizes) corners += static_cast<std::size_t>(size) * count;
+  const bool ply = std::string(e.path).ends_with(".ply");
+  EXPECT_EQ(counted->corners_counted, !ply);
+  EXPECT_EQ(counted->corners, ply ? 4 * e.faces : corners);
   ASSERT_EQ(mesh.face_offsets.front(), 0u);
   ASSERT_EQ(mesh.face_offsets.back(), mesh.face_indices.size());
   for (std::int32_t v : mesh.face_indices) {
@@ -501,6 +511,41 @@ INSTANTIATE_TEST_SUITE_P(Data, RealMesh, ::testing::ValuesIn(Table()),
                          });
 
 // Every mesh file in the data folder has a row above.
+// An OBJ of several of CountMeshElements' 4 MiB chunks, lines cut anywhere by them, with the
+// lines its count must tell apart: indented, CRLF, vt/vn, comments, faces of 3 to 5 corners.
+TEST(RealMeshes, CountsAnObjAcrossChunks) {
+  const std::string path = testing::TempPath(".obj");
+  std::size_t vertices = 0, faces = 0, corners = 0;
+  {
+    std::ofstream out(path, std::ios::binary);
+    for (int i = 0; i < 400000; ++i) {
+      out << (i % 7 == 0 ? "  v " : "v ") << i << ".5 0.25 -1" << (i % 5 == 0 ? "\r\n" : "\n");
+      ++vertices;
+      if (i % 3 == 0) out << "vt 0.5 0.5\nvn 0 0 1\n# v 1 2 3\n";
+      if (i >= 5) {
+        const int n = 3 + i % 3;
+        out << (i % 4 == 0 ? "\tf" : "f");
+        for (int k = 0; k < n; ++k) out << ' ' << (i - k) << "/1/1";
+        out << (i % 6 == 0 ? " \r\n" : "\n");
+        ++faces;
+        corners += static_cast<std::size_t>(n);
+      }
+    }
+  }
+  ASSERT_GT(std::filesystem::file_size(path), std::size_t{12} << 20);
+  StatusOr<MeshSize> counted = CountMeshElements(path);
+  ASSERT_TRUE(counted.ok()) << counted.status().message();
+  EXPECT_EQ(counted->vertices, vertices);
+  EXPECT_EQ(counted->faces, faces);
+  EXPECT_EQ(counted->corners, corners);
+  StatusOr<Mesh> read = ReadMesh(path);
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  EXPECT_EQ(read->num_vertices(), vertices);
+  EXPECT_EQ(read->face_indices.size(), corners);
+  std::filesystem::remove(path);
+  EXPECT_NE(CountMeshElements(path).status().message().find(path), std::string::npos);
+}
+
 TEST(RealMeshes, TableCoversTheDataFolder) {
   std::vector<std::string> files;
   const std::string root = DataPath("meshes");

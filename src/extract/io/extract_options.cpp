@@ -177,13 +177,6 @@ Status CheckShard(const ExtractOptions& o) {
     return Status::Error(
         "shard_count: vector maps are not made in shards (only scalar maps; docs/FARM.md)");
   }
-  if (o.shard_count > 0 && o.shard_sculpt == ShardSculpt::kPart &&
-      (o.method != ExtractMethod::kRays ||
-       o.search_distance.kind == SearchDistanceSpec::Kind::kAuto)) {
-    return Status::Error(
-        "shard_sculpt part: needs method rays and a given search_distance (the correspondence "
-        "and the automatic search distance read the whole sculpt)");
-  }
   return Status::Ok();
 }
 

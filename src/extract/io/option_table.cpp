@@ -354,8 +354,9 @@ const Entry kEntries[] = {
       .kind = OptionKind::kSize,
       .values = "bytes, or a size such as 8G or 512M (0: the memory available)",
       .in_manifest = true,
-      .help = "refuse work estimated to need more memory than this (e.g. 8G; default: the "
-              "memory available)"},
+      .help = "keep within this memory (e.g. 8G; default: the memory available): a sculpt "
+              "whose BVH would not fit is traced in parts, work that fits no plan is refused "
+              "before it starts"},
      DISPEX_SETTER({
        if (v.is_number_unsigned()) {
          o.max_memory = v.get<std::uint64_t>();
