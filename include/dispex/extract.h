@@ -476,6 +476,9 @@ struct ExtractReport {
     // With a given search distance: the Ptex faces whose reach the BVH holds when it holds
     // only part of the sculpt (docs/INCREMENTAL.md); 0 when it holds all of it.
     std::int64_t tracer_faces = 0;
+    // An automatic search distance through rays, updated from the rays of the run before (kept
+    // in cache_dir): the long rays cast again, of search_rays; -1 when it was not updated.
+    std::int64_t search_rays_recast = -1, search_rays = 0;
   } incremental;
 
   // UV-space maps (ExtractOptions::uv_maps_dir): the files written, texel centres inside a UV

@@ -327,10 +327,12 @@ StatusOr<SearchDistanceEstimate> EstimateSearchDistance(const Tracer& tracer,
 // verified: a long ray that slipped through a vertex would find the far side of the model).
 // Parallel (TBB), deterministic. Over parts of a sculpt, one tracer each, from infinity: |t| of
 // each query's hit on the whole sculpt, when every face that shares a vertex with a face of a
-// part is in a part with it (so that a hit's neighbourhood is whole in some part).
+// part is in a part with it (so that a hit's neighbourhood is whole in some part). `side`, when
+// given: which side of the origin that nearest hit lies on (+1, -1; 0 where equally near hits
+// lie on both, or none).
 void LowerNearestHits(const Tracer& tracer, std::span<const Float3> origins,
-                      std::span<const Float3> normals, float length,
-                      std::span<float> nearest_abs_t);
+                      std::span<const Float3> normals, float length, std::span<float> nearest_abs_t,
+                      std::span<std::int8_t> side = {});
 
 // EstimateSearchDistance's rule over hits found another way (the same long rays answered
 // without this tracer): `abs_t`, |t| of the hits among `samples` queries. Same errors.

@@ -23,6 +23,7 @@
 #include "extract/incremental/face_keys.h"
 #include "extract/incremental/face_records.h"
 #include "extract/incremental/previous_map.h"
+#include "extract/incremental/ray_cache.h"
 #include "extract/incremental/shard_parts.h"
 #include "extract/incremental/shard_plan.h"
 #include "extract/input_checks.h"
@@ -389,10 +390,19 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   const bool shard = options.shard_count > 0;
   const bool part_shard = shard && options.shard_sculpt == ShardSculpt::kPart;
   const bool traced = !options.vector && inputs.mapping == nullptr;
+  const bool auto_distance = options.search_distance.kind == SearchDistanceSpec::Kind::kAuto;
+  // An incremental run keeps the automatic search distance's rays (ray_cache.h); with those of
+  // the run before, it updates the estimate without a BVH of the whole sculpt.
+  if (traced && auto_distance && options.incremental && !shard) {
+    inputs.ray_cache_path =
+        RayCachePath(CacheFolder(options), options.sculpt_path, report.inputs.base_fingerprint);
+  }
+  std::error_code ec;
+  const bool rays_kept =
+      !inputs.ray_cache_path.empty() && std::filesystem::exists(inputs.ray_cache_path, ec);
   const bool within_reach =
-      traced && ((options.search_distance.kind != SearchDistanceSpec::Kind::kAuto &&
-                  previous.usable() && (options.incremental || parts != nullptr)) ||
-                 part_shard);
+      traced && ((previous.usable() && options.incremental && (!auto_distance || rays_kept)) ||
+                 (!auto_distance && previous.usable() && parts != nullptr) || part_shard);
   plan.tracer = !traced        ? ExtractPlan::Tracer::kNone
                 : within_reach ? ExtractPlan::Tracer::kWithinReach
                                : ExtractPlan::Tracer::kWholeSculpt;

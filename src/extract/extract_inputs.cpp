@@ -320,7 +320,8 @@ Status TraceRun(ExtractInputs& inputs, std::span<const int> run) {
 
 StatusOr<std::vector<float>> NearestHitsInParts(const ExtractInputs& inputs, int sculpt_parts,
                                                 std::span<const Float3> origins,
-                                                std::span<const Float3> normals, float length) {
+                                                std::span<const Float3> normals, float length,
+                                                std::span<std::int8_t> side) {
   // Each query's nearest hit over the whole sculpt is the nearest of its parts' when each part
   // is a run of the sculpt's faces (a long ray may reach anywhere) with every face that shares
   // a vertex with them: around a hit on a face of the run the part holds what the whole sculpt
@@ -329,6 +330,13 @@ StatusOr<std::vector<float>> NearestHitsInParts(const ExtractInputs& inputs, int
   const Mesh& sculpt = inputs.sculpt;
   const auto parts = static_cast<std::size_t>(std::max(1, sculpt_parts));
   std::vector<float> nearest(origins.size(), std::numeric_limits<float>::infinity());
+  if (parts == 1) {  // the whole sculpt, not a copy of it
+    DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer,
+                            MakeEmbreeTracer(sculpt, inputs.tracer_options));
+    LowerNearestHits(*tracer, origins, normals, length, nearest, side);
+    DISPEX_RETURN_IF_ERROR(tracer->status());
+    return nearest;
+  }
   std::vector<std::uint8_t> near_run(sculpt.num_vertices());
   for (std::size_t p = 0; p < parts; ++p) {
     const std::size_t begin = sculpt.num_faces() * p / parts;
@@ -351,7 +359,7 @@ StatusOr<std::vector<float>> NearestHitsInParts(const ExtractInputs& inputs, int
     keep = {};
     DISPEX_ASSIGN_OR_RETURN(std::unique_ptr<Tracer> tracer,
                             MakeEmbreeTracer(part, inputs.tracer_options));
-    LowerNearestHits(*tracer, origins, normals, length, nearest);
+    LowerNearestHits(*tracer, origins, normals, length, nearest, side);
     DISPEX_RETURN_IF_ERROR(tracer->status());
     if (CancelRequested()) return Cancelled();
   }

@@ -59,6 +59,9 @@ struct ExtractInputs {
   // Without a tracer of the whole sculpt: the parts its automatic search distance is estimated
   // in (NearestHitsInParts), at least sculpt_parts.
   int estimate_parts = 1;
+  // An incremental run's file of the automatic search distance's rays (ray_cache.h): read to
+  // update the estimate when there is no tracer of the whole sculpt, written after it ("": none).
+  std::string ray_cache_path{};
   double run_bvh_seconds = 0;  // building the runs' BVHs (TraceRun) ...
   int runs_traced = 0;         // ... of this many runs
   std::string run_backend{};   // their TracerStats::backend
@@ -135,11 +138,12 @@ Status ForEachTracedRun(ExtractInputs& inputs, std::span<const int> faces, Work 
 }
 
 // The long rays of the automatic search distance (EstimateSearchDistance) against the sculpt
-// in `parts` parts, one BVH at a time: per query, |t| of its nearest hit, or infinity. The
-// same whatever `parts`.
+// in `parts` parts, one BVH at a time: per query, |t| of its nearest hit, or infinity (and its
+// side, LowerNearestHits's, when `side` is given). The same whatever `parts`.
 StatusOr<std::vector<float>> NearestHitsInParts(const ExtractInputs& inputs, int parts,
                                                 std::span<const Float3> origins,
-                                                std::span<const Float3> normals, float length);
+                                                std::span<const Float3> normals, float length,
+                                                std::span<std::int8_t> side = {});
 
 // Frees the sculpt's arrays (its source stays) once a part's tracer holds all a run needs: a
 // shard's, whose faces' keys, settings and BVH are made. EnsureTraced must not be called then.

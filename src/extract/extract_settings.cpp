@@ -5,9 +5,12 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
+#include <optional>
 
 #include "core/system.h"
 #include "extract/coarse_sampling.h"
+#include "extract/incremental/ray_cache.h"
 #include "extract/mapping/extract_mapping.h"
 
 namespace dispex::extract {
@@ -54,21 +57,72 @@ Status ResolveTolerance(const ExtractOptions& options, const Mesh& sculpt, Extra
   return Status::Ok();
 }
 
-// EstimateSearchDistance over the sculpt in parts, one BVH at a time (NearestHitsInParts).
-StatusOr<SearchDistanceEstimate> EstimateInParts(const ExtractInputs& inputs,
-                                                 const CoarseSampling& coarse, double diagonal,
-                                                 ExtractPlan& plan) {
-  const SearchDistanceOptions options;
-  plan.search_estimate_parts = std::max(inputs.sculpt_parts, inputs.estimate_parts);
-  DISPEX_ASSIGN_OR_RETURN(
-      std::vector<float> nearest,
-      NearestHitsInParts(inputs, plan.search_estimate_parts, coarse.points, coarse.normals,
-                         static_cast<float>(options.ray_fraction * diagonal)));
+// EstimateSearchDistance's rule over each long ray's nearest |t| (infinity: no hit).
+StatusOr<SearchDistanceEstimate> EstimateFromNearest(std::span<const float> nearest,
+                                                     double diagonal) {
   std::vector<double> abs_t;
+  abs_t.reserve(nearest.size());
   for (float t : nearest) {
     if (std::isfinite(t)) abs_t.push_back(static_cast<double>(t));
   }
-  return SearchDistanceFromHits(std::move(abs_t), nearest.size(), diagonal, options);
+  return SearchDistanceFromHits(std::move(abs_t), nearest.size(), diagonal);
+}
+
+// The long rays' nearest |t| over the sculpt through rays: by the tracer of the whole sculpt;
+// else from the rays of the run before (inputs.ray_cache_path) where that file is for these
+// rays; else over the sculpt in parts, one BVH at a time (NearestHitsInParts). An incremental
+// run keeps them, with the sculpt's cell keys, for the next (ray_cache.h). Every way gives the
+// same |t|, those of a BVH of the whole sculpt.
+StatusOr<std::vector<float>> NearestHits(const ExtractInputs& inputs, const LongRays& rays,
+                                         ExtractReport& report) {
+  const bool cache = !inputs.ray_cache_path.empty();
+  std::optional<RayGrid> grid;
+  RayCache now;
+  if (cache) {
+    grid.emplace(rays);
+    now.rays_key = RaysKey(rays, *grid);
+    KeySculptCells(inputs.sculpt, *grid, now);
+  }
+  // (In parts, a memory limit holds: the rays near an edit could reach all of the sculpt.)
+  std::optional<RayCache> before;
+  if (cache && !inputs.tracer && inputs.sculpt_parts <= 1) {
+    before = ReadRayCache(inputs.ray_cache_path, now.rays_key);
+  }
+  if (inputs.tracer) {
+    now.nearest.assign(rays.origins.size(), std::numeric_limits<float>::infinity());
+    now.side.assign(rays.origins.size(), 0);
+    LowerNearestHits(*inputs.tracer, rays.origins, rays.normals, rays.length, now.nearest,
+                     now.side);
+    DISPEX_RETURN_IF_ERROR(inputs.tracer->status());
+  } else if (before) {
+    std::int64_t recast = 0;
+    DISPEX_RETURN_IF_ERROR(
+        UpdateNearestHits(inputs.sculpt, inputs.tracer_options, rays, *grid, *before, now, recast));
+    report.incremental.search_rays_recast = recast;
+    report.incremental.search_rays = static_cast<std::int64_t>(rays.origins.size());
+  } else {
+    report.plan.search_estimate_parts = std::max(inputs.sculpt_parts, inputs.estimate_parts);
+    now.side.assign(cache ? rays.origins.size() : 0, 0);
+    DISPEX_ASSIGN_OR_RETURN(
+        now.nearest, NearestHitsInParts(inputs, report.plan.search_estimate_parts, rays.origins,
+                                        rays.normals, rays.length, now.side));
+  }
+  if (cache && !WriteRayCache(inputs.ray_cache_path, now).ok()) {
+    report.warnings.push_back(
+        fmt::format("{}: cannot keep the search distance's rays there for the next run (cache_dir)",
+                    inputs.ray_cache_path));
+  }
+  return std::move(now.nearest);
+}
+
+StatusOr<SearchDistanceEstimate> EstimateByRays(const ExtractInputs& inputs,
+                                                const CoarseSampling& coarse, double diagonal,
+                                                ExtractReport& report) {
+  const SearchDistanceOptions options;
+  const LongRays rays{coarse.points, coarse.normals,
+                      static_cast<float>(options.ray_fraction * diagonal)};
+  DISPEX_ASSIGN_OR_RETURN(const std::vector<float> nearest, NearestHits(inputs, rays, report));
+  return EstimateFromNearest(nearest, diagonal);
 }
 
 Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs& inputs,
@@ -76,11 +130,9 @@ Status ResolveSearchDistances(const ExtractOptions& options, const ExtractInputs
   report.settings.search_distance_auto =
       options.search_distance.kind == SearchDistanceSpec::Kind::kAuto;
   if (report.settings.search_distance_auto) {
-    auto estimate =
-        inputs.mapping  ? EstimateSearchDistanceMapped(inputs, coarse, report.inputs.base_diagonal)
-        : inputs.tracer ? EstimateSearchDistance(*inputs.tracer, coarse.points, coarse.normals,
-                                                 report.inputs.base_diagonal)
-                        : EstimateInParts(inputs, coarse, report.inputs.base_diagonal, report.plan);
+    auto estimate = inputs.mapping
+                        ? EstimateSearchDistanceMapped(inputs, coarse, report.inputs.base_diagonal)
+                        : EstimateByRays(inputs, coarse, report.inputs.base_diagonal, report);
     if (!estimate.ok()) {
       return Status::Error(StatusCode::kMismatch,
                            fmt::format("{} and {} do not overlap: {}", options.base_path,

@@ -14,17 +14,16 @@ StatusOr<ShardMemoryPlan> PlanShardMemory(const ExtractOptions& options,
                                           std::uint64_t node_memory) {
   DISPEX_ASSIGN_OR_RETURN(const MeshSize sculpt, CountMeshElements(options.sculpt_path));
   const bool matches = options.method != ExtractMethod::kRays;
-  const bool may_trace = options.method != ExtractMethod::kMapping &&
-                         options.method != ExtractMethod::kInterpolate;
+  const bool may_trace =
+      options.method != ExtractMethod::kMapping && options.method != ExtractMethod::kInterpolate;
   // The output's bound as the run's, less the base's faces it does not know yet.
-  const extract::MemoryNeed need =
-      extract::EstimateMemory(sculpt.vertices, sculpt.faces, sculpt.corners,
-                              std::uint64_t{1} << 31, matches);
+  const extract::MemoryNeed need = extract::EstimateMemory(
+      sculpt.vertices, sculpt.faces, sculpt.corners, std::uint64_t{1} << 31, matches);
   ShardMemoryPlan plan;
   plan.floor_bytes =
       std::max(extract::ReadPeakBytes(options), need.arrays + need.match + need.output);
-  plan.whole_bytes = std::max(plan.floor_bytes,
-                              need.arrays + need.output + (may_trace ? need.bvh : need.match));
+  plan.whole_bytes =
+      std::max(plan.floor_bytes, need.arrays + need.output + (may_trace ? need.bvh : need.match));
   if (node_memory == 0 || plan.whole_bytes <= node_memory) return plan;
   if (plan.floor_bytes > node_memory) {
     return Status::Error(

@@ -34,7 +34,8 @@ MeshSize CountObjLines(std::string_view text, std::size_t begin, std::size_t end
   while (at < end) {
     const void* nl = std::memchr(text.data() + at, '\n', text.size() - at);
     const std::size_t line_end =
-        nl == nullptr ? text.size() : static_cast<std::size_t>(static_cast<const char*>(nl) - text.data());
+        nl == nullptr ? text.size()
+                      : static_cast<std::size_t>(static_cast<const char*>(nl) - text.data());
     std::size_t c = at;
     while (c < line_end && IsBlank(text[c])) ++c;
     if (c + 1 < line_end && IsBlank(text[c + 1])) {
@@ -67,8 +68,8 @@ MeshSize Add(MeshSize a, const MeshSize& b) {
 StatusOr<MeshSize> CountMeshElements(const std::string& path) {
   const MeshFormat format = DetectMeshFormat(path);
   if (format == MeshFormat::kUnknown) {
-    return Status::Error(fmt::format("{}: not an OBJ or PLY file (by its name and first bytes)",
-                                     path));
+    return Status::Error(
+        fmt::format("{}: not an OBJ or PLY file (by its name and first bytes)", path));
   }
   DISPEX_ASSIGN_OR_RETURN(MappedFile file, MappedFile::Open(path));
   const std::string_view text = file.view();

@@ -126,8 +126,8 @@ StatusOr<SearchDistanceEstimate> SearchDistanceFromHits(std::vector<double> abs_
 }
 
 void LowerNearestHits(const Tracer& tracer, std::span<const Float3> origins,
-                      std::span<const Float3> normals, float length,
-                      std::span<float> nearest_abs_t) {
+                      std::span<const Float3> normals, float length, std::span<float> nearest_abs_t,
+                      std::span<std::int8_t> side) {
   const NormalQuery query{length, HitPolicy::kNearest, /*verify_hits=*/true};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& r) {
@@ -140,7 +140,16 @@ void LowerNearestHits(const Tracer& tracer, std::span<const Float3> origins,
                       for (std::size_t i = 0; i < n; ++i) {
                         if (!(flags[i] & HitFlags::kHit)) continue;
                         float& kept = nearest_abs_t[b + i];
-                        kept = std::min(kept, std::fabs(t[i]));
+                        const float abs_t = std::fabs(t[i]);
+                        if (!side.empty()) {
+                          const std::int8_t s = t[i] < 0 ? -1 : 1;
+                          if (abs_t < kept) {
+                            side[b + i] = s;
+                          } else if (abs_t == kept && side[b + i] != s) {
+                            side[b + i] = 0;
+                          }
+                        }
+                        kept = std::min(kept, abs_t);
                       }
                     });
 }

@@ -269,6 +269,11 @@ TEST_P(Incremental, EveryStepEqualsAFullExtraction) {
     if (GetParam().local_tracer) {
       EXPECT_NE(r.tracer.find(" sculpt faces"), std::string::npos) << r.tracer;
     }
+    if (GetParam().local_tracer && GetParam().auto_search_distance) {
+      EXPECT_GT(r.incremental.search_rays_recast, 0);
+      EXPECT_LT(r.incremental.search_rays_recast, r.incremental.search_rays / 4)
+          << "the search distance's rays near a local edit are cast again, not all";
+    }
     // The sculpt's faces did not change: its adjacency comes from the cache (the ray path
     // does not match the sculpt).
     EXPECT_EQ(r.method.adjacency_cached, r.method.used != ExtractMethod::kRays);
@@ -346,6 +351,11 @@ INSTANTIATE_TEST_SUITE_P(
                       Variant{"spot2928_local_tracer_uv", "keenan_spot/spot_quadrangulated.obj", 2,
                               PtexDataType::kFloat, WatertightEdges::kFilter, false, true, 0.01,
                               std::nullopt, true},
+                      // Rays with the automatic search distance: each re-run updates the
+                      // estimate from the rays the run before kept (ray_cache.h), with no BVH
+                      // of the whole sculpt.
+                      Variant{"spot2928_rays_auto_distance", "keenan_spot/spot_quadrangulated.obj",
+                              2, PtexDataType::kFloat, WatertightEdges::kFilter, true, true, 0.01},
                       Variant{"car_ngons_boundary_float_off", "opensubdiv/catmark_car.obj", 3,
                               PtexDataType::kFloat, WatertightEdges::kOff, true},
                       Variant{"spot_vector_tangent", "keenan_spot/spot_control_mesh.obj", 3,

@@ -25,7 +25,9 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
                         {"faces_extracted", r.incremental.faces_extracted},
                         {"faces_copied_redone", r.incremental.faces_copied_redone},
                         {"redo_reason", r.incremental.redo_reason},
-                        {"tracer_faces", r.incremental.tracer_faces}};
+                        {"tracer_faces", r.incremental.tracer_faces},
+                        {"search_rays_recast", r.incremental.search_rays_recast},
+                        {"search_rays", r.incremental.search_rays}};
   }
   if (r.options.shard_count > 0) {
     j["shard"] = {{"index", r.options.shard_index},
@@ -270,6 +272,10 @@ std::string IncrementalLine(const ExtractReport& r) {
   if (r.incremental.tracer_faces > 0) {
     out += fmt::format("; the BVH held the sculpt within reach of {} faces",
                        r.incremental.tracer_faces);
+  }
+  if (r.incremental.search_rays_recast >= 0) {
+    out += fmt::format("; the search distance's rays: {} of {} cast again",
+                       r.incremental.search_rays_recast, r.incremental.search_rays);
   }
   return out + "\n";
 }
