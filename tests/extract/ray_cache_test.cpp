@@ -132,8 +132,8 @@ class RayCacheTest : public ::testing::Test {
     EXPECT_EQ(now.nearest.size(), expected.size());
     std::size_t differ = 0, hits = 0;
     for (std::size_t i = 0; i < expected.size() && i < now.nearest.size(); ++i) {
-      differ += std::bit_cast<std::uint32_t>(now.nearest[i]) !=
-                std::bit_cast<std::uint32_t>(expected[i]);
+      differ +=
+          std::bit_cast<std::uint32_t>(now.nearest[i]) != std::bit_cast<std::uint32_t>(expected[i]);
       hits += std::isfinite(expected[i]);
     }
     EXPECT_EQ(differ, 0u) << "of " << expected.size() << " rays, " << recast << " cast again";
@@ -148,9 +148,9 @@ class RayCacheTest : public ::testing::Test {
 
 TEST_F(RayCacheTest, AnEditRecastsTheRaysNearItAndGivesTheWholeSculptsHits) {
   const BoundingBox box = ComputeBounds(sculpt_);
-  const float diagonal = std::sqrt(std::pow(box.max.x - box.min.x, 2.0f) +
-                                   std::pow(box.max.y - box.min.y, 2.0f) +
-                                   std::pow(box.max.z - box.min.z, 2.0f));
+  const float diagonal =
+      std::sqrt(std::pow(box.max.x - box.min.x, 2.0f) + std::pow(box.max.y - box.min.y, 2.0f) +
+                std::pow(box.max.z - box.min.z, 2.0f));
   // A bump at a vertex of the sculpt's surface, then a deeper one (the rays that hit the old
   // surface there must be cast again in full), then nothing changed.
   const Float3 at = sculpt_.positions[sculpt_.positions.size() / 3];

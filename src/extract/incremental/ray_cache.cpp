@@ -87,9 +87,8 @@ struct Hits {
 // Per ray of `cast`, its nearest hit on the sculpt faces centred in a flagged cell (a BVH of
 // only those, built with `options`), or infinity.
 StatusOr<Hits> NearestOnCells(const Mesh& sculpt, const RayGrid& grid,
-                                            std::span<const std::uint8_t> cells,
-                                            const TracerOptions& options, const LongRays& rays,
-                                            std::span<const std::size_t> cast) {
+                              std::span<const std::uint8_t> cells, const TracerOptions& options,
+                              const LongRays& rays, std::span<const std::size_t> cast) {
   std::vector<std::uint8_t> keep(sculpt.num_faces(), 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sculpt.num_faces(), 1 << 14),
                     [&](const tbb::blocked_range<std::size_t>& range) {
@@ -298,8 +297,8 @@ Status UpdateNearestHits(const Mesh& sculpt, const TracerOptions& tracer_options
   // d of a point (per axis) lies at most floor(d / cell) + 1 cells from the point's cell.
   const double h = std::max(previous.half_extent, current.half_extent);
   const double cells_reach = 3 * h / grid.min_cell_size() + 0.25;
-  const int radius = cells_reach > kRayGridCells ? kRayGridCells
-                                                 : static_cast<int>(std::floor(cells_reach)) + 1;
+  const int radius =
+      cells_reach > kRayGridCells ? kRayGridCells : static_cast<int>(std::floor(cells_reach)) + 1;
   std::vector<std::uint8_t> changed(grid.num_cells());
   for (std::size_t c = 0; c < changed.size(); ++c) {
     changed[c] = !(previous.cells[c] == current.cells[c]);
@@ -348,8 +347,8 @@ Status UpdateNearestHits(const Mesh& sculpt, const TracerOptions& tracer_options
   // is no nearer than the ray's previous |t| (it was there before): kLower takes the nearer of
   // its previous |t| and this.
   const std::vector<std::uint8_t> first_cells = Dilate(dirty, radius);
-  DISPEX_ASSIGN_OR_RETURN(const Hits first, NearestOnCells(sculpt, grid, first_cells,
-                                                           tracer_options, rays, cast));
+  DISPEX_ASSIGN_OR_RETURN(const Hits first,
+                          NearestOnCells(sculpt, grid, first_cells, tracer_options, rays, cast));
   std::vector<float> first_of(num_rays, std::numeric_limits<float>::infinity());
   std::vector<std::int8_t> first_side(num_rays, 0);
   for (std::size_t j = 0; j < cast.size(); ++j) {
@@ -379,8 +378,8 @@ Status UpdateNearestHits(const Mesh& sculpt, const TracerOptions& tracer_options
   }
   Hits second;
   if (!covered) {
-    DISPEX_ASSIGN_OR_RETURN(second, NearestOnCells(sculpt, grid, second_cells, tracer_options,
-                                                   rays, recast_rays));
+    DISPEX_ASSIGN_OR_RETURN(
+        second, NearestOnCells(sculpt, grid, second_cells, tracer_options, rays, recast_rays));
   }
   for (std::size_t j = 0; j < recast_rays.size(); ++j) {
     const std::size_t i = recast_rays[j];

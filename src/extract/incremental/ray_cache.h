@@ -33,7 +33,9 @@ inline constexpr int kRayGridCells = 64;
 class RayGrid {
  public:
   explicit RayGrid(const LongRays& rays);
-  std::size_t num_cells() const { return std::size_t{kRayGridCells} * kRayGridCells * kRayGridCells; }
+  std::size_t num_cells() const {
+    return std::size_t{kRayGridCells} * kRayGridCells * kRayGridCells;
+  }
   std::array<int, 3> CellOf(const std::array<float, 3>& p) const;
   std::size_t Index(const std::array<int, 3>& c) const {
     return (static_cast<std::size_t>(c[2]) * kRayGridCells + static_cast<std::size_t>(c[1])) *
@@ -50,11 +52,11 @@ class RayGrid {
 };
 
 struct RayCache {
-  Hash128 rays_key;        // the rays (origins, normals, length) and the grid: RaysKey
-  float half_extent = 0;   // the largest half-size of a sculpt face's bounding box
-  std::vector<Hash128> cells;  // per cell: the order-free sum of the keys of the sculpt faces
-                               // whose box centre is in it (their corners' positions)
-  std::vector<float> nearest;  // per ray: |t| of its nearest hit on the sculpt, or infinity
+  Hash128 rays_key;               // the rays (origins, normals, length) and the grid: RaysKey
+  float half_extent = 0;          // the largest half-size of a sculpt face's bounding box
+  std::vector<Hash128> cells;     // per cell: the order-free sum of the keys of the sculpt faces
+                                  // whose box centre is in it (their corners' positions)
+  std::vector<float> nearest;     // per ray: |t| of its nearest hit on the sculpt, or infinity
   std::vector<std::int8_t> side;  // per ray: the side of that hit (LowerNearestHits)
 };
 
