@@ -2,16 +2,14 @@
 
 #include <unistd.h>
 
-#include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
 #include <span>
-#include <vector>
 
+#include "core/cache_files.h"
 #include "core/hash128.h"
 
 namespace dispex::subdiv {
@@ -113,40 +111,6 @@ void Write(const std::string& path, const Hash128& key, const QuadAdjacency& a) 
   if (!ok || ec) fs::remove(temp, ec);
 }
 
-// Removes the least recently used cache files beyond kAdjacencyCacheBytes (never `keep`), and
-// temporary files a killed run left.
-void Evict(const fs::path& folder, const fs::path& keep) {
-  struct Entry {
-    fs::file_time_type time;
-    std::uintmax_t size;
-    fs::path path;
-  };
-  std::vector<Entry> entries;
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(folder, ec)) {
-    const std::string name = entry.path().filename().string();
-    if (name.rfind(kPrefix, 0) != 0) continue;
-    std::error_code stat_error;
-    const auto time = entry.last_write_time(stat_error);
-    const auto size = entry.file_size(stat_error);
-    if (stat_error) continue;
-    if (name.find(".tmp.") != std::string::npos) {
-      if (fs::file_time_type::clock::now() - time > std::chrono::hours(1)) {
-        fs::remove(entry.path(), stat_error);
-      }
-      continue;
-    }
-    entries.push_back({time, size, entry.path()});
-  }
-  std::sort(entries.begin(), entries.end(),
-            [](const Entry& a, const Entry& b) { return a.time > b.time; });
-  std::uintmax_t total = 0;
-  for (const Entry& e : entries) {
-    total += e.size;
-    if (total > kAdjacencyCacheBytes && e.path != keep) fs::remove(e.path, ec);
-  }
-}
-
 }  // namespace
 
 StatusOr<QuadAdjacency> CachedQuadAdjacency(const Mesh& mesh, const std::string& folder,
@@ -166,7 +130,7 @@ StatusOr<QuadAdjacency> CachedQuadAdjacency(const Mesh& mesh, const std::string&
   fs::create_directories(folder, ec);
   if (!ec) {
     Write(path.string(), key, built);
-    Evict(folder, path);
+    EvictCacheFiles(folder, kPrefix, kAdjacencyCacheBytes, path.string());
   }
   return built;
 }

@@ -13,6 +13,7 @@
 #include <iterator>
 #include <limits>
 
+#include "core/cache_files.h"
 #include "dispex/files.h"
 #include "extract/incremental/face_keys.h"
 
@@ -20,6 +21,7 @@ namespace dispex::extract {
 namespace {
 
 constexpr char kMagic[8] = {'D', 'X', 'R', 'A', 'Y', 'S', '0', '2'};
+constexpr const char* kPrefix = "rays-";
 // The rays' box is grown by this fraction of their length: a hit may lie a little past the
 // window (retries past a surface in the margin, trace.h).
 constexpr double kLengthMargin = 0.05;
@@ -246,7 +248,7 @@ std::string RayCachePath(const std::string& folder, const std::string& sculpt_pa
   const std::filesystem::path absolute = std::filesystem::absolute(sculpt_path, ec);
   h.Add(std::string_view(ec ? sculpt_path : absolute.lexically_normal().string()));
   h.Add(std::string_view(base_fingerprint));
-  return (std::filesystem::path(folder) / ("rays-" + h.Digest().Hex() + ".bin")).string();
+  return (std::filesystem::path(folder) / (kPrefix + h.Digest().Hex() + ".bin")).string();
 }
 
 std::optional<RayCache> ReadRayCache(const std::string& path, const Hash128& rays_key) {
@@ -284,7 +286,10 @@ Status WriteRayCache(const std::string& path, const RayCache& cache) {
   AppendArray(bytes, cache.nearest);
   AppendArray(bytes, cache.side);
   Append(bytes, HashBytes(std::as_bytes(std::span(bytes.data(), bytes.size()))));
-  return WriteFileAtomically(path, bytes.data(), bytes.size());
+  DISPEX_RETURN_IF_ERROR(WriteFileAtomically(path, bytes.data(), bytes.size()));
+  EvictCacheFiles(std::filesystem::path(path).parent_path().string(), kPrefix, kRayCacheBytes,
+                  path);
+  return Status::Ok();
 }
 
 Status UpdateNearestHits(const Mesh& sculpt, const TracerOptions& tracer_options,

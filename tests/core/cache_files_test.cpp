@@ -1,0 +1,47 @@
+// A cache folder kept within a size: the least recently written files of one prefix go first,
+// never the file just written, never another prefix's; stale temporary files go.
+#include "core/cache_files.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace dispex {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(CacheFiles, LeastRecentlyWrittenGoFirst) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "dispex_cache_files_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto now = fs::file_time_type::clock::now();
+  // rays-0 oldest ... rays-4 newest, 100 bytes each; an adjacency file; temporary files.
+  auto make = [&](const std::string& name, int hours_ago) {
+    std::ofstream(dir / name, std::ios::binary) << std::string(100, 'x');
+    fs::last_write_time(dir / name, now - std::chrono::hours(hours_ago));
+  };
+  for (int i = 0; i < 5; ++i) make("rays-" + std::to_string(i) + ".bin", 10 - i);
+  make("adjacency-0.bin", 20);
+  make("rays-9.bin.tmp.abc", 2);
+  make("rays-8.bin.tmp.def", 0);
+  // Room for two and a half: all but the two newest go, except the one kept.
+  EvictCacheFiles(dir.string(), "rays-", 250, (dir / "rays-0.bin").string());
+  EXPECT_TRUE(fs::exists(dir / "rays-0.bin")) << "the file just written is kept";
+  EXPECT_FALSE(fs::exists(dir / "rays-1.bin"));
+  EXPECT_FALSE(fs::exists(dir / "rays-2.bin"));
+  EXPECT_TRUE(fs::exists(dir / "rays-3.bin"));
+  EXPECT_TRUE(fs::exists(dir / "rays-4.bin"));
+  EXPECT_TRUE(fs::exists(dir / "adjacency-0.bin")) << "another prefix's file";
+  EXPECT_FALSE(fs::exists(dir / "rays-9.bin.tmp.abc")) << "a killed run's temporary file";
+  EXPECT_TRUE(fs::exists(dir / "rays-8.bin.tmp.def")) << "a running write's temporary file";
+  // A folder that is not there: nothing happens.
+  EvictCacheFiles((dir / "missing").string(), "rays-", 0, "");
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace dispex
