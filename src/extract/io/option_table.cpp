@@ -504,7 +504,7 @@ const Entry kEntries[] = {
       .values = EnumNameListConstant<extract::kShardSculptNames>(),
       .in_manifest = false,
       .help = "what a shard keeps of the sculpt: whole, or part (only what its faces' rays "
-              "reach: memory falls with N; needs --method rays and --search-distance)",
+              "reach, an automatic search distance estimated in N parts: memory falls with N)",
       .default_text = "whole"},
      DISPEX_SETTER({ return SetNamed(o.shard_sculpt, v, ParseShardSculpt); })},
 };
