@@ -124,8 +124,8 @@ MeshFormat MeshFormatOfName(const std::string& path);
 
 // What a mesh file holds, counted without reading the mesh (to plan memory before reading it):
 // a PLY file's header counts, its corners taken as 4 per face (they are in the body); an OBJ's
-// `v` and `f` lines and the corners on them, in one pass over the file. Not validated: a file
-// ReadMesh refuses may be counted.
+// `v` and `f` lines and the corners on them, by the OBJ reader's counting pass. Not validated:
+// a file ReadMesh refuses may be counted.
 struct MeshSize {
   std::uint64_t vertices = 0, faces = 0, corners = 0;
   bool corners_counted = false;  // false: 4 per face assumed

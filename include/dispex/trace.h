@@ -330,6 +330,17 @@ StatusOr<SearchDistanceEstimate> EstimateSearchDistance(const Tracer& tracer,
 // part is in a part with it (so that a hit's neighbourhood is whole in some part). `side`, when
 // given: which side of the origin that nearest hit lies on (+1, -1; 0 where equally near hits
 // lie on both, or none).
+// LowerNearestHits's rule for one query's hit (|t| and side): lowered to another's when that is
+// nearer; equally near on the other side, side 0.
+inline void KeepNearerHit(float& abs_t, std::int8_t& side, float other_abs_t,
+                          std::int8_t other_side) {
+  if (other_abs_t < abs_t) {
+    abs_t = other_abs_t;
+    side = other_side;
+  } else if (other_abs_t == abs_t && side != other_side) {
+    side = 0;
+  }
+}
 void LowerNearestHits(const Tracer& tracer, std::span<const Float3> origins,
                       std::span<const Float3> normals, float length, std::span<float> nearest_abs_t,
                       std::span<std::int8_t> side = {});

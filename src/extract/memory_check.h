@@ -27,6 +27,8 @@ struct MemoryNeed {
   std::uint64_t bvh = 0;         // a BVH of the whole sculpt
   std::uint64_t output = 0;      // the map's blocks at most
 };
+// The most texels an output estimate counts (EstimateMemory's max_texels).
+inline constexpr std::uint64_t kMaxEstimatedTexels = std::uint64_t{1} << 31;
 MemoryNeed EstimateMemory(std::size_t sculpt_vertices, std::size_t sculpt_faces,
                           std::size_t sculpt_indices, std::uint64_t max_texels, bool matches);
 

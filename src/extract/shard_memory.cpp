@@ -18,7 +18,7 @@ StatusOr<ShardMemoryPlan> PlanShardMemory(const ExtractOptions& options,
       options.method != ExtractMethod::kMapping && options.method != ExtractMethod::kInterpolate;
   // The output's bound as the run's, less the base's faces it does not know yet.
   const extract::MemoryNeed need = extract::EstimateMemory(
-      sculpt.vertices, sculpt.faces, sculpt.corners, std::uint64_t{1} << 31, matches);
+      sculpt.vertices, sculpt.faces, sculpt.corners, extract::kMaxEstimatedTexels, matches);
   ShardMemoryPlan plan;
   plan.floor_bytes =
       std::max(extract::ReadPeakBytes(options), need.arrays + need.match + need.output);

@@ -19,6 +19,8 @@
 // buffer per thread), so the file itself is never resident in the process and its mapping's
 // pages are not touched (but for a chunk that cannot be copied). The result is identical for
 // any thread count and chunk size.
+#include "mesh/obj_reader.h"
+
 #include <fmt/format.h>
 #include <sys/mman.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -485,6 +487,23 @@ StatusOr<Mesh> ParseObjBuffer(std::string_view bytes, const std::string& name,
 }
 
 }  // namespace
+
+MeshSize CountObjElements(std::string_view bytes) {
+  const std::vector<Chunk> chunks = CutIntoChunks(bytes, kDefaultChunkBytes);
+  std::vector<ChunkCounts> counts(chunks.size());
+  tbb::parallel_for(std::size_t{0}, chunks.size(),
+                    [&](std::size_t i) { counts[i] = CountChunk(bytes.data(), chunks[i]); });
+  MeshSize size;
+  size.corners_counted = true;
+  for (const ChunkCounts& c : counts) {
+    size.vertices += static_cast<std::uint64_t>(c.vertices);
+    size.faces += static_cast<std::uint64_t>(c.faces);
+    size.corners += static_cast<std::uint64_t>(c.corners);
+    size.corners_counted = size.corners_counted && c.plain;
+  }
+  if (!size.corners_counted) size.corners = 4 * size.faces;
+  return size;
+}
 
 StatusOr<Mesh> ParseObj(std::string_view bytes, const std::string& name,
                         const ReadOptions& options) {

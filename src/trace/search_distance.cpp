@@ -141,15 +141,11 @@ void LowerNearestHits(const Tracer& tracer, std::span<const Float3> origins,
                         if (!(flags[i] & HitFlags::kHit)) continue;
                         float& kept = nearest_abs_t[b + i];
                         const float abs_t = std::fabs(t[i]);
-                        if (!side.empty()) {
-                          const std::int8_t s = t[i] < 0 ? -1 : 1;
-                          if (abs_t < kept) {
-                            side[b + i] = s;
-                          } else if (abs_t == kept && side[b + i] != s) {
-                            side[b + i] = 0;
-                          }
+                        if (side.empty()) {
+                          kept = std::min(kept, abs_t);
+                        } else {
+                          KeepNearerHit(kept, side[b + i], abs_t, t[i] < 0 ? -1 : 1);
                         }
-                        kept = std::min(kept, abs_t);
                       }
                     });
 }

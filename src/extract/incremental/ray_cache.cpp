@@ -16,6 +16,7 @@
 #include "core/cache_files.h"
 #include "dispex/files.h"
 #include "extract/incremental/face_keys.h"
+#include "extract/incremental/sculpt_face_bounds.h"
 
 namespace dispex::extract {
 namespace {
@@ -52,35 +53,6 @@ void ForEachCellOnRay(const RayGrid& grid, const LongRays& rays, std::size_t i, 
   }
 }
 
-// The centre of sculpt face s's bounding box; `half`: the larger distance from it to the box's
-// sides.
-std::array<float, 3> BoxCentre(const Mesh& sculpt, std::size_t s, float& half) {
-  std::array<float, 3> lower{INFINITY, INFINITY, INFINITY};
-  std::array<float, 3> upper{-INFINITY, -INFINITY, -INFINITY};
-  for (std::int32_t v : sculpt.face(s)) {
-    const Float3& p = sculpt.positions[static_cast<std::size_t>(v)];
-    lower = {std::min(lower[0], p.x), std::min(lower[1], p.y), std::min(lower[2], p.z)};
-    upper = {std::max(upper[0], p.x), std::max(upper[1], p.y), std::max(upper[2], p.z)};
-  }
-  std::array<float, 3> centre{};
-  half = 0;
-  for (int k = 0; k < 3; ++k) {
-    centre[k] = 0.5f * (lower[k] + upper[k]);
-    half = std::max({half, upper[k] - centre[k], centre[k] - lower[k]});
-  }
-  return centre;
-}
-
-// The nearer of two hits (|t| and side), as LowerNearestHits keeps them.
-void KeepNearer(float& t, std::int8_t& side, float other_t, std::int8_t other_side) {
-  if (other_t < t) {
-    t = other_t;
-    side = other_side;
-  } else if (other_t == t && side != other_side) {
-    side = 0;
-  }
-}
-
 struct Hits {
   std::vector<float> t;
   std::vector<std::int8_t> side;
@@ -94,9 +66,10 @@ StatusOr<Hits> NearestOnCells(const Mesh& sculpt, const RayGrid& grid,
   std::vector<std::uint8_t> keep(sculpt.num_faces(), 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sculpt.num_faces(), 1 << 14),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      float half = 0;
+                      Corners corners;
                       for (std::size_t s = range.begin(); s != range.end(); ++s) {
-                        keep[s] = cells[grid.Index(grid.CellOf(BoxCentre(sculpt, s, half)))];
+                        const FaceBounds b = Bounds(corners.Of(sculpt, s));
+                        keep[s] = cells[grid.Index(grid.CellOf(b.centre))];
                       }
                     });
   const Mesh part = SculptPart(sculpt, keep);
@@ -214,18 +187,13 @@ void KeySculptCells(const Mesh& sculpt, const RayGrid& grid, RayCache& cache) {
       tbb::blocked_range<std::size_t>(0, sculpt.num_faces(), 1 << 14),
       [&](const tbb::blocked_range<std::size_t>& range) {
         float local_half = 0;
-        std::vector<float> xyz;
+        Corners corners;
         for (std::size_t s = range.begin(); s != range.end(); ++s) {
-          xyz.clear();
-          for (std::int32_t v : sculpt.face(s)) {
-            const Float3& p = sculpt.positions[static_cast<std::size_t>(v)];
-            xyz.insert(xyz.end(), {p.x, p.y, p.z});
-          }
-          float half = 0;
-          const std::array<float, 3> centre = BoxCentre(sculpt, s, half);
-          local_half = std::max(local_half, half);
-          const Hash128 key = HashBytes(std::as_bytes(std::span<const float>(xyz)));
-          const std::size_t cell = grid.Index(grid.CellOf(centre));
+          const std::span<const float> xyz = corners.Of(sculpt, s);
+          const FaceBounds b = Bounds(xyz);
+          local_half = std::max(local_half, b.half_extent);
+          const Hash128 key = HashBytes(std::as_bytes(xyz));
+          const std::size_t cell = grid.Index(grid.CellOf(b.centre));
           lanes[2 * cell].fetch_add(key.low, std::memory_order_relaxed);
           lanes[2 * cell + 1].fetch_add(key.high, std::memory_order_relaxed);
         }
@@ -360,7 +328,7 @@ Status UpdateNearestHits(const Mesh& sculpt, const TracerOptions& tracer_options
     const std::size_t i = cast[j];
     first_of[i] = first.t[j];
     first_side[i] = first.side[j];
-    KeepNearer(current.nearest[i], current.side[i], first.t[j], first.side[j]);
+    KeepNearerHit(current.nearest[i], current.side[i], first.t[j], first.side[j]);
   }
   // kRecast: its nearest is a changed face's (found above, whole around it) or an unchanged
   // face's at |t| from its previous |t| up to the first pass's. Where the sculpt along those
@@ -390,7 +358,7 @@ Status UpdateNearestHits(const Mesh& sculpt, const TracerOptions& tracer_options
     const std::size_t i = recast_rays[j];
     current.nearest[i] = first_of[i];
     current.side[i] = first_side[i];
-    if (!covered) KeepNearer(current.nearest[i], current.side[i], second.t[j], second.side[j]);
+    if (!covered) KeepNearerHit(current.nearest[i], current.side[i], second.t[j], second.side[j]);
   }
   return Status::Ok();
 }
