@@ -100,6 +100,16 @@ enum class PtexCompressor : std::uint8_t {
   kZlib,        // zlib's deflate; at level 6 it reproduces the reference writer's bytes
 };
 
+// One face as a file stores it, still encoded: what PtexFile::ReadEncodedFace gives and
+// PtexWriter::SetEncodedFace stores again without decoding and re-encoding its texels.
+struct PtexEncodedFace {
+  std::int8_t ulog2 = 0, vlog2 = 0;
+  bool constant = false;
+  std::vector<std::uint32_t> headers;  // FaceDataHeader of level 0, then of each stored reduction
+  std::vector<std::uint8_t> blocks;    // their blocks, in that order
+  std::vector<std::uint8_t> average;   // the face's constant-data texel (pixel_size() bytes)
+};
+
 struct PtexWriterOptions {
   PtexMeshType mesh_type = PtexMeshType::kQuad;
   PtexDataType data_type = PtexDataType::kFloat;
@@ -117,7 +127,16 @@ struct PtexWriterOptions {
   // -1: the compressor's default here (libdeflate 1, zlib 6; see docs/ptex.md for why).
   // Otherwise libdeflate 0..12, zlib 0..9.
   int compression_level = -1;
+  // Not empty: Finish() adds a string meta data item of this key holding the hash of the file's
+  // level data (PtexFile::LevelDataHash), so that a reader can tell the face data is as written
+  // without inflating it.
+  std::string level_data_hash_key;
 };
+
+// Everything the options fix about how a face's texels are encoded (the compressor, its
+// library version and level, the data type, channels, alpha, reductions and tiles): two
+// writers with the same name encode the same texels into the same bytes.
+std::string PtexEncodingName(const PtexWriterOptions& options);
 
 // Empty when `level` (-1: the default) is a level `compressor` takes, else why not.
 std::string PtexCompressionLevelProblem(PtexCompressor compressor, int level);
@@ -157,6 +176,13 @@ class PtexWriter {
   // The same with texels already in the file's data type (ures * vres * pixel bytes,
   // little-endian, interleaved); no conversion and no finiteness check.
   Status SetFaceRaw(PtexFaceId face, const PtexFaceInfo& info, std::span<const std::uint8_t> data);
+  // A face as another file stores it (PtexFile::ReadEncodedFace), its bytes kept as they are;
+  // `info` gives the adjacency and subface flag, and its resolution must be the encoded one.
+  // The file is byte-identical to one where SetFace was given the face's texels when the
+  // encoding was made with this writer's PtexEncodingName. Fails (and stores nothing) when the
+  // encoded face cannot be this writer's: another resolution or texel size, another number of
+  // stored reductions, or blocks that are not the sizes their headers say.
+  Status SetEncodedFace(PtexFaceId face, const PtexFaceInfo& info, const PtexEncodedFace& encoded);
   // A constant face: `value` has num_channels floats (converted as in SetFace). The
   // resolution in `info` stays the face's logical resolution.
   Status SetConstantFace(PtexFaceId face, const PtexFaceInfo& info, std::span<const float> value);
@@ -272,6 +298,9 @@ class PtexFile {
   // (num_channels values written to `out`).
   void ConstantValue(PtexFaceId face, float* out) const;
   std::span<const std::uint8_t> ConstantValueRaw(PtexFaceId face) const;
+  // The face's stored bytes as they are (nothing inflated). Fails, naming the face, for a face
+  // an edit block changed: its stored levels are no longer one encoding of its texels.
+  Status ReadEncodedFace(PtexFaceId face, PtexEncodedFace& out) const;
 
   // Bilinear sample of level 0 at (u, v) in [0, 1]^2: texel centres at ((i + 0.5) / ures,
   // (j + 0.5) / vres), clamped at the face border (no blending across edges), as a renderer
@@ -282,6 +311,9 @@ class PtexFile {
   // Frees the faces cached by Sample(). Not to be called while Sample() runs.
   void ReleaseSampleCache() const;
 
+  // The hash (32 hex digits, XXH3-128) of the level data section's bytes: every face's blocks
+  // at every level, and the levels' headers.
+  std::string LevelDataHash() const;
   // Inflates and checks every block of every level (Open checks only the structure), faces
   // in parallel (TBB); the error returned is the one of the lowest failing face id.
   Status Validate() const;

@@ -45,6 +45,7 @@ StatusOr<PtexWriter> CreateMap(const ExtractOptions& options, const ExtractInput
   PtexWriterOptions writer_options;
   writer_options.data_type = options.data_type;
   writer_options.compression_level = options.compression_level;
+  writer_options.level_data_hash_key = kLevelDataHashMetaKey;
   if (options.vector) {
     writer_options.num_channels = 3;
     writer_options.edge_filter = *options.vector == VectorSpace::kObject

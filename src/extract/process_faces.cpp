@@ -79,6 +79,14 @@ void RoundToDataType(PtexDataType type, std::span<float> texels) {
   for (float& t : texels) t = HalfToFloat(FloatToHalf(t));
 }
 
+// Face `face` as the previous map stores it, its bytes as they are (PreviousMap::EncodedAs).
+Status WriteEncoded(PtexWriter& writer, const ExtractInputs& inputs, const PreviousMap& previous,
+                    PtexFaceId face) {
+  thread_local PtexEncodedFace encoded;
+  DISPEX_RETURN_IF_ERROR(previous.ReadEncoded(static_cast<std::size_t>(face.value), encoded));
+  return writer.SetEncodedFace(face, FaceInfo(inputs, face, encoded.ulog2, encoded.vlog2), encoded);
+}
+
 PtexFaceInfo FaceInfo(const ExtractInputs& inputs, PtexFaceId face, int ulog2, int vlog2) {
   PtexFaceInfo info = inputs.faces[static_cast<std::size_t>(face.value)];
   info.ulog2 = static_cast<std::int8_t>(ulog2);
@@ -111,7 +119,10 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
       [&] { return FaceScratch(inputs.surface); });
   Progress bar("extract", static_cast<std::uint64_t>(num_faces), "faces", progress, counter);
 
-  // The face's first pass as the previous map holds it.
+  // The face's first pass as the previous map holds it: still encoded when the map's faces are
+  // encoded as this one's and nothing needs its texels.
+  const std::string encoding = PtexEncodingName(writer.options());
+  if (previous != nullptr && previous->usable()) out.encoded_like = previous;
   auto copy = [&](PtexFaceId face) -> Status {
     const auto f = static_cast<std::size_t>(face.value);
     const FaceRecord& record = previous->record(f);
@@ -119,6 +130,9 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
     out.edge_means[f] = record.edge_means;
     copied[f] = 1;
     if (record.stats.all_missed) return Status::Ok();
+    if (!keep && previous->EncodedAs(f, encoding)) {
+      return WriteEncoded(writer, inputs, *previous, face);
+    }
     KeptFace kept;
     DISPEX_RETURN_IF_ERROR(previous->ReadTexels(f, kept));
     if (keep) {
@@ -246,11 +260,19 @@ Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
 Status WriteKeptFaces(PtexWriter& writer, const ExtractInputs& inputs,
                       const ProcessedFaces& processed) {
   const int num_faces = inputs.surface.num_ptex_faces();
+  const PreviousMap* previous = processed.encoded_like;
+  const std::string encoding = PtexEncodingName(writer.options());
   FirstError error;
   tbb::parallel_for(0, num_faces, [&](int f) {
-    const KeptFace& kept = processed.kept[static_cast<std::size_t>(f)];
+    const auto i = static_cast<std::size_t>(f);
+    const KeptFace& kept = processed.kept[i];
     if (!kept.kept || error.failed()) return;
-    Status s = WriteTexels(writer, inputs, PtexFaceId(f), kept.ulog2, kept.vlog2, kept.texels);
+    const bool as_copied =
+        processed.copied[i] && (processed.redone.empty() || !processed.redone[i]);
+    Status s =
+        as_copied && previous != nullptr && previous->EncodedAs(i, encoding)
+            ? WriteEncoded(writer, inputs, *previous, PtexFaceId(f))
+            : WriteTexels(writer, inputs, PtexFaceId(f), kept.ulog2, kept.vlog2, kept.texels);
     if (!s.ok()) error.Record(f, s);
   });
   return error.failed() ? error.status() : Status::Ok();

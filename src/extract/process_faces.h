@@ -31,6 +31,8 @@ struct KeptFace {
 // Texels rounded to what a map of `type` stores (half: to the nearest half; float as is).
 void RoundToDataType(PtexDataType type, std::span<float> texels);
 
+class PreviousMap;
+
 struct ProcessedFaces {
   int channels = 1;                   // of the map
   std::vector<FaceStats> stats;       // per Ptex face
@@ -41,12 +43,13 @@ struct ProcessedFaces {
   std::vector<std::uint8_t> copied;  // per Ptex face: its first pass taken from the previous map
   std::vector<std::uint8_t> redone;  // per Ptex face: extracted again by the edge pass
   std::int64_t faces_copied = 0;     // taken from the previous map
+  // The map they were taken from, when its faces are encoded as the new map's: a copied face
+  // the edges did not redo is written still encoded (PreviousMap::EncodedAs).
+  const PreviousMap* encoded_like = nullptr;
   // Through the mapping: samples it left undecided and the faces they were in, over every face
   // extracted (the edge pass's too).
   std::int64_t fallback_samples = 0, fallback_faces = 0;
 };
-
-class PreviousMap;
 
 // Where a Ptex face's texels come from in this run (PlanFaces decides it): its first pass run
 // here, copied from the previous map or the parts, another shard's (not in this part), or a

@@ -12,6 +12,7 @@
 #include <limits>
 
 #include "core/check.h"
+#include "core/hash128.h"
 #include "ptex/format.h"
 #include "ptex/reader_impl.h"
 #include "ptex/texel_ops.h"
@@ -199,9 +200,42 @@ std::span<const std::uint8_t> PtexFile::ConstantValueRaw(PtexFaceId face) const 
   return {impl_->const_data.data() + std::size_t(face.value) * pixel, pixel};
 }
 
+Status PtexFile::ReadEncodedFace(PtexFaceId face, PtexEncodedFace& out) const {
+  DISPEX_CHECK(face.value >= 0 && face.value < num_faces());
+  const PtexFaceInfo& info = impl_->faces[std::size_t(face.value)];
+  if (info.has_edits) {
+    return impl_->Fail("face " + std::to_string(face.value) +
+                       " has edits: its stored levels are not one encoding of its texels");
+  }
+  out.ulog2 = info.ulog2;
+  out.vlog2 = info.vlog2;
+  out.constant = info.constant;
+  const std::span<const std::uint8_t> average = ConstantValueRaw(face);
+  out.average.assign(average.begin(), average.end());
+  out.headers.clear();
+  out.blocks.clear();
+  if (info.constant) {
+    out.headers.push_back(0);
+    return Status::Ok();
+  }
+  for (int l = 0; l < impl_->NumStoredLevels(face.value); ++l) {
+    const Impl::Block* block = impl_->FindBlock(face.value, l);
+    out.headers.push_back(block->fdh);
+    const std::uint8_t* begin = impl_->data + block->offset;
+    out.blocks.insert(out.blocks.end(), begin, begin + BlockSizeOf(block->fdh));
+  }
+  return Status::Ok();
+}
+
 void PtexFile::ConstantValue(PtexFaceId face, float* out) const {
   std::span<const std::uint8_t> raw = ConstantValueRaw(face);
   ToFloat(raw.data(), std::size_t(impl_->header.num_channels), impl_->header.data_type, out);
+}
+
+std::string PtexFile::LevelDataHash() const {
+  return HashBytes(std::as_bytes(std::span(impl_->data + impl_->level_data_pos,
+                                           static_cast<std::size_t>(impl_->level_data_size))))
+      .Hex();
 }
 
 Status PtexFile::Validate() const {

@@ -357,9 +357,9 @@ Status PtexFile::Impl::ParseLevels(const Layout& layout) {
   const std::uint32_t nfaces = layout.nfaces;
   const std::uint16_t nlevels = static_cast<std::uint16_t>(header.num_levels);
   const std::uint64_t pixel = layout.pixel;
-  const std::uint64_t level_data_pos = layout.level_data_pos,
-                      level_info_pos = layout.level_info_pos;
-  const std::uint64_t level_data_size = layout.level_data_size;
+  const std::uint64_t level_info_pos = layout.level_info_pos;
+  level_data_pos = layout.level_data_pos;
+  level_data_size = layout.level_data_size;
   levels.resize(nlevels);
   level_blocks.resize(nlevels);
   std::uint64_t level_pos = level_data_pos, level_total = 0;

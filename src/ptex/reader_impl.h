@@ -26,6 +26,7 @@ struct PtexFile::Impl {
   std::vector<PtexFaceInfo> faces;
   std::vector<std::uint8_t> const_data;  // num_faces x pixel size
   std::vector<PtexLevelInfo> levels;
+  std::uint64_t level_data_pos = 0, level_data_size = 0;  // the level data section
 
   // A parsed tiled block: tile resolution, where the tile blocks start, their headers.
   struct TileTable {

@@ -21,6 +21,7 @@
 
 #include "core/atomic_output.h"
 #include "core/check.h"
+#include "core/hash128.h"
 #include "dispex/ptex.h"
 #include "ptex/format.h"
 #include "ptex/meta_data.h"
@@ -38,6 +39,21 @@ constexpr int kMaxFaces = 1 << 28;
 constexpr std::size_t kMaxFaceBytes = std::size_t{1} << 29;
 
 enum FaceState : std::uint8_t { kUnset = 0, kBusy = 1, kSet = 2 };
+
+// A face's record as the file stores it: flags cleared (constant is the writer's to set),
+// none on triangles, no edge id where there is no neighbour.
+PtexFaceInfo StoredInfo(const PtexFaceInfo& given, PtexMeshType mesh_type) {
+  PtexFaceInfo info = given;
+  info.constant = info.neighborhood_constant = info.has_edits = false;
+  if (mesh_type == PtexMeshType::kTriangle) {
+    info.subface = false;  // no flags on triangles but constant (as the reference)
+    info.adjfaces[3] = -1;
+  }
+  for (int e = 0; e < 4; ++e) {
+    if (info.adjfaces[e] < 0) info.adjedges[e] = 0;
+  }
+  return info;
+}
 
 // Per-thread buffers reused across faces (no allocation per face once warm).
 struct Scratch {
@@ -153,10 +169,25 @@ struct PtexWriter::Impl {
   void CompressLevels(const std::vector<PtexFaceInfo>& infos, FileSections& sections) const;
   void CompressMetaData(FileSections& sections) const;
   std::vector<std::uint8_t> EncodeHeaders(const FileSections& sections) const;
+  template <class Visit>
+  Status ForEachLevelDataPiece(const FileSections& sections, Visit&& visit) const;
   Status WriteSections(const FileSections& sections);
 };
 
 // ---- Construction -------------------------------------------------------------------------
+
+std::string PtexEncodingName(const PtexWriterOptions& options) {
+  const int level = options.compression_level < 0 ? DefaultCompressionLevel(options.compressor)
+                                                  : options.compression_level;
+  std::string name = CompressorName(options.compressor) + " level " + std::to_string(level) + ", " +
+                     std::string(PtexMeshTypeName(options.mesh_type)) + " " +
+                     std::string(PtexDataTypeName(options.data_type)) + " x" +
+                     std::to_string(options.num_channels);
+  if (options.alpha_channel >= 0) name += ", alpha " + std::to_string(options.alpha_channel);
+  if (options.write_reductions) name += ", reductions";
+  if (options.tile_large_faces) name += ", tiles";
+  return name;
+}
 
 PtexWriter::PtexWriter() = default;
 PtexWriter::PtexWriter(PtexWriter&&) noexcept = default;
@@ -182,6 +213,10 @@ StatusOr<PtexWriter> PtexWriter::Create(const std::string& path, const PtexWrite
   if (std::string why = CheckCompressionLevel(options.compressor, options.compression_level);
       !why.empty()) {
     return fail(why);
+  }
+  if (options.level_data_hash_key.size() > 254 ||
+      options.level_data_hash_key.find('\0') != std::string::npos) {
+    return fail("the level data hash's meta data key is not 1..254 bytes without NUL");
   }
   if (num_faces < 1 || num_faces > kMaxFaces) {
     return fail("face count " + std::to_string(num_faces) + " is not in 1.." +
@@ -329,15 +364,7 @@ std::uint32_t PtexWriter::Impl::WriteFaceBlock(const std::uint8_t* data, std::si
 // its reductions and its average.
 void PtexWriter::Impl::StoreFace(int face_id, const PtexFaceInfo& given, const std::uint8_t* data) {
   Face& face = faces[static_cast<std::size_t>(face_id)];
-  PtexFaceInfo info = given;
-  info.constant = info.neighborhood_constant = info.has_edits = false;
-  if (options.mesh_type == PtexMeshType::kTriangle) {
-    info.subface = false;  // no flags on triangles but constant (as the reference)
-    info.adjfaces[3] = -1;
-  }
-  for (int e = 0; e < 4; ++e) {
-    if (info.adjfaces[e] < 0) info.adjedges[e] = 0;
-  }
+  PtexFaceInfo info = StoredInfo(given, options.mesh_type);
   std::uint8_t* average = const_data.data() + std::size_t(face_id) * pixel_size;
   const int ures = info.ures(), vres = info.vres();
   const std::size_t count = info.num_texels();
@@ -428,6 +455,50 @@ Status PtexWriter::SetFaceRaw(PtexFaceId face, const PtexFaceInfo& info,
   }
   DISPEX_RETURN_IF_ERROR(w.Claim(face));
   w.StoreFace(face.value, info, data.data());
+  w.faces_set.fetch_add(1);
+  w.state[face.value].store(kSet, std::memory_order_release);
+  return Status::Ok();
+}
+
+Status PtexWriter::SetEncodedFace(PtexFaceId face, const PtexFaceInfo& info,
+                                  const PtexEncodedFace& encoded) {
+  DISPEX_CHECK(impl_ != nullptr);
+  Impl& w = *impl_;
+  DISPEX_RETURN_IF_ERROR(w.CheckFace(face, info));
+  const auto fail = [&](const std::string& what) {
+    return Status::Error(w.FaceName(face.value) + ": the encoded face " + what);
+  };
+  if (encoded.ulog2 != info.ulog2 || encoded.vlog2 != info.vlog2) {
+    return fail("has resolution log2 (" + std::to_string(encoded.ulog2) + ", " +
+                std::to_string(encoded.vlog2) + "), not the face's (" + std::to_string(info.ulog2) +
+                ", " + std::to_string(info.vlog2) + ")");
+  }
+  if (encoded.average.size() != std::size_t(w.pixel_size)) {
+    return fail("has texels of " + std::to_string(encoded.average.size()) +
+                " bytes, the file's have " + std::to_string(w.pixel_size));
+  }
+  const std::size_t levels =
+      encoded.constant ? 1
+                       : 1 + std::size_t(w.options.write_reductions ? StoredReductions(info) : 0);
+  if (encoded.headers.size() != levels) {
+    return fail("stores " + std::to_string(encoded.headers.size()) + " levels, this file " +
+                std::to_string(levels));
+  }
+  std::size_t bytes = 0;
+  for (std::uint32_t h : encoded.headers) bytes += BlockSizeOf(h);
+  if (bytes != encoded.blocks.size() || (encoded.constant && bytes != 0)) {
+    return fail("has " + std::to_string(encoded.blocks.size()) +
+                " bytes of blocks, its headers say " + std::to_string(bytes));
+  }
+  DISPEX_RETURN_IF_ERROR(w.Claim(face));
+  Impl::Face& stored = w.faces[static_cast<std::size_t>(face.value)];
+  stored.info = StoredInfo(info, w.options.mesh_type);
+  stored.info.constant = encoded.constant;
+  stored.headers = encoded.headers;
+  stored.blocks = encoded.blocks;
+  std::memcpy(w.const_data.data() + std::size_t(face.value) * w.pixel_size, encoded.average.data(),
+              encoded.average.size());
+  w.compressed_bytes.fetch_add(stored.blocks.size(), std::memory_order_relaxed);
   w.faces_set.fetch_add(1);
   w.state[face.value].store(kSet, std::memory_order_release);
   return Status::Ok();
@@ -538,6 +609,22 @@ Status PtexWriter::Impl::WriteFile() {
   const std::vector<PtexFaceInfo> infos = CloseUnsetFaces();
   FileSections sections;
   CompressLevels(infos, sections);
+  if (!options.level_data_hash_key.empty()) {
+    Hasher hasher;
+    DISPEX_RETURN_IF_ERROR(
+        ForEachLevelDataPiece(sections, [&](const std::uint8_t* data, std::size_t size) {
+          hasher.Add(std::as_bytes(std::span(data, size)));
+          return Status::Ok();
+        }));
+    const std::string hex = hasher.Digest().Hex();
+    PtexMetaItem item;
+    item.key = options.level_data_hash_key;
+    item.type = PtexMetaType::kString;
+    item.bytes.assign(hex.begin(), hex.end());
+    item.bytes.push_back(0);
+    std::lock_guard<std::mutex> lock(meta_mutex);
+    UpsertMetaItem(meta, std::move(item));
+  }
   CompressMetaData(sections);
   if (sections.OverSectionLimit()) {
     return Status::Error(path + ": a section exceeds the format's 4 GiB section limit");
@@ -662,15 +749,31 @@ std::vector<std::uint8_t> PtexWriter::Impl::EncodeHeaders(const FileSections& x)
   return header;
 }
 
-// The file, section by section, in order; it must come out file_size bytes long.
-Status PtexWriter::Impl::WriteSections(const FileSections& x) {
-  const std::size_t nlevels = x.num_levels();
+// The level data section's bytes in file order, piece by piece: each level's compressed
+// headers, then its faces' blocks. Stops at the first error `visit` returns.
+template <class Visit>
+Status PtexWriter::Impl::ForEachLevelDataPiece(const FileSections& x, Visit&& visit) const {
   // Offsets of each stored level inside a face's block buffer.
   auto block_offset = [&](const Face& face, std::size_t level_index) {
     std::size_t off = 0;
     for (std::size_t l = 0; l < level_index; ++l) off += BlockSizeOf(face.headers[l]);
     return off;
   };
+  for (std::size_t l = 0; l < x.num_levels(); ++l) {
+    DISPEX_RETURN_IF_ERROR(visit(x.level_header_zip[l].data(), x.level_header_zip[l].size()));
+    for (std::size_t r = 0; r < x.level_entries[l]; ++r) {
+      const Face& face = faces[l == 0 ? r : std::size_t(x.order[r])];
+      const std::uint32_t size = BlockSizeOf(face.headers[l]);
+      if (size == 0) continue;
+      DISPEX_RETURN_IF_ERROR(visit(face.blocks.data() + block_offset(face, l), size));
+    }
+  }
+  return Status::Ok();
+}
+
+// The file, section by section, in order; it must come out file_size bytes long.
+Status PtexWriter::Impl::WriteSections(const FileSections& x) {
+  const std::size_t nlevels = x.num_levels();
   BufferedOutput out(output);
   DISPEX_RETURN_IF_ERROR(out.Write(EncodeHeaders(x)));
   DISPEX_RETURN_IF_ERROR(out.Write(x.face_info_zip));
@@ -682,15 +785,8 @@ Status PtexWriter::Impl::WriteSections(const FileSections& x) {
     Store<std::uint32_t>(info + 12, x.level_entries[l]);
     DISPEX_RETURN_IF_ERROR(out.Write(info, sizeof(info)));
   }
-  for (std::size_t l = 0; l < nlevels; ++l) {
-    DISPEX_RETURN_IF_ERROR(out.Write(x.level_header_zip[l]));
-    for (std::size_t r = 0; r < x.level_entries[l]; ++r) {
-      const Face& face = faces[l == 0 ? r : std::size_t(x.order[r])];
-      const std::uint32_t size = BlockSizeOf(face.headers[l]);
-      if (size == 0) continue;
-      DISPEX_RETURN_IF_ERROR(out.Write(face.blocks.data() + block_offset(face, l), size));
-    }
-  }
+  DISPEX_RETURN_IF_ERROR(ForEachLevelDataPiece(
+      x, [&](const std::uint8_t* data, std::size_t size) { return out.Write(data, size); }));
   DISPEX_RETURN_IF_ERROR(out.Write(x.small_zip));
   const std::uint8_t barrier[kBarrierSize] = {};
   DISPEX_RETURN_IF_ERROR(out.Write(barrier, sizeof(barrier)));

@@ -37,6 +37,11 @@ libdeflate_decompressor* ThreadDecompressor() {
 
 }  // namespace
 
+std::string CompressorName(PtexCompressor compressor) {
+  if (compressor == PtexCompressor::kZlib) return std::string("zlib ") + zlibVersion();
+  return "libdeflate " LIBDEFLATE_VERSION_STRING;
+}
+
 int DefaultCompressionLevel(PtexCompressor compressor) {
   return compressor == PtexCompressor::kZlib ? 6 : 1;
 }

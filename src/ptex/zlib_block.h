@@ -14,6 +14,9 @@
 
 namespace dispex::ptex {
 
+// The compressor and its library's version ("libdeflate 1.14", "zlib 1.2.13"): other versions
+// may deflate the same data into other bytes.
+std::string CompressorName(PtexCompressor compressor);
 // The level used for `level` = -1.
 int DefaultCompressionLevel(PtexCompressor compressor);
 // Empty when `level` is valid for the compressor, else the reason.

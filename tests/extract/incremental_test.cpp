@@ -449,6 +449,47 @@ TEST(IncrementalMaps, ASculptFaceOfManyCornersIsKeyedByEveryCorner) {
   EXPECT_NE(testing::MapDifference(old_map, full.output_path, /*faces_only=*/true), "");
 }
 
+// Copied faces go to the new map still encoded only when the map before encoded them the same
+// way: after the compression level changed, they are encoded again at the new level (copied
+// as they were, the map would differ from a full extraction), and after that, with the level
+// kept, they are copied still encoded.
+TEST(IncrementalMaps, CopiedFacesAreEncodedAgainWhenTheEncodingChanged) {
+  TempDir dir;
+  const std::string base = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
+  const std::string sculpt = dir / "sculpt.obj";
+  ASSERT_TRUE(MakeSculpt(testing::SculptOptions(base, sculpt, 2, Pattern::kDetail, 0.005)).ok());
+  ExtractOptions o;
+  o.base_path = base;
+  o.sculpt_path = sculpt;
+  o.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.01};
+  o.output_path = dir / "inc.ptx";
+  o.incremental = true;
+  o.cache_dir = dir / "cache";
+  for (WatertightEdges watertight : {WatertightEdges::kFilter, WatertightEdges::kOff}) {
+    o.watertight = watertight;
+    o.compression_level = -1;
+    ASSERT_TRUE(Extract(o).ok());
+    for (int level : {6, 6}) {
+      o.compression_level = level;
+      // One sculpt vertex moved, so that the run is not an unchanged one.
+      auto mesh = ReadMesh(sculpt);
+      ASSERT_TRUE(mesh.ok());
+      mesh->positions[mesh->num_vertices() / 3].x += 1e-4f;
+      ASSERT_TRUE(WriteObj(sculpt, *mesh).ok());
+      auto r = Extract(o);
+      ASSERT_TRUE(r.ok()) << r.status().message();
+      EXPECT_GT(r->incremental.faces_copied, r->inputs.ptex_faces / 2);
+      ExtractOptions full = o;
+      full.incremental = false;
+      full.output_path = dir / "full.ptx";
+      ASSERT_TRUE(Extract(full).ok());
+      EXPECT_TRUE(Slurp(o.output_path) == Slurp(full.output_path))
+          << WatertightEdgesName(watertight) << ", level " << level << ": "
+          << testing::MapDifference(o.output_path, full.output_path);
+    }
+  }
+}
+
 TEST(IncrementalMaps, AMapNotWrittenByDispexIsIgnoredWithANotice) {
   TempDir dir;
   const std::string base = DataPath("meshes/keenan_spot/spot_control_mesh.obj");

@@ -123,6 +123,9 @@ void ExpectEditsApplied(const PtexFile& f) {
   ASSERT_TRUE(f.ReadFace(PtexFaceId(1), 0, t).ok());
   EXPECT_EQ(t, Ramp(32, 100));
   EXPECT_FALSE(f.ReadFace(PtexFaceId(1), 1, t).ok());
+  PtexEncodedFace encoded;
+  EXPECT_EQ(f.ReadEncodedFace(PtexFaceId(1), encoded).message(),
+            "edits.ptx: face 1 has edits: its stored levels are not one encoding of its texels");
   float v = 0;
   f.ConstantValue(PtexFaceId(1), &v);
   EXPECT_EQ(v, 115.5f);

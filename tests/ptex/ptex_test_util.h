@@ -114,6 +114,7 @@ struct Sections {
     std::vector<std::vector<std::uint8_t>> blocks, inflated;
   };
   std::vector<Level> levels;
+  std::size_t level_data_end = 0;                     // where the level data section ends
   std::vector<std::uint8_t> meta;                     // inflated small block
   std::vector<std::uint8_t> barrier;                  // the 8 bytes after it (if present)
   std::vector<std::uint8_t> lmd_header;               // inflated
@@ -164,6 +165,7 @@ inline Sections ReadSections(const std::vector<std::uint8_t>& b) {
       pos += size;
     }
   }
+  s.level_data_end = pos;
   if (mdz) {
     s.meta = ZlibInflate(&b[pos], mdz, mdm);
     pos += mdz;

@@ -316,6 +316,139 @@ TEST(PtexWriterDeterminism, SameBytesWhateverTheOrderAndThreads) {
   }
 }
 
+// Every face copied still encoded (ReadEncodedFace into SetEncodedFace, in another order) makes
+// the same file, byte for byte, as writing its texels: tiled, constant, 1-texel-high and
+// alpha faces, half and integer types, triangles, both compressors.
+TEST(PtexEncodedFaces, CopiedFacesMakeTheSameFile) {
+  TempDir dir;
+  struct Case {
+    PtexDataType type;
+    int channels, alpha;
+    PtexMeshType mesh;
+    PtexCompressor compressor;
+  };
+  for (const Case& c :
+       {Case{PtexDataType::kFloat, 2, -1, PtexMeshType::kQuad, PtexCompressor::kLibdeflate},
+        Case{PtexDataType::kHalf, 1, -1, PtexMeshType::kQuad, PtexCompressor::kLibdeflate},
+        Case{PtexDataType::kUint8, 4, 3, PtexMeshType::kQuad, PtexCompressor::kZlib},
+        Case{PtexDataType::kUint16, 3, -1, PtexMeshType::kTriangle, PtexCompressor::kLibdeflate}}) {
+    RandomTexture t = MakeRandom(7, c.type, c.channels, c.alpha, c.mesh, 30);
+    t.faces[2].ulog2 = t.faces[2].vlog2 = 9;  // tiled at level 0 and 1
+    t.constant[2].clear();
+    t.texels[2].clear();
+    for (int i = 0; i < (1 << 18) * c.channels; ++i) {
+      t.texels[2].push_back(0.5f + 0.4f * std::sin(0.001f * float(i)));
+    }
+    PtexWriterOptions options = t.options;
+    options.compressor = c.compressor;
+    std::vector<int> order(t.faces.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+    const std::string original = (dir / "original.ptx").string();
+    ASSERT_TRUE(WriteTexture(t, original, order, 1, options).ok());
+    StatusOr<PtexFile> file = PtexFile::Open(original);
+    ASSERT_TRUE(file.ok()) << file.status().message();
+    ASSERT_EQ(file->BlockInfo(PtexFaceId(2), 0).encoding, PtexBlockInfo::Encoding::kTiled);
+
+    const std::string copy = (dir / "copy.ptx").string();
+    StatusOr<PtexWriter> w = PtexWriter::Create(copy, options, file->num_faces());
+    ASSERT_TRUE(w.ok());
+    PtexEncodedFace encoded;
+    for (int f = file->num_faces() - 1; f >= 0; --f) {
+      ASSERT_TRUE(file->ReadEncodedFace(PtexFaceId(f), encoded).ok());
+      EXPECT_EQ(encoded.constant, file->face_info(PtexFaceId(f)).constant);
+      const Status set = w->SetEncodedFace(PtexFaceId(f), t.faces[std::size_t(f)], encoded);
+      ASSERT_TRUE(set.ok()) << set.message();
+    }
+    ASSERT_TRUE(w->AddMetaData("name", "round trip").ok());
+    const std::vector<double> d = {1.0, -2.5};
+    ASSERT_TRUE(w->AddMetaData("d", std::span<const double>(d)).ok());
+    std::vector<std::int16_t> big(700);
+    for (std::size_t i = 0; i < big.size(); ++i) big[i] = static_cast<std::int16_t>(i * 37 - 9000);
+    ASSERT_TRUE(w->AddMetaData("big", std::span<const std::int16_t>(big)).ok());
+    ASSERT_TRUE(w->Finish().ok());
+    EXPECT_EQ(ReadBytes(copy), ReadBytes(original)) << PtexEncodingName(options);
+  }
+}
+
+// The level data hash the writer records is the reader's hash of the file's level data, and a
+// changed byte of a face block changes it.
+TEST(PtexLevelDataHash, RecordedAsTheReaderComputesIt) {
+  TempDir dir;
+  RandomTexture t = MakeRandom(9, PtexDataType::kHalf, 1, -1);
+  PtexWriterOptions options = t.options;
+  options.level_data_hash_key = "test:level_data_hash";
+  std::vector<int> order(t.faces.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  const std::string path = (dir / "a.ptx").string();
+  ASSERT_TRUE(WriteTexture(t, path, order, 2, options).ok());
+  StatusOr<PtexFile> file = PtexFile::Open(path);
+  ASSERT_TRUE(file.ok());
+  const PtexMetaItem* recorded = file->FindMetaData("test:level_data_hash");
+  ASSERT_NE(recorded, nullptr);
+  EXPECT_EQ(recorded->AsString().size(), 32u);
+  EXPECT_EQ(recorded->AsString(), file->LevelDataHash());
+
+  // The last byte of the last level's last block (the level data ends where the meta data
+  // begins), changed.
+  std::vector<std::uint8_t> bytes = ReadBytes(path);
+  bytes[ptex_test::ReadSections(bytes).level_data_end - 1] ^= 0x5a;
+  StatusOr<PtexFile> changed = ParsePtex(
+      std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), "changed.ptx");
+  ASSERT_TRUE(changed.ok()) << changed.status().message();
+  EXPECT_NE(changed->LevelDataHash(), recorded->AsString());
+
+  options.level_data_hash_key = std::string(255, 'k');
+  EXPECT_FALSE(PtexWriter::Create((dir / "b.ptx").string(), options, 1).ok());
+}
+
+// An encoded face that this writer would not have made is refused, naming what differs.
+TEST(PtexEncodedFaces, AFaceOfAnotherEncodingIsRefused) {
+  TempDir dir;
+  RandomTexture t = MakeRandom(8, PtexDataType::kFloat, 1, -1);
+  t.faces[0].ulog2 = t.faces[0].vlog2 = 4;  // reductions stored at levels 1 and 2
+  t.constant[0].clear();
+  t.texels[0].assign(256, 0);
+  for (std::size_t i = 0; i < 256; ++i) t.texels[0][i] = float(i);
+  std::vector<int> order(t.faces.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  const std::string path = (dir / "a.ptx").string();
+  ASSERT_TRUE(WriteTexture(t, path, order, 1, t.options).ok());
+  StatusOr<PtexFile> file = PtexFile::Open(path);
+  ASSERT_TRUE(file.ok());
+  PtexEncodedFace encoded;
+  ASSERT_TRUE(file->ReadEncodedFace(PtexFaceId(0), encoded).ok());
+  ASSERT_EQ(encoded.headers.size(), 3u);
+
+  const auto refused = [&](PtexWriterOptions options, PtexFaceInfo info, const PtexEncodedFace& e) {
+    StatusOr<PtexWriter> w =
+        PtexWriter::Create((dir / "b.ptx").string(), options, static_cast<int>(t.faces.size()));
+    EXPECT_TRUE(w.ok());
+    const Status s = w->SetEncodedFace(PtexFaceId(0), info, e);
+    EXPECT_EQ(w->faces_set(), s.ok() ? 1 : 0);  // nothing stored when refused
+    return s.ok() ? std::string() : s.message();
+  };
+  PtexWriterOptions no_reductions = t.options;
+  no_reductions.write_reductions = false;
+  EXPECT_NE(refused(no_reductions, t.faces[0], encoded).find("stores 3 levels, this file 1"),
+            std::string::npos);
+  PtexWriterOptions half = t.options;
+  half.data_type = PtexDataType::kHalf;
+  EXPECT_NE(refused(half, t.faces[0], encoded).find("texels of 4 bytes, the file's have 2"),
+            std::string::npos);
+  PtexFaceInfo smaller = t.faces[0];
+  smaller.ulog2 = 3;
+  EXPECT_NE(
+      refused(t.options, smaller, encoded).find("resolution log2 (4, 4), not the face's (3, 4)"),
+      std::string::npos);
+  PtexEncodedFace cut = encoded;
+  cut.blocks.pop_back();
+  EXPECT_NE(refused(t.options, t.faces[0], cut).find("bytes of blocks, its headers say"),
+            std::string::npos);
+  EXPECT_EQ(refused(t.options, t.faces[0], encoded), "");
+  EXPECT_NE(PtexEncodingName(t.options), PtexEncodingName(no_reductions));
+  EXPECT_NE(PtexEncodingName(t.options), PtexEncodingName(half));
+}
+
 // Large faces are tiled by the reference rule; constant tiles are stored raw; reading back
 // reassembles them.
 TEST(PtexWriterTiling, TilesByTheReferenceRule) {

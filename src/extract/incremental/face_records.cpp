@@ -149,4 +149,13 @@ std::optional<std::vector<Hash128>> DecodeFaceKeys(std::span<const std::uint8_t>
   return keys;
 }
 
+Status CheckMapFaceData(const PtexFile& file) {
+  const PtexMetaItem* recorded = file.FindMetaData(kLevelDataHashMetaKey);
+  if (recorded != nullptr && recorded->type == PtexMetaType::kString &&
+      recorded->AsString() == file.LevelDataHash()) {
+    return Status::Ok();
+  }
+  return file.Validate();
+}
+
 }  // namespace dispex::extract

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "core/hash128.h"
+#include "dispex/ptex.h"
+#include "dispex/status.h"
 #include "extract/face_pipeline.h"
 
 namespace dispex::extract {
@@ -16,6 +18,16 @@ inline constexpr const char* kFaceKeysMetaKey = "dispex:face_keys";
 inline constexpr const char* kFaceRecordsMetaKey = "dispex:face_records_v1";
 inline constexpr const char* kInputsKeyMetaKey = "dispex:inputs_key";
 inline constexpr const char* kVectorFaceRecordsMetaKey = "dispex:vector_face_records_v1";
+// How the map's faces are encoded (PtexEncodingName): a face of a map encoded as the new one
+// is copied into it still encoded.
+inline constexpr const char* kFaceEncodingMetaKey = "dispex:face_encoding";
+// The hash of the map's face data as it was written (PtexWriterOptions::level_data_hash_key).
+inline constexpr const char* kLevelDataHashMetaKey = "dispex:level_data_hash";
+
+// A map's face data checked before its faces are re-used: by the hash its writer recorded when
+// the bytes still have it (they are those dispex wrote), else by inflating every block
+// (PtexFile::Validate).
+Status CheckMapFaceData(const PtexFile& file);
 
 struct FaceRecord {
   FaceStats stats;

@@ -42,7 +42,7 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces, bo
   if (!decoded_keys || !decoded_records) return ignore("has malformed face keys");
   out.keys_ = std::move(*decoded_keys);
   out.records_ = std::move(*decoded_records);
-  out.files_.push_back(std::move(*file));
+  out.AddFile(std::move(*file));
   return out;
 }
 
@@ -67,14 +67,20 @@ PreviousMap PreviousMap::FromParts(std::vector<ShardPart> parts,
       out.records_[f] = records[f];
       out.part_of_[f] = static_cast<std::uint32_t>(k);
     }
-    out.files_.push_back(std::move(part.file));
+    out.AddFile(std::move(part.file));
   }
   return out;
 }
 
+void PreviousMap::AddFile(PtexFile file) {
+  const PtexMetaItem* encoding = file.FindMetaData(kFaceEncodingMetaKey);
+  encodings_.push_back(encoding != nullptr ? encoding->AsString() : "");
+  files_.push_back(std::move(file));
+}
+
 void PreviousMap::CheckFaceData() {
   if (files_.size() != 1) return;  // none, or parts (OpenShardPart checks them)
-  Status valid = files_[0].Validate();
+  Status valid = CheckMapFaceData(files_[0]);
   if (valid.ok()) return;
   notice_ = fmt::format("{}: corrupt face data ({}); not re-used, every face is extracted",
                         files_[0].name(), valid.message());

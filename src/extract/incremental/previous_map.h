@@ -46,11 +46,21 @@ class PreviousMap {
   const FaceRecord& record(std::size_t f) const { return records_[f]; }
   // The face's texels as KeptFace holds them (one value per channel for a constant face).
   Status ReadTexels(std::size_t f, KeptFace& out) const;
+  // Whether face f is stored as a writer of `encoding` (PtexEncodingName) would store its
+  // texels, so that ReadEncoded's bytes can go to that writer as they are.
+  bool EncodedAs(std::size_t f, const std::string& encoding) const {
+    return !files_.empty() && encodings_[part_of_.empty() ? 0 : part_of_[f]] == encoding;
+  }
+  Status ReadEncoded(std::size_t f, PtexEncodedFace& out) const {
+    return file(f).ReadEncodedFace(PtexFaceId(static_cast<int>(f)), out);
+  }
 
  private:
+  void AddFile(PtexFile file);
   const PtexFile& file(std::size_t f) const { return files_[part_of_.empty() ? 0 : part_of_[f]]; }
 
   std::vector<PtexFile> files_;
+  std::vector<std::string> encodings_;  // per file, kFaceEncodingMetaKey's value ("" if none)
   std::vector<std::uint32_t> part_of_;  // per face, its file; empty: one file
   std::vector<Hash128> keys_;
   std::vector<FaceRecord> records_;

@@ -115,7 +115,7 @@ StatusOr<ShardPart> ReadShardPart(const std::string& path) {
       !DecodeFaceRecords(records->bytes, num_faces, 1)) {
     return Status::Error(fmt::format("{}: malformed shard record", path));
   }
-  Status data = part.file.Validate();
+  Status data = CheckMapFaceData(part.file);
   if (!data.ok()) return data.WithPrefix(path + ": corrupt face data");
   return part;
 }

@@ -137,6 +137,8 @@ Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractRep
   if (face_keys.empty()) return Status::Ok();  // a map whose faces are not re-used
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
       kFaceKeysMetaKey, std::span<const std::int8_t>(EncodeFaceKeys(face_keys))));
+  DISPEX_RETURN_IF_ERROR(
+      writer.AddMetaData(kFaceEncodingMetaKey, PtexEncodingName(writer.options())));
   const std::optional<VectorSpace> vector = report.options.vector;
   const int channels = vector ? 3 : 1;
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
