@@ -39,14 +39,20 @@ struct MatchOptions {
   // Fill SculptCorrespondence::face_ptex, face_cell and face_rotation (cell_labels holds the
   // same facts by cell; without the tables the match needs 9 bytes per sculpt face less).
   bool face_tables = true;
+  // Fill SculptCorrespondence::vertex_uvs (8 bytes per sculpt vertex; vertex_faces is always
+  // filled).
+  bool vertex_uvs = true;
   // A sculpt whose every face winds the other way from the cage's (flipped normals), and which
   // reversed is the cage refined, matches: SculptCorrespondence::reversed is set and the result
   // is that of the sculpt after ReverseWinding, which the caller applies to it before using
   // the two together. Otherwise such a sculpt fails, saying so.
   bool accept_reversed = false;
   // A folder where the sculpt's half-edge adjacency, which depends on its faces only and is
-  // the match's largest step, is kept for the next match of a sculpt with the same faces (an
-  // incremental run after its vertices moved); "": none. The result is the same either way.
+  // the match's largest step, and the match itself are kept for the next match of a sculpt with
+  // the same faces (an incremental run after its vertices moved); "": none. The next match
+  // takes the kept one when its choice among the refinement's symmetries is still the one
+  // these positions make (the position check is run anew), else matches with the adjacency
+  // read back. The result is the same either way.
   std::string cache_dir;
 };
 
@@ -64,7 +70,8 @@ struct SculptCorrespondence {
   std::vector<std::int32_t> grid_sizes;  // per Ptex face: n
 
   // Per sculpt vertex: one home, in the first Ptex face (by id) whose grid holds it, and its
-  // (u, v) there (2 floats per vertex, exact: multiples of 1 / n).
+  // (u, v) there (2 floats per vertex, exact: multiples of 1 / n; empty unless
+  // MatchOptions::vertex_uvs).
   std::vector<PtexFaceId> vertex_faces;
   std::vector<float> vertex_uvs;
 
@@ -82,6 +89,9 @@ struct SculptCorrespondence {
 
   std::size_t components = 0;         // connected components matched (edge-connected)
   bool adjacency_from_cache = false;  // read from MatchOptions::cache_dir, not built
+  // The labelling was kept in MatchOptions::cache_dir by a match of a sculpt with the same
+  // faces, and its seeds are still those chosen with these positions: no adjacency was needed.
+  bool labelling_from_cache = false;
 
   // The position check: |sculpt vertex - limit point at its home| over the vertices checked,
   // each once, at its home: every vertex of grids up to 8 x 8; on larger grids those on the

@@ -397,8 +397,10 @@ struct ExtractReport {
     // Samples the mapping could not decide, answered by a BVH of the sculpt within their
     // reach, and the Ptex faces they are in (of the faces extracted in this run).
     std::int64_t fallback_samples = 0, fallback_faces = 0;
-    // The sculpt's adjacency was read from the cache folder (ExtractOptions::cache_dir).
+    // The sculpt's adjacency was read from the cache folder (ExtractOptions::cache_dir), or the
+    // match itself kept there was still this sculpt's (MatchOptions::cache_dir).
     bool adjacency_cached = false;
+    bool labelling_cached = false;
   } method;
 
   // Sampling and rays.

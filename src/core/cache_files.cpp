@@ -1,9 +1,18 @@
 #include "core/cache_files.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <memory>
 #include <vector>
+
+#include "core/byte_record.h"
+#include "core/hash128.h"
 
 namespace dispex {
 
@@ -40,6 +49,47 @@ void EvictCacheFiles(const std::string& folder, std::string_view prefix, std::ui
     total += e.size;
     if (total > max_bytes && e.path != fs::path(keep)) fs::remove(e.path, ec);
   }
+}
+
+std::optional<std::string> ReadCacheRecord(const std::string& path, std::string_view magic) {
+  std::error_code ec;
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) return std::nullopt;
+  std::string bytes(size, '\0');
+  {
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), std::fclose);
+    if (!f || std::fread(bytes.data(), 1, bytes.size(), f.get()) != bytes.size()) {
+      return std::nullopt;
+    }
+  }
+  constexpr std::size_t kCheck = sizeof(Hash128);
+  if (bytes.size() < magic.size() + kCheck || bytes.compare(0, magic.size(), magic) != 0) {
+    return std::nullopt;
+  }
+  Hash128 check;
+  std::memcpy(&check, bytes.data() + bytes.size() - kCheck, kCheck);
+  bytes.resize(bytes.size() - kCheck);
+  if (!(HashBytes(std::as_bytes(std::span(bytes.data(), bytes.size()))) == check)) {
+    return std::nullopt;
+  }
+  return bytes;
+}
+
+bool WriteCacheRecord(const std::string& path, std::string bytes) {
+  Append(bytes, HashBytes(std::as_bytes(std::span(bytes.data(), bytes.size()))));
+  static std::atomic<unsigned> written{0};  // two runs of one process at once
+  const std::string temp =
+      path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(written.fetch_add(1));
+  std::error_code ec;
+  fs::create_directories(fs::path(path).parent_path(), ec);
+  bool ok = false;
+  if (std::FILE* f = std::fopen(temp.c_str(), "wb")) {
+    ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    ok = std::fclose(f) == 0 && ok;
+  }
+  if (ok) fs::rename(temp, path, ec);
+  if (!ok || ec) fs::remove(temp, ec);
+  return ok && !ec;
 }
 
 }  // namespace dispex

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -13,5 +14,14 @@ namespace dispex {
 // over an hour ago. Errors are ignored: a cache that cannot be trimmed only takes more room.
 void EvictCacheFiles(const std::string& folder, std::string_view prefix, std::uint64_t max_bytes,
                      const std::string& keep);
+
+// A cache record file: an 8-byte magic, the record (core/byte_record.h), and the XXH3-128 of
+// both. The file's bytes less the hash (the magic first), or nullopt when it is missing, starts
+// with another magic, or fails its hash (cut short by a crash, or changed).
+std::optional<std::string> ReadCacheRecord(const std::string& path, std::string_view magic);
+// Writes `bytes` (the magic first) and their hash beside `path` and renames the file onto it,
+// without syncing: a file a crash cuts short fails its hash. False when it could not be written
+// (a cache not kept only makes the next run slower).
+bool WriteCacheRecord(const std::string& path, std::string bytes);
 
 }  // namespace dispex

@@ -107,7 +107,7 @@ StatusOr<std::vector<float>> NearestHits(const ExtractInputs& inputs, const Long
         now.nearest, NearestHitsInParts(inputs, report.plan.search_estimate_parts, rays.origins,
                                         rays.normals, rays.length, now.side));
   }
-  if (cache && !WriteRayCache(inputs.ray_cache_path, now).ok()) {
+  if (cache && !WriteRayCache(inputs.ray_cache_path, now)) {
     report.warnings.push_back(
         fmt::format("{}: cannot keep the search distance's rays there for the next run (cache_dir)",
                     inputs.ray_cache_path));

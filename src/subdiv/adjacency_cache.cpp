@@ -25,13 +25,6 @@ struct Counts {
   std::uint64_t half_edges = 0, vertices = 0;
 };
 
-Hash128 FacesKey(const Mesh& mesh) {
-  Hasher hasher;
-  hasher.Add(std::string_view("dispex quad adjacency 1")).Add(mesh.num_vertices());
-  hasher.AddArray(std::span<const std::int32_t>(mesh.face_indices));
-  return hasher.Digest();
-}
-
 template <class T>
 std::span<const std::byte> Bytes(const T& values) {
   return std::as_bytes(std::span(values.data(), values.size()));
@@ -113,11 +106,18 @@ void Write(const std::string& path, const Hash128& key, const QuadAdjacency& a) 
 
 }  // namespace
 
+Hash128 SculptFacesKey(const Mesh& mesh) {
+  Hasher hasher;
+  hasher.Add(std::string_view("dispex quad adjacency 1")).Add(mesh.num_vertices());
+  hasher.AddArray(std::span<const std::int32_t>(mesh.face_indices));
+  return hasher.Digest();
+}
+
 StatusOr<QuadAdjacency> CachedQuadAdjacency(const Mesh& mesh, const std::string& folder,
-                                            bool& from_cache) {
+                                            bool& from_cache, const Hash128* faces_key) {
   from_cache = false;
   if (folder.empty() || !mesh.all_quads()) return BuildQuadAdjacency(mesh);
-  const Hash128 key = FacesKey(mesh);
+  const Hash128 key = faces_key != nullptr ? *faces_key : SculptFacesKey(mesh);
   const fs::path path = fs::path(folder) / (kPrefix + key.Hex() + ".bin");
   QuadAdjacency cached;
   std::error_code ec;

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 
+#include "core/hash128.h"
 #include "dispex/mesh.h"
 #include "dispex/status.h"
 #include "subdiv/quad_adjacency.h"
@@ -17,10 +18,14 @@ namespace dispex::subdiv {
 
 inline constexpr std::uint64_t kAdjacencyCacheBytes = std::uint64_t{4} << 30;
 
+// The key of a mesh's faces (and vertex count): equal for two meshes with the same faces.
+Hash128 SculptFacesKey(const Mesh& mesh);
+
 // BuildQuadAdjacency(mesh), read from `folder` when a file there holds it, else built and
 // written there (a folder that cannot be written is only a slower run). `from_cache` says
-// which. The result is the same either way.
+// which. The result is the same either way. `faces_key`: SculptFacesKey(mesh) when the caller
+// has it.
 StatusOr<QuadAdjacency> CachedQuadAdjacency(const Mesh& mesh, const std::string& folder,
-                                            bool& from_cache);
+                                            bool& from_cache, const Hash128* faces_key = nullptr);
 
 }  // namespace dispex::subdiv

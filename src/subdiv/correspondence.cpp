@@ -37,6 +37,7 @@
 #include "core/check.h"
 #include "core/parallel.h"
 #include "core/system.h"
+#include "dispex/version.h"
 #include "subdiv/adjacency_cache.h"
 #include "subdiv/correspondence_matcher.h"
 
@@ -69,10 +70,17 @@ StatusOr<SculptCorrespondence> Matcher::Run() {
 Status Matcher::RunSteps() {
   DISPEX_RETURN_IF_ERROR(CheckInputs());
   DISPEX_RETURN_IF_ERROR(FindLevel());
-  DISPEX_ASSIGN_OR_RETURN(adjacency_, subdiv::CachedQuadAdjacency(sculpt_, options_.cache_dir,
-                                                                  out_.adjacency_from_cache));
+  FindBaseComponents();
+  if (TakeKeptMatch()) {
+    labelling_ = true;
+    DISPEX_RETURN_IF_ERROR(FindHomes());
+    return CheckPositions();
+  }
+  DISPEX_ASSIGN_OR_RETURN(adjacency_, subdiv::CachedQuadAdjacency(
+                                          sculpt_, options_.cache_dir, out_.adjacency_from_cache,
+                                          options_.cache_dir.empty() ? nullptr : &faces_key_));
   DISPEX_RETURN_IF_ERROR(MatchComponents());
-  DISPEX_RETURN_IF_ERROR(EvaluateBaseVertices());
+  if (base_limit_.empty()) DISPEX_RETURN_IF_ERROR(EvaluateBaseVertices());
   IndexSculptVertexClasses();
   labelling_ = true;
   for (const BaseComponent& component : components_) {
@@ -85,7 +93,56 @@ Status Matcher::RunSteps() {
   DISPEX_RETURN_IF_ERROR(CheckFaces());
   DISPEX_RETURN_IF_ERROR(CheckSeams());
   DISPEX_RETURN_IF_ERROR(FindHomes());
-  return CheckPositions();
+  DISPEX_RETURN_IF_ERROR(CheckPositions());
+  KeepMatch();
+  return Status::Ok();
+}
+
+// ---- A match kept in the cache folder ----------------------------------------------------
+
+// What the kept match depends on besides the positions: the sculpt's faces, the cage's
+// topology and Ptex faces, the limit points and normals of its vertices (the seeds' scores),
+// the level, the offset limit, and the version (the rules).
+Hash128 Matcher::MatchKey() const {
+  Hasher h;
+  h.Add(std::string_view("dispex match record 1")).Add(std::string_view(Version()));
+  h.Add(faces_key_).Add(out_.levels).Add(offset_limit_);
+  h.AddArray(std::span<const std::int32_t>(s_.first_ptex));
+  h.AddArray(std::span<const std::uint8_t>(s_.ptex_hole));
+  h.AddArray(std::span<const PtexAdjacency>(s_.adjacency));
+  const auto& level = s_.refiner->GetLevel(0);
+  for (int f = 0; f < s_.num_base_faces(); ++f) {
+    const auto vertices = level.GetFaceVertices(f);
+    h.AddArray(std::span<const int>(&vertices[0], static_cast<std::size_t>(vertices.size())));
+  }
+  h.AddArray(std::span<const Vec3d>(base_limit_)).AddArray(std::span<const Vec3d>(base_normal_));
+  return h.Digest();
+}
+
+bool Matcher::TakeKeptMatch() {
+  if (options_.cache_dir.empty() || !sculpt_.all_quads()) return false;
+  // A cage whose limit points cannot be evaluated fails where a match without a cache does.
+  if (!EvaluateBaseVertices().ok()) {
+    base_limit_.clear();
+    return false;
+  }
+  faces_key_ = SculptFacesKey(sculpt_);
+  match_key_ = MatchKey();
+  logging_ = true;
+  std::optional<MatchRecord> kept = ReadMatchRecord(MatchRecordPath(options_.cache_dir, match_key_),
+                                                    match_key_, sculpt_.num_faces());
+  if (!kept || !SeedsStillChosen(*kept)) return false;
+  GridsFromCells(std::move(kept->cell_labels));
+  out_.labelling_from_cache = true;
+  return true;
+}
+
+// Kept when every component's seeding was logged (a match that failed a seeding and found its
+// labelling again without the logs keeps nothing).
+void Matcher::KeepMatch() const {
+  if (!logging_ || seed_logs_.size() != components_.size()) return;
+  WriteMatchRecord(MatchRecordPath(options_.cache_dir, match_key_), match_key_, out_.levels,
+                   out_.cell_labels, seed_logs_);
 }
 
 // ---- 1. Inputs and level ------------------------------------------------------------------
@@ -169,7 +226,7 @@ Status Matcher::FindLevel() {
 
 // ---- 2. Components ------------------------------------------------------------------------
 
-Status Matcher::MatchComponents() {
+void Matcher::FindBaseComponents() {
   const int num_ptex = cage_.num_ptex_faces();
   std::vector<int> component_of(num_ptex, -1);
   std::vector<int> queue;
@@ -202,6 +259,9 @@ Status Matcher::MatchComponents() {
                              component.vertices.end());
   }
   ptex_component_ = std::move(component_of);
+}
+
+Status Matcher::MatchComponents() {
   // With one base component, every quad of a sculpt of the right count must lie in its
   // grids, which the fill and face checks prove: the sculpt's components are compared only
   // where a step fails (Run), sparing a pass over the quads.

@@ -37,7 +37,7 @@ constexpr int kCheckedLines = 8;
 
 // ---- 4. Grids -----------------------------------------------------------------------------
 
-Status Matcher::FillGrids() {
+void Matcher::SizeGrids() {
   const int num_ptex = cage_.num_ptex_faces();
   out_.grid_sizes.resize(num_ptex);
   out_.grid_offsets.assign(num_ptex + 1, 0);
@@ -49,8 +49,46 @@ Status Matcher::FillGrids() {
     cell_offsets_[p + 1] = cell_offsets_[p] + n * n;
   }
   DISPEX_CHECK_EQ(static_cast<std::size_t>(cell_offsets_.back()), sculpt_.num_faces());
-  AssignTouched(cells_, sculpt_.num_faces(), Label{0});  // all written when FillGrids succeeds
   AssignTouched(out_.grid_vertices, static_cast<std::size_t>(out_.grid_offsets.back()), VertexId());
+}
+
+// What FillGrids and CheckFaces make of the cells, from the kept ones (which passed them).
+void Matcher::GridsFromCells(std::vector<Label> cells) {
+  SizeGrids();
+  const std::size_t num_faces = sculpt_.num_faces();
+  if (options_.face_tables) {
+    AssignTouched(out_.face_ptex, num_faces, PtexFaceId());
+    AssignTouched(out_.face_cell, num_faces, std::int32_t{-1});
+    AssignTouched(out_.face_rotation, num_faces, std::uint8_t{0});
+  }
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, cage_.num_ptex_faces()), [&](const tbb::blocked_range<int>& r) {
+        for (int p = r.begin(); p < r.end(); ++p) {
+          const int n = cage_.grid_size(p);
+          const Label* cell = &cells[static_cast<std::size_t>(cell_offsets_[p])];
+          VertexId* grid = &out_.grid_vertices[out_.grid_offsets[p]];
+          for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+              const Label label = cell[j * n + i];
+              for (int corner = 0; corner < 4; ++corner) {
+                const int gi = i + (corner == 1 || corner == 2), gj = j + (corner >= 2);
+                grid[gj * (n + 1) + gi] = VertexId(VertexAt(label, corner));
+              }
+              if (!options_.face_tables) continue;
+              out_.face_ptex[label / 4] = PtexFaceId(p);
+              out_.face_cell[label / 4] = j * n + i;
+              out_.face_rotation[label / 4] = static_cast<std::uint8_t>(label & 3);
+            }
+          }
+        }
+      });
+  out_.cell_labels = std::move(cells);
+}
+
+Status Matcher::FillGrids() {
+  const int num_ptex = cage_.num_ptex_faces();
+  SizeGrids();
+  AssignTouched(cells_, sculpt_.num_faces(), Label{0});  // all written when FillGrids succeeds
   FirstError error;
   tbb::parallel_for(tbb::blocked_range<int>(0, num_ptex), [&](const tbb::blocked_range<int>& r) {
     for (int p = r.begin(); p < r.end(); ++p) {
@@ -243,7 +281,7 @@ Status Matcher::FindHomes() {
   const std::size_t num_vertices = sculpt_.num_vertices();
   constexpr std::int32_t kNone = std::numeric_limits<std::int32_t>::max();
   AssignTouched(out_.vertex_faces, num_vertices, PtexFaceId(kNone));
-  AssignTouched(out_.vertex_uvs, 2 * num_vertices, 0.0f);
+  if (options_.vertex_uvs) AssignTouched(out_.vertex_uvs, 2 * num_vertices, 0.0f);
   // Row by row; with `borders_only`, the points on the grid's border only.
   const auto each_grid_point = [&](bool borders_only, auto&& visit) {
     tbb::parallel_for(tbb::blocked_range<int>(0, cage_.num_ptex_faces()),
@@ -262,6 +300,7 @@ Status Matcher::FindHomes() {
                       });
   };
   const auto set_uv = [&](int n, int i, int j, std::int32_t v) {
+    if (!options_.vertex_uvs) return;
     out_.vertex_uvs[2 * static_cast<std::size_t>(v)] = static_cast<float>(i) / n;
     out_.vertex_uvs[2 * static_cast<std::size_t>(v) + 1] = static_cast<float>(j) / n;
   };
@@ -276,9 +315,11 @@ Status Matcher::FindHomes() {
     while (p < current && !home.compare_exchange_weak(current, p, std::memory_order_relaxed)) {
     }
   });
-  each_grid_point(true, [&](int p, int n, int i, int j, bool border, std::int32_t v) {
-    if (border && out_.vertex_faces[v].value == p) set_uv(n, i, j, v);
-  });
+  if (options_.vertex_uvs) {
+    each_grid_point(true, [&](int p, int n, int i, int j, bool border, std::int32_t v) {
+      if (border && out_.vertex_faces[v].value == p) set_uv(n, i, j, v);
+    });
+  }
   for (std::size_t v = 0; v < num_vertices; ++v) {
     if (out_.vertex_faces[v].value == kNone) {
       return Status::Error(fmt::format(
@@ -346,12 +387,20 @@ Status Matcher::CheckPositions() {
   out_.worst_vertex = VertexId(worst);
   if (out_.max_offset > offset_limit_) {
     const PtexFaceId home = out_.vertex_faces[worst];
+    const int n = out_.grid_sizes[home.value];
+    GridPoint at;
+    for (int k = 0; k < (n + 1) * (n + 1); ++k) {
+      if (GridVertex(home.value, {k % (n + 1), k / (n + 1)}).value == worst) {
+        at = {k % (n + 1), k / (n + 1)};
+        break;
+      }
+    }
     return Status::Error(fmt::format(
         "{}: the position check failed: vertex {} is {:.6g} from its home on Ptex face {} at "
         "({}, {}), more than max_offset {:.6g} (is the cage the one the sculpt was refined "
         "from, with the same tags?)",
-        where_, worst, out_.max_offset, home.value, out_.vertex_uvs[2 * worst],
-        out_.vertex_uvs[2 * worst + 1], offset_limit_));
+        where_, worst, out_.max_offset, home.value, static_cast<float>(at.i) / n,
+        static_cast<float>(at.j) / n, offset_limit_));
   }
   return Status::Ok();
 }

@@ -2,7 +2,8 @@
 // Its steps, and how a cell's label names a sculpt quad, are described in correspondence.cpp;
 // they are defined in three files:
 //   correspondence.cpp          1. inputs and level, 2. components, and Run
-//   correspondence_seeds.cpp    3. seeds: the labelling of each component's (0,0) cells
+//   correspondence_seeds.cpp    3. seeds: the labelling of each component's (0,0) cells, and
+//                               whether a kept match's labelling is still the one chosen
 //   correspondence_grids.cpp    4. grids, 5. faces and seams, 6. homes and positions
 // The small accessors the grid loops call per cell stay here, inline.
 #pragma once
@@ -13,8 +14,10 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "core/first_error.h"
@@ -23,6 +26,7 @@
 #include "dispex/mesh.h"
 #include "dispex/status.h"
 #include "dispex/subdiv.h"
+#include "subdiv/match_cache.h"
 #include "subdiv/quad_adjacency.h"
 #include "subdiv/refined_cage.h"
 #include "subdiv/surface_impl.h"
@@ -88,8 +92,15 @@ class Matcher {
   Status FindLevel();
 
   // ---- 2. Components (correspondence.cpp) ---------------------------------------------------
+  void FindBaseComponents();
   Status MatchComponents();
   Status CompareComponents();
+
+  // ---- A match kept in the cache folder (correspondence.cpp, match_cache.h) -----------------
+  Hash128 MatchKey() const;
+  // True when the kept match is this sculpt's (its labelling then in place, grids filled).
+  bool TakeKeptMatch();
+  void KeepMatch() const;
 
   // ---- 3. Seeds (correspondence_seeds.cpp) --------------------------------------------------
   LimitEvaluator& Evaluator() {
@@ -133,10 +144,27 @@ class Matcher {
     std::int64_t nearest = -1;            // the nearest of the class, for messages
     double nearest_distance = HUGE_VAL;
   };
-  CandidateList Candidates(int vertex_class, int w, std::uint64_t cells) const;
+  // The sculpt vertices of `vertex_class` in unmatched components of `cells` quads, ascending.
+  std::vector<std::uint32_t> ClassVertices(int vertex_class, std::uint64_t cells) const;
+  CandidateList Candidates(std::span<const std::uint32_t> class_vertices, int w) const;
+  // The seed vertex of a component and its corner in the first of its Ptex faces there.
+  std::pair<int, const RefinedCage::Corner*> SeedVertex(const BaseComponent& component) const;
   Status SeedComponent(const BaseComponent& component);
+  // SeedComponent's rule for which labelling wins, applied to the labellings' logs (the order
+  // in which they met base vertices, and the sculpt vertex there) with these positions: the
+  // first of the least score among those whose walk completed; one stops at a vertex beyond the
+  // offset limit, or once its score passes the best one's. -1: none.
+  int ChosenLabelling(const ComponentSeeds& log) const;
+  // Seeds the component trying every labelling whole, logged, the positions judged after
+  // (ChosenLabelling); log.chosen < 0 when none fits.
+  void SeedComponentLogged(const BaseComponent& component, const RefinedCage::Corner* place,
+                           const CandidateList& candidates, ComponentSeeds& log);
+  bool SeedsStillChosen(const MatchRecord& kept) const;
 
   // ---- 4. Grids (correspondence_grids.cpp) --------------------------------------------------
+  void SizeGrids();
+  // A kept match's grids and tables from its cells' labels.
+  void GridsFromCells(std::vector<Label> cells);
   Status FillGrids();
   void FillGrid(int p, FirstError& error);
 
@@ -163,6 +191,11 @@ class Matcher {
   Status CheckPositions();
 
   bool labelling_ = false;
+  // With MatchOptions::cache_dir: the keys, and what step 3 read of the positions and chose.
+  Hash128 faces_key_, match_key_;
+  bool logging_ = false;
+  std::vector<ComponentSeeds> seed_logs_;
+  ComponentSeeds* met_log_ = nullptr;  // the labelling being tried logs its base vertices here
   const LimitSurface& surface_;
   const LimitSurface::Impl& s_;
   const Mesh& sculpt_;

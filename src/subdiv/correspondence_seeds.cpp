@@ -164,6 +164,11 @@ bool Matcher::SeedFace(int p, Label label, double prune_above, SeedAttempt& atte
     return false;
   }
   base_sculpt_[w] = x;
+  if (met_log_ != nullptr) {  // the positions are judged once every labelling is logged
+    met_log_->met_w.push_back(w);
+    met_log_->met_x.push_back(x);
+    return true;
+  }
   const double d2 = Distance2(Position(x), base_limit_[w]);
   if (d2 > offset_limit_ * offset_limit_) {
     attempt.failure = Status::Error(fmt::format(
@@ -289,55 +294,51 @@ double Matcher::SeedScore(std::int32_t x, int w) const {
   return Dot(offset, offset) - (1 - kAlongNormalWeight) * along * along;
 }
 
-// The sculpt vertices of `vertex_class` in unmatched components of `cells` quads within
-// the offset limit of base vertex w's limit point, at most kCandidates.
-Matcher::CandidateList Matcher::Candidates(int vertex_class, int w, std::uint64_t cells) const {
-  using Ranked = std::pair<double, std::uint32_t>;
-  struct Found {
-    std::vector<Ranked> best;
-    Ranked nearest{HUGE_VAL, 0};
-  };
-  const auto keep_best = [](std::vector<Ranked>& list) {
-    std::sort(list.begin(), list.end());
-    if (list.size() > kCandidates) list.resize(kCandidates);
-  };
-  tbb::combinable<Found> found;
-  // The class's vertices: from its bucket, or (one component) all vertices of the class.
-  const bool bucketed = !class_vertices_.empty();
-  const std::uint32_t* begin =
-      bucketed ? class_vertices_.data() + class_offsets_[vertex_class] : nullptr;
-  const std::size_t count = bucketed ? ClassSize(vertex_class) : sculpt_.num_vertices();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 4096),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      Found& mine = found.local();
-                      for (std::size_t k = r.begin(); k < r.end(); ++k) {
-                        const auto x = bucketed ? begin[k] : static_cast<std::uint32_t>(k);
-                        if (!bucketed && SculptClass(x) != vertex_class) continue;
-                        if (!components_trusted_) {
-                          const std::uint32_t component =
-                              sculpt_component_[adjacency_.first_half_edge[x] / 4];
-                          if (sculpt_component_matched_[component] ||
-                              sculpt_component_faces_[component] != cells) {
-                            continue;
-                          }
-                        }
-                        const auto vertex = static_cast<std::int32_t>(x);
-                        const double d2 = Distance2(Position(vertex), base_limit_[w]);
-                        mine.nearest = std::min(mine.nearest, Ranked{d2, x});
-                        if (d2 > offset_limit_ * offset_limit_) continue;
-                        mine.best.emplace_back(SeedScore(vertex, w), x);
-                        if (mine.best.size() >= 4 * kCandidates) keep_best(mine.best);
-                      }
-                    });
-  std::vector<Ranked> all;
-  Ranked nearest{HUGE_VAL, 0};
-  found.combine_each([&](const Found& list) {
-    all.insert(all.end(), list.best.begin(), list.best.end());
-    nearest = std::min(nearest, list.nearest);
+std::vector<std::uint32_t> Matcher::ClassVertices(int vertex_class, std::uint64_t cells) const {
+  // From its bucket, or (one component) a scan of every vertex in blocks, joined in order.
+  if (!class_vertices_.empty()) {
+    const std::uint32_t* begin = class_vertices_.data() + class_offsets_[vertex_class];
+    std::vector<std::uint32_t> out(begin, begin + ClassSize(vertex_class));
+    if (!components_trusted_) {
+      std::erase_if(out, [&](std::uint32_t x) {
+        const std::uint32_t component = sculpt_component_[adjacency_.first_half_edge[x] / 4];
+        return sculpt_component_matched_[component] || sculpt_component_faces_[component] != cells;
+      });
+    }
+    return out;
+  }
+  constexpr std::size_t kBlock = std::size_t{1} << 16;
+  const std::size_t num_vertices = sculpt_.num_vertices();
+  std::vector<std::vector<std::uint32_t>> blocks((num_vertices + kBlock - 1) / kBlock);
+  tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
+    for (std::size_t x = b * kBlock; x < std::min(num_vertices, (b + 1) * kBlock); ++x) {
+      if (SculptClass(x) == vertex_class) blocks[b].push_back(static_cast<std::uint32_t>(x));
+    }
   });
-  keep_best(all);
+  std::vector<std::uint32_t> out;
+  for (const auto& block : blocks) out.insert(out.end(), block.begin(), block.end());
+  return out;
+}
+
+// Of `class_vertices`, those within the offset limit of base vertex w's limit point, at most
+// kCandidates, best SeedScore first (ties by id).
+Matcher::CandidateList Matcher::Candidates(std::span<const std::uint32_t> class_vertices,
+                                           int w) const {
+  using Ranked = std::pair<double, std::uint32_t>;
+  std::vector<Ranked> ranked;
+  Ranked nearest{HUGE_VAL, 0};
+  for (std::uint32_t x : class_vertices) {
+    const auto vertex = static_cast<std::int32_t>(x);
+    const double d2 = Distance2(Position(vertex), base_limit_[w]);
+    nearest = std::min(nearest, Ranked{d2, x});
+    if (d2 > offset_limit_ * offset_limit_) continue;
+    ranked.emplace_back(SeedScore(vertex, w), x);
+  }
+  const std::size_t kept = std::min<std::size_t>(ranked.size(), kCandidates);
+  std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(kept),
+                    ranked.end());
   CandidateList out;
-  for (const Ranked& ranked : all) out.vertices.push_back(ranked.second);
+  for (std::size_t k = 0; k < kept; ++k) out.vertices.push_back(ranked[k].second);
   if (nearest.first < HUGE_VAL) {
     out.nearest = nearest.second;
     out.nearest_distance = std::sqrt(nearest.first);
@@ -345,10 +346,9 @@ Matcher::CandidateList Matcher::Candidates(int vertex_class, int w, std::uint64_
   return out;
 }
 
-Status Matcher::SeedComponent(const BaseComponent& component) {
-  seeds_.resize(cage_.num_ptex_faces(), kNoLabel);
-  base_sculpt_.resize(cage_.num_vertices(), -1);
-  // The seed vertex: manifold, of the class rarest in the sculpt, lowest id.
+// Manifold, of the class rarest in the sculpt, lowest id.
+std::pair<int, const RefinedCage::Corner*> Matcher::SeedVertex(
+    const BaseComponent& component) const {
   int seed_vertex = -1;
   for (int w : component.vertices) {
     const auto rank = [&](int v) {
@@ -360,10 +360,18 @@ Status Matcher::SeedComponent(const BaseComponent& component) {
   const int id = static_cast<int>(&component - components_.data());
   const RefinedCage::Corner* place = cage_.corners_begin(seed_vertex);
   while (ptex_component_[place->ptex] != id) ++place;
+  return {seed_vertex, place};
+}
+
+Status Matcher::SeedComponent(const BaseComponent& component) {
+  seeds_.resize(cage_.num_ptex_faces(), kNoLabel);
+  base_sculpt_.resize(cage_.num_vertices(), -1);
+  const auto [seed_vertex, place] = SeedVertex(component);
   const int valence = cage_.valence(seed_vertex);
   const bool boundary = cage_.boundary(seed_vertex);
-  const CandidateList candidates =
-      Candidates(VertexClass(valence, boundary), seed_vertex, component.cells);
+  const std::vector<std::uint32_t> class_vertices =
+      ClassVertices(VertexClass(valence, boundary), component.cells);
+  const CandidateList candidates = Candidates(class_vertices, seed_vertex);
   if (candidates.nearest < 0) {
     return Status::Error(fmt::format(
         "{}: no {} vertex of valence {} like base vertex {} (Ptex face {}) in a component of "
@@ -378,6 +386,20 @@ Status Matcher::SeedComponent(const BaseComponent& component) {
         "{:.6g} away",
         where_, boundary ? "boundary" : "interior", valence, offset_limit_, seed_vertex,
         place->ptex, candidates.nearest, candidates.nearest_distance));
+  }
+  if (logging_) {
+    ComponentSeeds log;
+    log.seed_vertex = seed_vertex;
+    log.class_vertices = class_vertices;
+    log.candidates = candidates.vertices;
+    SeedComponentLogged(component, place, candidates, log);
+    if (log.chosen >= 0) {
+      seed_logs_.push_back(std::move(log));
+      return Status::Ok();
+    }
+    // No labelling fits: the match fails. Tried again as without a cache folder, for the
+    // failure it names.
+    logging_ = false;
   }
 
   std::optional<SeedAttempt> best, furthest_failure;
@@ -408,6 +430,81 @@ Status Matcher::SeedComponent(const BaseComponent& component) {
   }
   if (!components_trusted_) sculpt_component_matched_[sculpt_component_[best_seeds[0] / 4]] = 1;
   return Status::Ok();
+}
+
+void Matcher::SeedComponentLogged(const BaseComponent& component, const RefinedCage::Corner* place,
+                                  const CandidateList& candidates, ComponentSeeds& log) {
+  std::vector<Label> starts;
+  for (std::uint32_t x : candidates.vertices) {
+    for (std::uint32_t h : HalfEdgesAround(x)) {
+      starts.push_back((h & ~3u) | ((h - static_cast<std::uint32_t>(place->corner)) & 3u));
+      met_log_ = &log;
+      const SeedAttempt attempt =
+          TrySeed(component, place->ptex, place->corner, starts.back(), HUGE_VAL);
+      met_log_ = nullptr;
+      log.walk_complete.push_back(attempt.complete ? 1 : 0);
+      log.met_end.push_back(static_cast<std::uint32_t>(log.met_w.size()));
+    }
+  }
+  log.chosen = ChosenLabelling(log);
+  if (log.chosen < 0) return;
+  // The chosen labelling walked once more, for its seeds.
+  const SeedAttempt chosen = TrySeed(component, place->ptex, place->corner,
+                                     starts[static_cast<std::size_t>(log.chosen)], HUGE_VAL);
+  DISPEX_CHECK(chosen.complete);
+  if (!components_trusted_) {
+    sculpt_component_matched_[sculpt_component_[seeds_[component.faces[0]] / 4]] = 1;
+  }
+}
+
+int Matcher::ChosenLabelling(const ComponentSeeds& log) const {
+  int best = -1;
+  double best_score = 0;
+  std::uint32_t begin = 0;
+  for (std::size_t a = 0; a < log.walk_complete.size(); ++a) {
+    const std::uint32_t end = log.met_end[a];
+    const double prune_above = best >= 0 ? best_score : HUGE_VAL;
+    double score = 0;
+    bool stopped = false;
+    for (std::uint32_t k = begin; k < end && !stopped; ++k) {
+      const std::int32_t w = log.met_w[k], x = log.met_x[k];
+      stopped = Distance2(Position(x), base_limit_[w]) > offset_limit_ * offset_limit_;
+      if (stopped) break;
+      score += SeedScore(x, w);
+      stopped = score > prune_above;
+    }
+    begin = end;
+    if (stopped || !log.walk_complete[a]) continue;
+    if (best < 0 || score < best_score) {
+      best = static_cast<int>(a);
+      best_score = score;
+    }
+  }
+  return best;
+}
+
+// Whether every component's seeding, re-run on the kept logs with these positions, ranks the
+// same candidates and chooses the same labelling.
+bool Matcher::SeedsStillChosen(const MatchRecord& kept) const {
+  if (kept.levels != out_.levels || kept.components.size() != components_.size()) return false;
+  for (std::size_t k = 0; k < components_.size(); ++k) {
+    const ComponentSeeds& log = kept.components[k];
+    if (log.seed_vertex < 0 || log.seed_vertex >= cage_.num_vertices()) return false;
+    for (std::uint32_t x : log.class_vertices) {
+      if (x >= sculpt_.num_vertices()) return false;
+    }
+    for (std::int32_t w : log.met_w) {
+      if (w < 0 || w >= cage_.num_vertices()) return false;
+    }
+    for (std::int32_t x : log.met_x) {
+      if (x < 0 || static_cast<std::size_t>(x) >= sculpt_.num_vertices()) return false;
+    }
+    if (Candidates(log.class_vertices, log.seed_vertex).vertices != log.candidates ||
+        ChosenLabelling(log) != log.chosen) {
+      return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace dispex::subdiv::matching

@@ -43,5 +43,32 @@ TEST(CacheFiles, LeastRecentlyWrittenGoFirst) {
   fs::remove_all(dir);
 }
 
+// A record reads back as written (a folder made for it); a record cut short, changed in one
+// byte, of another magic or missing reads as none.
+TEST(CacheFiles, RecordsReadBackWholeOrNotAtAll) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "dispex_cache_records_test";
+  fs::remove_all(dir);
+  const std::string path = (dir / "folder" / "record.bin").string();
+  std::string bytes = "DXTEST01";
+  for (int i = 0; i < 1000; ++i) bytes += static_cast<char>(i * 7);
+  ASSERT_TRUE(WriteCacheRecord(path, bytes));
+  EXPECT_EQ(ReadCacheRecord(path, "DXTEST01"), bytes);
+  EXPECT_EQ(ReadCacheRecord(path, "DXTEST02"), std::nullopt);
+  EXPECT_EQ(ReadCacheRecord((dir / "missing.bin").string(), "DXTEST01"), std::nullopt);
+  const std::uintmax_t size = fs::file_size(path);
+  {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(500);
+    f.put('!');
+  }
+  EXPECT_EQ(ReadCacheRecord(path, "DXTEST01"), std::nullopt) << "a changed byte";
+  ASSERT_TRUE(WriteCacheRecord(path, bytes));
+  fs::resize_file(path, size - 1);
+  EXPECT_EQ(ReadCacheRecord(path, "DXTEST01"), std::nullopt) << "cut short";
+  // An unwritable place: false, nothing left behind.
+  EXPECT_FALSE(WriteCacheRecord((dir / "folder" / "record.bin" / "below.bin").string(), bytes));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace dispex

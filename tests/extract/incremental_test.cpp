@@ -274,9 +274,10 @@ TEST_P(Incremental, EveryStepEqualsAFullExtraction) {
       EXPECT_LT(r.incremental.search_rays_recast, r.incremental.search_rays / 4)
           << "the search distance's rays near a local edit are cast again, not all";
     }
-    // The sculpt's faces did not change: its adjacency comes from the cache (the ray path
-    // does not match the sculpt).
-    EXPECT_EQ(r.method.adjacency_cached, r.method.used != ExtractMethod::kRays);
+    // The sculpt's faces did not change: its match, or else its adjacency, comes from the
+    // cache (the ray path does not match the sculpt).
+    EXPECT_EQ(r.method.adjacency_cached || r.method.labelling_cached,
+              r.method.used != ExtractMethod::kRays);
     if (GetParam().uv_maps) {  // half tiles are extracted whole (uv_maps.h)
       EXPECT_EQ(r.uv.faces_copied > 0, GetParam().data_type == PtexDataType::kFloat)
           << r.uv.faces_copied << " faces' UV texels copied";

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <numeric>
 #include <random>
@@ -194,6 +195,102 @@ TEST_P(RefinedSculpts, AsMadeAndShuffledLandOnTheirTruth) {
     EXPECT_EQ(matched->components, as_made->components);
     EXPECT_DOUBLE_EQ(matched->max_offset, as_made->max_offset);
   }
+}
+
+// Every field of two matches equal (how they were found aside).
+void ExpectSameMatch(const SculptCorrespondence& a, const SculptCorrespondence& b,
+                     const std::string& what) {
+  EXPECT_EQ(a.levels, b.levels) << what;
+  EXPECT_EQ(a.reversed, b.reversed) << what;
+  EXPECT_EQ(a.grid_offsets, b.grid_offsets) << what;
+  EXPECT_EQ(a.grid_vertices, b.grid_vertices) << what;
+  EXPECT_EQ(a.grid_sizes, b.grid_sizes) << what;
+  EXPECT_EQ(a.vertex_faces, b.vertex_faces) << what;
+  EXPECT_EQ(a.vertex_uvs, b.vertex_uvs) << what;
+  EXPECT_EQ(a.face_ptex, b.face_ptex) << what;
+  EXPECT_EQ(a.face_cell, b.face_cell) << what;
+  EXPECT_EQ(a.face_rotation, b.face_rotation) << what;
+  EXPECT_EQ(a.cell_labels, b.cell_labels) << what;
+  EXPECT_EQ(a.components, b.components) << what;
+  EXPECT_EQ(a.checked_vertices, b.checked_vertices) << what;
+  EXPECT_EQ(a.max_offset, b.max_offset) << what;
+  EXPECT_EQ(a.rms_offset, b.rms_offset) << what;
+  EXPECT_EQ(a.worst_vertex, b.worst_vertex) << what;
+}
+
+// The match kept in a cache folder: the next match of the same sculpt takes it; after the
+// positions moved by a small smooth field, it is taken only when the seeds' choice is still
+// the one these positions make, and the result is always the match without a cache.
+TEST_P(RefinedSculpts, AKeptMatchIsTheMatchOfTheNewPositions) {
+  TempDir dir;
+  const std::string cage = Cage(GetParam().cage);
+  Sculpt sculpt =
+      MakeRefined(dir, cage, GetParam().levels, GetParam().pattern, GetParam().amplitude);
+  const LimitSurface surface = Surface(cage);
+  MatchOptions cached;
+  cached.cache_dir = dir / "cache";
+  auto fresh = MatchRefinedSculpt(surface, sculpt.mesh);
+  ASSERT_TRUE(fresh.ok()) << fresh.status().message();
+  auto first = MatchRefinedSculpt(surface, sculpt.mesh, cached);
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  EXPECT_FALSE(first->labelling_from_cache);
+  ExpectSameMatch(*first, *fresh, "the match that keeps it");
+  auto again = MatchRefinedSculpt(surface, sculpt.mesh, cached);
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  EXPECT_TRUE(again->labelling_from_cache);
+  EXPECT_FALSE(again->adjacency_from_cache);  // not needed
+  ExpectSameMatch(*again, *fresh, "the same sculpt again");
+
+  // Every vertex moved along a smooth field of 0.1% of the box (the seeds' scores change).
+  Mesh moved = sculpt.mesh;
+  for (Float3& p : moved.positions) {
+    p.x += 0.002f * std::sin(3 * p.y);
+    p.z += 0.002f * std::cos(2 * p.x);
+  }
+  auto moved_fresh = MatchRefinedSculpt(surface, moved);
+  auto moved_cached = MatchRefinedSculpt(surface, moved, cached);
+  ASSERT_EQ(moved_fresh.ok(), moved_cached.ok());
+  if (moved_fresh.ok()) ExpectSameMatch(*moved_cached, *moved_fresh, "positions moved");
+}
+
+// A cube refined, its positions turned a quarter about z: the same faces, but every vertex now
+// lies where another labelling puts it (the cube's symmetry), so the seeds' choice moves. The
+// kept match of the unturned sculpt must not be taken; taking it would keep the old labels.
+TEST(MatchRefinedSculpt, AKeptMatchIsNotTakenWhenTheSymmetryChosenMoves) {
+  TempDir dir;
+  const std::string cage = Cage("catmark_cube");
+  Sculpt sculpt = MakeRefined(dir, cage, 3, Pattern::kDetail, 0.001);
+  const LimitSurface surface = Surface(cage);
+  MatchOptions cached;
+  cached.cache_dir = dir / "cache";
+  auto first = MatchRefinedSculpt(surface, sculpt.mesh, cached);
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  Mesh turned = sculpt.mesh;
+  for (Float3& p : turned.positions) p = {-p.y, p.x, p.z};
+  auto fresh = MatchRefinedSculpt(surface, turned);
+  ASSERT_TRUE(fresh.ok()) << fresh.status().message();
+  ASSERT_NE(fresh->cell_labels, first->cell_labels) << "the turn did not change the labelling";
+  auto again = MatchRefinedSculpt(surface, turned, cached);
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  EXPECT_FALSE(again->labelling_from_cache);
+  EXPECT_TRUE(again->adjacency_from_cache);
+  ExpectSameMatch(*again, *fresh, "turned");
+  // Kept again for the turned sculpt, the next match takes it.
+  auto third = MatchRefinedSculpt(surface, turned, cached);
+  ASSERT_TRUE(third.ok());
+  EXPECT_TRUE(third->labelling_from_cache);
+  ExpectSameMatch(*third, *fresh, "turned, again");
+  // A kept match damaged since is matched again.
+  for (const auto& entry : std::filesystem::directory_iterator(cached.cache_dir)) {
+    if (entry.path().filename().string().rfind("match-", 0) != 0) continue;
+    std::fstream f(entry.path(), std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(100);
+    f.put('!');
+  }
+  auto fourth = MatchRefinedSculpt(surface, turned, cached);
+  ASSERT_TRUE(fourth.ok());
+  EXPECT_FALSE(fourth->labelling_from_cache);
+  ExpectSameMatch(*fourth, *fresh, "turned, the kept match damaged");
 }
 
 INSTANTIATE_TEST_SUITE_P(

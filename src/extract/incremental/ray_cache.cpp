@@ -13,6 +13,7 @@
 #include <iterator>
 #include <limits>
 
+#include "core/byte_record.h"
 #include "core/cache_files.h"
 #include "dispex/files.h"
 #include "extract/incremental/face_keys.h"
@@ -112,34 +113,6 @@ std::vector<std::uint8_t> Dilate(std::vector<std::uint8_t> flags, int radius) {
   return flags;
 }
 
-template <class T>
-void Append(std::string& out, const T& value) {
-  out.append(reinterpret_cast<const char*>(&value), sizeof(T));
-}
-template <class T>
-void AppendArray(std::string& out, const std::vector<T>& values) {
-  Append(out, std::uint64_t{values.size()});
-  out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
-}
-
-// Reads what Append wrote at `at`, advancing it; false past the end.
-template <class T>
-bool Take(std::string_view bytes, std::size_t& at, T& value) {
-  if (bytes.size() - at < sizeof(T)) return false;
-  std::memcpy(&value, bytes.data() + at, sizeof(T));
-  at += sizeof(T);
-  return true;
-}
-template <class T>
-bool TakeArray(std::string_view bytes, std::size_t& at, std::vector<T>& values) {
-  std::uint64_t count = 0;
-  if (!Take(bytes, at, count) || count > (bytes.size() - at) / sizeof(T)) return false;
-  values.resize(count);
-  std::memcpy(values.data(), bytes.data() + at, count * sizeof(T));
-  at += count * sizeof(T);
-  return true;
-}
-
 }  // namespace
 
 RayGrid::RayGrid(const LongRays& rays) {
@@ -220,20 +193,10 @@ std::string RayCachePath(const std::string& folder, const std::string& sculpt_pa
 }
 
 std::optional<RayCache> ReadRayCache(const std::string& path, const Hash128& rays_key) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  constexpr std::size_t kCheck = sizeof(Hash128);
-  if (bytes.size() < sizeof(kMagic) + kCheck ||
-      std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
-    return std::nullopt;
-  }
-  const std::string_view body(bytes.data(), bytes.size() - kCheck);
-  Hash128 check;
-  std::memcpy(&check, bytes.data() + body.size(), kCheck);
-  if (!(HashBytes(std::as_bytes(std::span(body.data(), body.size()))) == check)) {
-    return std::nullopt;
-  }
+  const std::optional<std::string> bytes =
+      ReadCacheRecord(path, std::string_view(kMagic, sizeof(kMagic)));
+  if (!bytes) return std::nullopt;
+  const std::string_view body(*bytes);
   RayCache cache;
   std::size_t at = sizeof(kMagic);
   if (!Take(body, at, cache.rays_key) || !(cache.rays_key == rays_key) ||
@@ -246,18 +209,17 @@ std::optional<RayCache> ReadRayCache(const std::string& path, const Hash128& ray
   return cache;
 }
 
-Status WriteRayCache(const std::string& path, const RayCache& cache) {
+bool WriteRayCache(const std::string& path, const RayCache& cache) {
   std::string bytes(kMagic, sizeof(kMagic));
   Append(bytes, cache.rays_key);
   Append(bytes, cache.half_extent);
   AppendArray(bytes, cache.cells);
   AppendArray(bytes, cache.nearest);
   AppendArray(bytes, cache.side);
-  Append(bytes, HashBytes(std::as_bytes(std::span(bytes.data(), bytes.size()))));
-  DISPEX_RETURN_IF_ERROR(WriteFileAtomically(path, bytes.data(), bytes.size()));
+  if (!WriteCacheRecord(path, std::move(bytes))) return false;
   EvictCacheFiles(std::filesystem::path(path).parent_path().string(), kPrefix, kRayCacheBytes,
                   path);
-  return Status::Ok();
+  return true;
 }
 
 Status UpdateNearestHits(const Mesh& sculpt, const TracerOptions& tracer_options,

@@ -72,10 +72,10 @@ std::string RayCachePath(const std::string& folder, const std::string& sculpt_pa
                          const std::string& base_fingerprint);
 // A cache file as written, or nullopt when it is missing, damaged or not for `rays_key`.
 std::optional<RayCache> ReadRayCache(const std::string& path, const Hash128& rays_key);
-// Writes it, then keeps the folder's ray files within kRayCacheBytes (least recently written
-// first out).
+// Writes it (false when it cannot be), then keeps the folder's ray files within kRayCacheBytes
+// (least recently written first out).
 inline constexpr std::uint64_t kRayCacheBytes = std::uint64_t{1} << 30;
-Status WriteRayCache(const std::string& path, const RayCache& cache);
+bool WriteRayCache(const std::string& path, const RayCache& cache);
 
 // Every ray's nearest |t| over `sculpt` into current.nearest, from `previous` (the same rays
 // over the sculpt as it was) and current.cells (KeySculptCells of `sculpt`): a ray none of whose

@@ -62,7 +62,8 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
                  {"sheet_bound", r.method.sheet_bound},
                  {"fallback_samples", r.method.fallback_samples},
                  {"fallback_faces", r.method.fallback_faces},
-                 {"adjacency_cached", r.method.adjacency_cached}};
+                 {"adjacency_cached", r.method.adjacency_cached},
+                 {"labelling_cached", r.method.labelling_cached}};
   j["phases_seconds"] = {{"read_base", r.times.read_base},
                          {"read_sculpt", r.times.read_sculpt},
                          {"topology", r.times.topology},

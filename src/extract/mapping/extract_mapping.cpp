@@ -25,7 +25,10 @@ StatusOr<SculptCorrespondence> MatchSculpt(const ExtractOptions& options, MatchO
   if (options.incremental) match.cache_dir = CacheFolder(options);
   StatusOr<SculptCorrespondence> correspondence =
       MatchRefinedSculpt(inputs.surface, inputs.sculpt, match);
-  if (correspondence.ok()) report.method.adjacency_cached = correspondence->adjacency_from_cache;
+  if (correspondence.ok()) {
+    report.method.adjacency_cached = correspondence->adjacency_from_cache;
+    report.method.labelling_cached = correspondence->labelling_from_cache;
+  }
   if (correspondence.ok() && correspondence->reversed) {
     ReverseWinding(inputs.sculpt);
     report.warnings.push_back(fmt::format(
@@ -61,7 +64,8 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   MatchOptions match;
   match.threads = report.settings.threads;
   match.face_tables = false;  // the mapping reads the cells
-  if (interpolate) {          // the bound vector maps take too
+  match.vertex_uvs = false;
+  if (interpolate) {  // the bound vector maps take too
     DISPEX_ASSIGN_OR_RETURN(match.max_offset, OffsetBound(options, report.inputs.base_diagonal));
   }
   StatusOr<SculptCorrespondence> correspondence = MatchSculpt(options, match, inputs, report);

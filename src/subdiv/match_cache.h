@@ -1,0 +1,59 @@
+// A match of the sculpt kept in a cache folder for the next match of a sculpt with the same
+// faces (an incremental run after an edit of positions only): the cells' labels, and what the
+// seeding read of the positions to choose its labelling. Which labelling a match finds depends
+// on the positions only through that choice (correspondence.cpp, step 3); the steps after it
+// read the topology alone. So a kept match is the match of a sculpt with the same faces when
+// the seeding, re-run on the kept record with the new positions, chooses the same labelling
+// (Matcher::SeedsStillChosen); the position check is then run anew. A file is keyed by the
+// sculpt's faces, the cage (its topology, the limit points and normals of its vertices), the
+// offset limit and the version, and checked whole by a hash of its content.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/hash128.h"
+
+namespace dispex::subdiv::matching {
+
+// What SeedComponent read of the positions for one base component, and what it chose.
+struct ComponentSeeds {
+  // The base vertex the seeding starts from (its class is the rarest in the sculpt: the faces
+  // decide it).
+  std::int32_t seed_vertex = -1;
+  // The sculpt vertices Candidates ranked (those of the seed vertex's class, in the component's
+  // size), ascending, and the candidates it gave, best first.
+  std::vector<std::uint32_t> class_vertices;
+  std::vector<std::uint32_t> candidates;
+  // Per labelling tried, in order: whether its walk over the component's faces completed (the
+  // positions aside), and where its list of base vertices met ends in met_w / met_x.
+  std::vector<std::uint8_t> walk_complete;
+  std::vector<std::uint32_t> met_end;
+  // Each labelling's base vertices, in the order it met them, and the sculpt vertex there.
+  std::vector<std::int32_t> met_w, met_x;
+  std::int32_t chosen = -1;  // the labelling chosen
+};
+
+struct MatchRecord {
+  std::int32_t levels = 0;
+  std::vector<std::uint32_t> cell_labels;  // SculptCorrespondence::cell_labels
+  std::vector<ComponentSeeds> components;
+};
+
+inline constexpr std::uint64_t kMatchCacheBytes = std::uint64_t{1} << 30;
+
+// The file of `key` in `folder`.
+std::string MatchRecordPath(const std::string& folder, const Hash128& key);
+// The record in `path` when it is there, whole and of `key` and `num_cells` cells.
+std::optional<MatchRecord> ReadMatchRecord(const std::string& path, const Hash128& key,
+                                           std::size_t num_cells);
+// Writes the record (a folder that cannot be written is only a slower next run), then keeps the
+// folder's match files within kMatchCacheBytes, the least recently written first out.
+void WriteMatchRecord(const std::string& path, const Hash128& key, std::int32_t levels,
+                      std::span<const std::uint32_t> cell_labels,
+                      std::span<const ComponentSeeds> components);
+
+}  // namespace dispex::subdiv::matching
