@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
+#include <atomic>
 #include <bit>
 #include <cfloat>
 #include <cmath>
@@ -178,14 +179,27 @@ class BinaryReader {
       const Element& element = header_.elements[e];
       const std::size_t start = pos;
       if (static_cast<int>(e) == layout_.face_element) {
-        DISPEX_RETURN_IF_ERROR(SizeFaces(element, pos, mesh));
+        const bool last = e + 1 == header_.elements.size();
+        if (!last || !LayOutUniformFaces(element, pos, mesh)) {
+          DISPEX_RETURN_IF_ERROR(SizeFaces(element, pos, mesh));
+        }
       } else {
         DISPEX_RETURN_IF_ERROR(Skip(element, pos));
       }
       starts_.push_back(start);
     }
     DISPEX_RETURN_IF_ERROR(ReadVertices(mesh));
-    DISPEX_RETURN_IF_ERROR(ReadFaces(mesh));
+    bool uniform_broken = false;
+    Status faces = ReadFaces(mesh, uniform_broken);
+    if (uniform_broken) {  // a face of another size: walked record by record after all
+      uniform_corners_ = 0;
+      face_block_starts_.clear();
+      std::size_t at = starts_[static_cast<std::size_t>(layout_.face_element)];
+      DISPEX_RETURN_IF_ERROR(
+          SizeFaces(header_.elements[static_cast<std::size_t>(layout_.face_element)], at, mesh));
+      faces = ReadFaces(mesh, uniform_broken);
+    }
+    DISPEX_RETURN_IF_ERROR(faces);
     return mesh;
   }
 
@@ -234,6 +248,38 @@ class BinaryReader {
       }
     }
     return Status::Ok();
+  }
+
+  // Faces as records of one size: the vertex index list alone, every face with the first
+  // face's corner count (a sculpt of quads or triangles). Laid out without a walk over the
+  // records; ReadFaces checks each face's count and says when one differs. False when the first
+  // record, the file's length or the corner total rule it out (SizeFaces then walks, and names
+  // what is wrong).
+  bool LayOutUniformFaces(const Element& element, std::size_t& pos, Mesh& mesh) {
+    if (element.properties.size() != 1 || layout_.indices != 0 || element.count == 0) return false;
+    const Property& list = element.properties[0];
+    const std::size_t count_size = static_cast<std::size_t>(mesh::SizeOf(list.count_type));
+    const std::size_t item_size = static_cast<std::size_t>(mesh::SizeOf(list.type));
+    if (size_ - pos < count_size) return false;
+    const std::int64_t corners = LoadInt(data_ + pos, list.count_type, swap_);
+    if (corners < 3) return false;
+    const std::uint64_t record = count_size + static_cast<std::uint64_t>(corners) * item_size;
+    if ((size_ - pos) / record < element.count ||
+        element.count * static_cast<std::uint64_t>(corners) >
+            std::numeric_limits<std::uint32_t>::max()) {
+      return false;
+    }
+    const std::size_t n = static_cast<std::size_t>(element.count);
+    RunWithThreads(threads_, [&] {
+      AssignTouched(mesh.face_offsets, n + 1, 0u);
+      tbb::parallel_for(std::size_t{0}, n + 1, [&](std::size_t f) {
+        mesh.face_offsets[f] = static_cast<std::uint32_t>(f * static_cast<std::size_t>(corners));
+      });
+    });
+    for (std::size_t f = 0; f < n; f += kBlock) face_block_starts_.push_back(pos + f * record);
+    pos += static_cast<std::size_t>(element.count * record);
+    uniform_corners_ = corners;
+    return true;
   }
 
   // Walks the face records: face sizes into face_offsets, a record start every kBlock faces.
@@ -330,7 +376,9 @@ class BinaryReader {
     return Status::Ok();
   }
 
-  Status ReadFaces(Mesh& mesh) const {
+  // `uniform_broken`: set when the faces were laid out as one size (LayOutUniformFaces) and
+  // one is not; the indices read are then not the file's, and the status means nothing.
+  Status ReadFaces(Mesh& mesh, bool& uniform_broken) const {
     const Element& element = header_.elements[static_cast<std::size_t>(layout_.face_element)];
     const std::size_t n = static_cast<std::size_t>(element.count);
     RunWithThreads(threads_,
@@ -340,6 +388,7 @@ class BinaryReader {
     const std::size_t item_size = static_cast<std::size_t>(mesh::SizeOf(list.type));
     const std::int64_t num_vertices = static_cast<std::int64_t>(layout_.num_vertices);
     FirstError error;
+    std::atomic<bool> broken{false};
     RunWithThreads(threads_, [&] {
       tbb::parallel_for(std::size_t{0}, face_block_starts_.size(), [&](std::size_t b) {
         std::size_t pos = face_block_starts_[b];
@@ -349,6 +398,11 @@ class BinaryReader {
               std::int64_t unused = 0;
               DISPEX_CHECK(StepProperty(element.properties[k], pos, &unused));  // walked before
               continue;
+            }
+            if (uniform_corners_ > 0 &&
+                LoadInt(data_ + pos, list.count_type, swap_) != uniform_corners_) {
+              broken.store(true, std::memory_order_relaxed);
+              return;
             }
             pos += count_size;
             std::int32_t* out = mesh.face_indices.data() + mesh.face_offsets[f];
@@ -368,6 +422,7 @@ class BinaryReader {
         }
       });
     });
+    uniform_broken = broken.load();
     if (error.failed()) return error.status();
     return Status::Ok();
   }
@@ -381,6 +436,7 @@ class BinaryReader {
   bool swap_;
   std::vector<std::size_t> starts_;             // byte offset of each element
   std::vector<std::size_t> face_block_starts_;  // byte offset of face b * kBlock
+  std::int64_t uniform_corners_ = 0;            // LayOutUniformFaces' corners per face, or 0
 };
 
 // ---- ASCII -------------------------------------------------------------------------------

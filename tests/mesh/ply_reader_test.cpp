@@ -287,6 +287,60 @@ TEST(PlyReader, FirstBadIndexAcrossBlocks) {
   }
 }
 
+// Binary faces are laid out as records of the first face's size when they all are; one face of
+// another size anywhere (across blocks of faces) makes the reader walk them record by record,
+// with the same mesh as the ASCII file and the same first error.
+TEST(PlyReader, OneFaceOfAnotherSizeAmongUniformFaces) {
+  const int faces = 200000;
+  for (int odd : {0, 70000, faces - 1}) {
+    for (int bad : {-1, 120000}) {
+      std::vector<Mesh> meshes;
+      std::vector<std::string> errors;
+      for (Fmt f : {Fmt::kAscii, Fmt::kLittle, Fmt::kBig}) {
+        std::string bytes = fmt::format(
+            "ply\nformat {} 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+            "property float z\nelement face {}\nproperty list uchar int vertex_indices\n"
+            "end_header\n",
+            FormatName(f), faces);
+        for (float c : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 1.f, 1.f, 0.f, 0.f, 1.f, 0.f}) {
+          Put(bytes, f, "float", c);
+        }
+        EndRecord(bytes, f);
+        for (int face = 0; face < faces; ++face) {
+          const bool quad = face == odd;
+          Put(bytes, f, "uchar", quad ? 4 : 3);
+          for (int v : {0, 1, 2}) Put(bytes, f, "int", face == bad && v == 2 ? 4 : v);
+          if (quad) Put(bytes, f, "int", 3);
+          EndRecord(bytes, f);
+        }
+        for (int threads : {1, 2}) {
+          StatusOr<Mesh> mesh = ParsePly(bytes, "odd.ply", ReadOptions{threads, 0});
+          if (!mesh.ok()) {
+            errors.push_back(mesh.status().message());
+            continue;
+          }
+          meshes.push_back(std::move(mesh).value());
+        }
+      }
+      if (bad >= 0) {
+        ASSERT_EQ(errors.size(), 6u) << odd << " " << bad;
+        const std::string what =
+            fmt::format(": face {}: vertex index 4 out of range (4 vertices)", bad);
+        for (std::size_t i = 0; i < errors.size(); ++i) {  // ASCII names the line too
+          EXPECT_EQ(errors[i], (i < 2 ? fmt::format("odd.ply:{}", bad + 11) : "odd.ply") + what);
+        }
+        continue;
+      }
+      ASSERT_EQ(meshes.size(), 6u) << odd;
+      EXPECT_EQ(meshes[0].face(static_cast<std::size_t>(odd)).size(), 4u);
+      EXPECT_EQ(meshes[0].face_offsets.back(), static_cast<std::uint32_t>(3 * faces + 1));
+      for (std::size_t i = 1; i < meshes.size(); ++i) {
+        EXPECT_TRUE(testing::SameMesh(meshes[i], meshes[0])) << odd << " " << i;
+      }
+    }
+  }
+}
+
 TEST(PlyReader, AsciiErrorsNameLineAndElement) {
   const std::string header =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
