@@ -7,9 +7,11 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <span>
 #include <string>
+#include <utility>
 
 #include "dispex/version.h"
 #include "extract/incremental/sculpt_face_bounds.h"
@@ -352,27 +354,68 @@ Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
 }
 
 Mesh SculptPart(const Mesh& sculpt, std::span<const std::uint8_t> keep) {
+  // In blocks, in parallel: what each block holds is counted, the blocks' offsets summed in
+  // order, and each block written at its offset, so the part is the one a pass in order makes.
+  constexpr std::size_t kBlock = std::size_t{1} << 16;
+  const std::size_t num_faces = sculpt.num_faces(), num_vertices = sculpt.num_vertices();
+  const auto blocks = [](std::size_t n) { return (n + kBlock - 1) / kBlock; };
+  const auto offsets_of = [](std::vector<std::size_t>& counts) {  // exclusive, in place
+    std::size_t total = 0;
+    for (std::size_t& c : counts) total += std::exchange(c, total);
+    return total;
+  };
+  std::vector<std::uint8_t> used(num_vertices, 0);
+  tbb::parallel_for(std::size_t{0}, blocks(num_faces), [&](std::size_t b) {
+    for (std::size_t s = b * kBlock; s < std::min(num_faces, (b + 1) * kBlock); ++s) {
+      if (!keep[s]) continue;
+      for (std::int32_t v : sculpt.face(s)) {
+        std::atomic_ref<std::uint8_t>(used[static_cast<std::size_t>(v)])
+            .store(1, std::memory_order_relaxed);
+      }
+    }
+  });
+  std::vector<std::size_t> vertex_at(blocks(num_vertices), 0);
+  tbb::parallel_for(std::size_t{0}, vertex_at.size(), [&](std::size_t b) {
+    for (std::size_t v = b * kBlock; v < std::min(num_vertices, (b + 1) * kBlock); ++v) {
+      vertex_at[b] += used[v];
+    }
+  });
   Mesh part;
   part.source = sculpt.source;
-  part.face_offsets.push_back(0);
-  std::vector<std::int32_t> vertex(sculpt.num_vertices(), -1);
-  for (std::size_t s = 0; s < sculpt.num_faces(); ++s) {
-    if (!keep[s]) continue;
-    for (std::int32_t v : sculpt.face(s)) vertex[static_cast<std::size_t>(v)] = 0;
-  }
-  for (std::size_t v = 0; v < vertex.size(); ++v) {
-    if (vertex[v] < 0) continue;
-    vertex[v] = static_cast<std::int32_t>(part.positions.size());
-    part.positions.push_back(sculpt.positions[v]);
-  }
-  part.positions.reserve(part.positions.size() + 1);
-  for (std::size_t s = 0; s < sculpt.num_faces(); ++s) {
-    if (!keep[s]) continue;
-    for (std::int32_t v : sculpt.face(s)) {
-      part.face_indices.push_back(vertex[static_cast<std::size_t>(v)]);
+  const std::size_t part_vertices = offsets_of(vertex_at);
+  part.positions.reserve(part_vertices + 1);  // Embree reads 16 bytes at the last vertex
+  part.positions.resize(part_vertices);
+  std::vector<std::int32_t> vertex(num_vertices, -1);
+  tbb::parallel_for(std::size_t{0}, vertex_at.size(), [&](std::size_t b) {
+    std::size_t next = vertex_at[b];
+    for (std::size_t v = b * kBlock; v < std::min(num_vertices, (b + 1) * kBlock); ++v) {
+      if (!used[v]) continue;
+      vertex[v] = static_cast<std::int32_t>(next);
+      part.positions[next++] = sculpt.positions[v];
     }
-    part.face_offsets.push_back(static_cast<std::uint32_t>(part.face_indices.size()));
-  }
+  });
+  std::vector<std::size_t> face_at(blocks(num_faces), 0), corner_at(blocks(num_faces), 0);
+  tbb::parallel_for(std::size_t{0}, face_at.size(), [&](std::size_t b) {
+    for (std::size_t s = b * kBlock; s < std::min(num_faces, (b + 1) * kBlock); ++s) {
+      if (!keep[s]) continue;
+      ++face_at[b];
+      corner_at[b] += sculpt.face_size(s);
+    }
+  });
+  const std::size_t part_faces = offsets_of(face_at), part_corners = offsets_of(corner_at);
+  part.face_offsets.resize(part_faces + 1);
+  part.face_offsets[part_faces] = static_cast<std::uint32_t>(part_corners);
+  part.face_indices.resize(part_corners);
+  tbb::parallel_for(std::size_t{0}, face_at.size(), [&](std::size_t b) {
+    std::size_t face = face_at[b], corner = corner_at[b];
+    for (std::size_t s = b * kBlock; s < std::min(num_faces, (b + 1) * kBlock); ++s) {
+      if (!keep[s]) continue;
+      part.face_offsets[face++] = static_cast<std::uint32_t>(corner);
+      for (std::int32_t v : sculpt.face(s)) {
+        part.face_indices[corner++] = vertex[static_cast<std::size_t>(v)];
+      }
+    }
+  });
   return part;
 }
 
