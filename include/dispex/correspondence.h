@@ -39,9 +39,8 @@ struct MatchOptions {
   // Fill SculptCorrespondence::face_ptex, face_cell and face_rotation (cell_labels holds the
   // same facts by cell; without the tables the match needs 9 bytes per sculpt face less).
   bool face_tables = true;
-  // Fill SculptCorrespondence::vertex_uvs (8 bytes per sculpt vertex; vertex_faces is always
-  // filled).
-  bool vertex_uvs = true;
+  // Fill SculptCorrespondence::vertex_faces and vertex_uvs (12 bytes per sculpt vertex).
+  bool vertex_homes = true;
   // A sculpt whose every face winds the other way from the cage's (flipped normals), and which
   // reversed is the cage refined, matches: SculptCorrespondence::reversed is set and the result
   // is that of the sculpt after ReverseWinding, which the caller applies to it before using
@@ -70,8 +69,8 @@ struct SculptCorrespondence {
   std::vector<std::int32_t> grid_sizes;  // per Ptex face: n
 
   // Per sculpt vertex: one home, in the first Ptex face (by id) whose grid holds it, and its
-  // (u, v) there (2 floats per vertex, exact: multiples of 1 / n; empty unless
-  // MatchOptions::vertex_uvs).
+  // (u, v) there (2 floats per vertex, exact: multiples of 1 / n). Empty unless
+  // MatchOptions::vertex_homes.
   std::vector<PtexFaceId> vertex_faces;
   std::vector<float> vertex_uvs;
 

@@ -111,7 +111,7 @@ Status MatchVectorSculpt(const ExtractOptions& options, ExtractInputs& inputs,
   Stopwatch clock;
   MatchOptions match;
   match.threads = report.settings.threads;
-  match.vertex_uvs = false;
+  match.vertex_homes = false;
   DISPEX_ASSIGN_OR_RETURN(match.max_offset, OffsetBound(options, report.inputs.base_diagonal));
   auto correspondence = MatchSculpt(options, match, inputs, report);
   if (!correspondence.ok()) {

@@ -71,10 +71,12 @@ Status Matcher::RunSteps() {
   DISPEX_RETURN_IF_ERROR(CheckInputs());
   DISPEX_RETURN_IF_ERROR(FindLevel());
   FindBaseComponents();
-  if (TakeKeptMatch()) {
+  if (std::optional<MatchRecord> kept = KeptMatch()) {
     labelling_ = true;
-    DISPEX_RETURN_IF_ERROR(FindHomes());
-    return CheckPositions();
+    out_.labelling_from_cache = true;
+    GridsFromCells(std::move(kept->cell_labels));
+    if (options_.vertex_homes) DISPEX_RETURN_IF_ERROR(FindHomes());
+    return CheckPositions(&kept->checks);
   }
   DISPEX_ASSIGN_OR_RETURN(adjacency_, subdiv::CachedQuadAdjacency(
                                           sculpt_, options_.cache_dir, out_.adjacency_from_cache,
@@ -93,48 +95,58 @@ Status Matcher::RunSteps() {
   DISPEX_RETURN_IF_ERROR(CheckFaces());
   DISPEX_RETURN_IF_ERROR(CheckSeams());
   DISPEX_RETURN_IF_ERROR(FindHomes());
-  DISPEX_RETURN_IF_ERROR(CheckPositions());
+  DISPEX_RETURN_IF_ERROR(CheckPositions(nullptr));
   KeepMatch();
+  if (!options_.vertex_homes) out_.vertex_faces = {};
   return Status::Ok();
 }
 
 // ---- A match kept in the cache folder ----------------------------------------------------
 
-// What the kept match depends on besides the positions: the sculpt's faces, the cage's
-// topology and Ptex faces, the limit points and normals of its vertices (the seeds' scores),
-// the level, the offset limit, and the version (the rules).
+// What the kept match depends on besides the sculpt's positions: the sculpt's faces; the cage's
+// topology, Ptex faces and limit surface (positions, tags, scheme and approximation options),
+// and the limit points and normals of its vertices (the seeds' scores); the level, the offset
+// limit, and the version (the rules).
 Hash128 Matcher::MatchKey() const {
   Hasher h;
-  h.Add(std::string_view("dispex match record 1")).Add(std::string_view(Version()));
+  h.Add(std::string_view("dispex match record 2")).Add(std::string_view(Version()));
   h.Add(faces_key_).Add(out_.levels).Add(offset_limit_);
   h.AddArray(std::span<const std::int32_t>(s_.first_ptex));
   h.AddArray(std::span<const std::uint8_t>(s_.ptex_hole));
   h.AddArray(std::span<const PtexAdjacency>(s_.adjacency));
+  h.AddArray(std::span<const double>(s_.positions));
   const auto& level = s_.refiner->GetLevel(0);
   for (int f = 0; f < s_.num_base_faces(); ++f) {
     const auto vertices = level.GetFaceVertices(f);
     h.AddArray(std::span<const int>(&vertices[0], static_cast<std::size_t>(vertices.size())));
   }
+  for (int e = 0; e < level.GetNumEdges(); ++e) h.Add(level.GetEdgeSharpness(e));
+  for (int v = 0; v < level.GetNumVertices(); ++v) h.Add(level.GetVertexSharpness(v));
+  const auto scheme = s_.refiner->GetSchemeOptions();
+  h.Add(static_cast<int>(scheme.GetVtxBoundaryInterpolation()))
+      .Add(static_cast<int>(scheme.GetCreasingMethod()))
+      .Add(static_cast<int>(scheme.GetTriangleSubdivision()));
+  h.Add(s_.options.approx_level_smooth)
+      .Add(s_.options.approx_level_sharp)
+      .Add(s_.options.regular_fast_path);
   h.AddArray(std::span<const Vec3d>(base_limit_)).AddArray(std::span<const Vec3d>(base_normal_));
   return h.Digest();
 }
 
-bool Matcher::TakeKeptMatch() {
-  if (options_.cache_dir.empty() || !sculpt_.all_quads()) return false;
+std::optional<MatchRecord> Matcher::KeptMatch() {
+  if (options_.cache_dir.empty() || !sculpt_.all_quads()) return std::nullopt;
   // A cage whose limit points cannot be evaluated fails where a match without a cache does.
   if (!EvaluateBaseVertices().ok()) {
     base_limit_.clear();
-    return false;
+    return std::nullopt;
   }
   faces_key_ = SculptFacesKey(sculpt_);
   match_key_ = MatchKey();
   logging_ = true;
   std::optional<MatchRecord> kept = ReadMatchRecord(MatchRecordPath(options_.cache_dir, match_key_),
                                                     match_key_, sculpt_.num_faces());
-  if (!kept || !SeedsStillChosen(*kept)) return false;
-  GridsFromCells(std::move(kept->cell_labels));
-  out_.labelling_from_cache = true;
-  return true;
+  if (!kept || !SeedsStillChosen(*kept) || !ChecksFitTheGrids(kept->checks)) return std::nullopt;
+  return kept;
 }
 
 // Kept when every component's seeding was logged (a match that failed a seeding and found its
@@ -142,7 +154,7 @@ bool Matcher::TakeKeptMatch() {
 void Matcher::KeepMatch() const {
   if (!logging_ || seed_logs_.size() != components_.size()) return;
   WriteMatchRecord(MatchRecordPath(options_.cache_dir, match_key_), match_key_, out_.levels,
-                   out_.cell_labels, seed_logs_);
+                   out_.cell_labels, seed_logs_, checks_);
 }
 
 // ---- 1. Inputs and level ------------------------------------------------------------------

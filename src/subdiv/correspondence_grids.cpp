@@ -14,6 +14,7 @@
 
 #include "core/check.h"
 #include "core/first_touch.h"
+#include "core/hash128.h"
 #include "subdiv/correspondence_matcher.h"
 
 namespace dispex::subdiv::matching {
@@ -31,6 +32,16 @@ constexpr int kCheckedLines = 8;
 [[gnu::cold, gnu::noinline]] void RecordError(FirstError& error, std::int64_t index,
                                               std::string message) {
   error.Record(index, Status::Error(std::move(message)));
+}
+
+// The points of a grid of size n the position check reads, row by row: every point of grids up
+// to kCheckedLines, else those on every (n / kCheckedLines)-th row and column.
+template <class Visit>
+void ForEachLatticePoint(int n, Visit&& visit) {
+  const int step = n <= kCheckedLines ? 1 : n / kCheckedLines;
+  for (int j = 0; j <= n && n > 0; ++j) {
+    for (int i = 0; i <= n; i += (j % step == 0) ? 1 : step) visit(i, j);
+  }
 }
 
 }  // namespace
@@ -281,7 +292,7 @@ Status Matcher::FindHomes() {
   const std::size_t num_vertices = sculpt_.num_vertices();
   constexpr std::int32_t kNone = std::numeric_limits<std::int32_t>::max();
   AssignTouched(out_.vertex_faces, num_vertices, PtexFaceId(kNone));
-  if (options_.vertex_uvs) AssignTouched(out_.vertex_uvs, 2 * num_vertices, 0.0f);
+  if (options_.vertex_homes) AssignTouched(out_.vertex_uvs, 2 * num_vertices, 0.0f);
   // Row by row; with `borders_only`, the points on the grid's border only.
   const auto each_grid_point = [&](bool borders_only, auto&& visit) {
     tbb::parallel_for(tbb::blocked_range<int>(0, cage_.num_ptex_faces()),
@@ -300,7 +311,7 @@ Status Matcher::FindHomes() {
                       });
   };
   const auto set_uv = [&](int n, int i, int j, std::int32_t v) {
-    if (!options_.vertex_uvs) return;
+    if (!options_.vertex_homes) return;
     out_.vertex_uvs[2 * static_cast<std::size_t>(v)] = static_cast<float>(i) / n;
     out_.vertex_uvs[2 * static_cast<std::size_t>(v) + 1] = static_cast<float>(j) / n;
   };
@@ -315,7 +326,7 @@ Status Matcher::FindHomes() {
     while (p < current && !home.compare_exchange_weak(current, p, std::memory_order_relaxed)) {
     }
   });
-  if (options_.vertex_uvs) {
+  if (options_.vertex_homes) {
     each_grid_point(true, [&](int p, int n, int i, int j, bool border, std::int32_t v) {
       if (border && out_.vertex_faces[v].value == p) set_uv(n, i, j, v);
     });
@@ -329,28 +340,79 @@ Status Matcher::FindHomes() {
   return Status::Ok();
 }
 
-Status Matcher::CheckPositions() {
+std::vector<std::size_t> Matcher::LatticeOffsets() const {
   const int num_ptex = cage_.num_ptex_faces();
-  std::vector<FaceOffsets> offsets(num_ptex);
+  std::vector<std::size_t> at(static_cast<std::size_t>(num_ptex) + 1, 0);
+  for (int p = 0; p < num_ptex; ++p) {
+    std::size_t points = 0;
+    ForEachLatticePoint(cage_.grid_size(p), [&](int, int) { ++points; });
+    at[p + 1] = at[p] + points;
+  }
+  return at;
+}
+
+bool Matcher::ChecksFitTheGrids(const PositionChecks& checks) const {
+  const auto num_ptex = static_cast<std::size_t>(cage_.num_ptex_faces());
+  if (checks.lattice_keys.size() != num_ptex || checks.own.size() != LatticeOffsets().back()) {
+    return false;
+  }
+  return std::all_of(checks.worst.begin(), checks.worst.end(), [&](std::int32_t v) {
+    return v >= -1 && (v < 0 || static_cast<std::size_t>(v) < sculpt_.num_vertices());
+  });
+}
+
+Status Matcher::CheckPositions(const PositionChecks* kept) {
+  const int num_ptex = cage_.num_ptex_faces();
+  const auto faces = static_cast<std::size_t>(num_ptex);
+  PositionChecks& now = checks_;
+  now.max.assign(faces, -1);
+  now.sum_squares.assign(faces, 0);
+  now.worst.assign(faces, -1);
+  now.count.assign(faces, 0);
+  // What a match run whole keeps for the next (KeepMatch), and what a kept one compares.
+  const bool keep = logging_ && kept == nullptr;
+  const std::vector<std::size_t> lattice_at =
+      keep || kept != nullptr ? LatticeOffsets() : std::vector<std::size_t>();
+  now.own.assign(keep ? lattice_at.back() : 0, 0);
+  now.lattice_keys.assign(keep ? faces : 0, Hash128{});
   FirstError error;
   tbb::parallel_for(tbb::blocked_range<int>(0, num_ptex), [&](const tbb::blocked_range<int>& r) {
     std::vector<float> uv, xyz;
     std::vector<std::int32_t> vertices;
+    std::vector<Float3> points;
     for (int p = r.begin(); p < r.end(); ++p) {
       const int n = cage_.grid_size(p);
       if (n == 0) continue;
-      const int step = n <= kCheckedLines ? 1 : n / kCheckedLines;
-      uv.clear();
-      vertices.clear();
-      for (int j = 0; j <= n; ++j) {
-        for (int i = 0; i <= n; i += (j % step == 0) ? 1 : step) {
-          const VertexId v = GridVertex(p, {i, j});
-          if (out_.vertex_faces[v.value].value != p) continue;
-          vertices.push_back(v.value);
-          uv.push_back(static_cast<float>(i) / n);
-          uv.push_back(static_cast<float>(j) / n);
+      const auto f = static_cast<std::size_t>(p);
+      if (keep || kept != nullptr) {
+        points.clear();
+        ForEachLatticePoint(n, [&](int i, int j) {
+          points.push_back(sculpt_.positions[GridVertex(p, {i, j}).value]);
+        });
+        const Hash128 key = HashBytes(std::as_bytes(std::span(points)));
+        if (keep) now.lattice_keys[f] = key;
+        if (kept != nullptr && kept->lattice_keys[f] == key) {
+          now.max[f] = kept->max[f];
+          now.sum_squares[f] = kept->sum_squares[f];
+          now.worst[f] = kept->worst[f];
+          now.count[f] = kept->count[f];
+          continue;
         }
       }
+      uv.clear();
+      vertices.clear();
+      std::size_t k = 0;
+      ForEachLatticePoint(n, [&](int i, int j) {
+        const VertexId v = GridVertex(p, {i, j});
+        const bool own = kept != nullptr ? kept->own[lattice_at[f] + k] != 0
+                                         : out_.vertex_faces[v.value].value == p;
+        if (keep) now.own[lattice_at[f] + k] = own ? 1 : 0;
+        ++k;
+        if (!own) return;
+        vertices.push_back(v.value);
+        uv.push_back(static_cast<float>(i) / n);
+        uv.push_back(static_cast<float>(j) / n);
+      });
       if (vertices.empty()) continue;
       xyz.resize(3 * vertices.size());
       Status st = Evaluator().EvaluatePoints(PtexFaceId(p), uv, xyz, {});
@@ -358,39 +420,39 @@ Status Matcher::CheckPositions() {
         error.Record(p, st);
         continue;
       }
-      FaceOffsets& mine = offsets[p];
-      for (std::size_t k = 0; k < vertices.size(); ++k) {
-        const Vec3d limit{xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]};
-        const double d2 = Distance2(Position(vertices[k]), limit);
-        mine.sum_squares += d2;
-        if (d2 > mine.max) {
-          mine.max = d2;
-          mine.worst = vertices[k];
+      for (std::size_t q = 0; q < vertices.size(); ++q) {
+        const Vec3d limit{xyz[3 * q], xyz[3 * q + 1], xyz[3 * q + 2]};
+        const double d2 = Distance2(Position(vertices[q]), limit);
+        now.sum_squares[f] += d2;
+        if (d2 > now.max[f]) {
+          now.max[f] = d2;
+          now.worst[f] = vertices[q];
         }
       }
-      mine.count = vertices.size();
+      now.count[f] = vertices.size();
     }
   });
   if (error.failed()) return error.status();
   double max = -1, sum_squares = 0;
   std::int32_t worst = -1;
-  for (const FaceOffsets& face : offsets) {
-    out_.checked_vertices += face.count;
-    sum_squares += face.sum_squares;
-    if (face.max > max) {
-      max = face.max;
-      worst = face.worst;
+  int worst_face = -1;
+  for (std::size_t f = 0; f < faces; ++f) {
+    out_.checked_vertices += now.count[f];
+    sum_squares += now.sum_squares[f];
+    if (now.max[f] > max) {
+      max = now.max[f];
+      worst = now.worst[f];
+      worst_face = static_cast<int>(f);
     }
   }
   out_.max_offset = std::sqrt(std::max(max, 0.0));
   out_.rms_offset = out_.checked_vertices ? std::sqrt(sum_squares / out_.checked_vertices) : 0;
   out_.worst_vertex = VertexId(worst);
   if (out_.max_offset > offset_limit_) {
-    const PtexFaceId home = out_.vertex_faces[worst];
-    const int n = out_.grid_sizes[home.value];
+    const int n = out_.grid_sizes[worst_face];
     GridPoint at;
     for (int k = 0; k < (n + 1) * (n + 1); ++k) {
-      if (GridVertex(home.value, {k % (n + 1), k / (n + 1)}).value == worst) {
+      if (GridVertex(worst_face, {k % (n + 1), k / (n + 1)}).value == worst) {
         at = {k % (n + 1), k / (n + 1)};
         break;
       }
@@ -399,7 +461,7 @@ Status Matcher::CheckPositions() {
         "{}: the position check failed: vertex {} is {:.6g} from its home on Ptex face {} at "
         "({}, {}), more than max_offset {:.6g} (is the cage the one the sculpt was refined "
         "from, with the same tags?)",
-        where_, worst, out_.max_offset, home.value, static_cast<float>(at.i) / n,
+        where_, worst, out_.max_offset, worst_face, static_cast<float>(at.i) / n,
         static_cast<float>(at.j) / n, offset_limit_));
   }
   return Status::Ok();

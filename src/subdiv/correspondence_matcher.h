@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <tuple>
@@ -98,8 +99,8 @@ class Matcher {
 
   // ---- A match kept in the cache folder (correspondence.cpp, match_cache.h) -----------------
   Hash128 MatchKey() const;
-  // True when the kept match is this sculpt's (its labelling then in place, grids filled).
-  bool TakeKeptMatch();
+  // The kept match when it is this sculpt's.
+  std::optional<MatchRecord> KeptMatch();
   void KeepMatch() const;
 
   // ---- 3. Seeds (correspondence_seeds.cpp) --------------------------------------------------
@@ -183,12 +184,14 @@ class Matcher {
 
   // ---- 6. Homes and positions (correspondence_grids.cpp) ------------------------------------
   Status FindHomes();
-  struct FaceOffsets {
-    double max = -1, sum_squares = 0;
-    std::int32_t worst = -1;
-    std::size_t count = 0;
-  };
-  Status CheckPositions();
+  // The position check, into checks_ and out_. With `kept` (a kept match's checks), a face
+  // whose lattice has the positions it had then takes what was measured there, and the others
+  // are measured with the vertices it owned; otherwise each vertex is measured at its home
+  // (FindHomes).
+  Status CheckPositions(const PositionChecks* kept);
+  // Per Ptex face, where its lattice's points start in PositionChecks::own; the total last.
+  std::vector<std::size_t> LatticeOffsets() const;
+  bool ChecksFitTheGrids(const PositionChecks& checks) const;
 
   bool labelling_ = false;
   // With MatchOptions::cache_dir: the keys, and what step 3 read of the positions and chose.
@@ -196,6 +199,7 @@ class Matcher {
   bool logging_ = false;
   std::vector<ComponentSeeds> seed_logs_;
   ComponentSeeds* met_log_ = nullptr;  // the labelling being tried logs its base vertices here
+  PositionChecks checks_;
   const LimitSurface& surface_;
   const LimitSurface::Impl& s_;
   const Mesh& sculpt_;

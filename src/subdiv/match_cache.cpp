@@ -58,6 +58,16 @@ std::optional<MatchRecord> ReadMatchRecord(const std::string& path, const Hash12
       return std::nullopt;
     }
   }
+  PositionChecks& checks = record.checks;
+  if (!TakeArray(body, at, checks.own) || !TakeArray(body, at, checks.lattice_keys) ||
+      !TakeArray(body, at, checks.max) || !TakeArray(body, at, checks.sum_squares) ||
+      !TakeArray(body, at, checks.worst) || !TakeArray(body, at, checks.count) ||
+      checks.max.size() != checks.lattice_keys.size() ||
+      checks.sum_squares.size() != checks.lattice_keys.size() ||
+      checks.worst.size() != checks.lattice_keys.size() ||
+      checks.count.size() != checks.lattice_keys.size()) {
+    return std::nullopt;
+  }
   if (at != body.size()) return std::nullopt;
   std::error_code ec;
   std::filesystem::last_write_time(path, std::filesystem::file_time_type::clock::now(), ec);
@@ -66,7 +76,7 @@ std::optional<MatchRecord> ReadMatchRecord(const std::string& path, const Hash12
 
 void WriteMatchRecord(const std::string& path, const Hash128& key, std::int32_t levels,
                       std::span<const std::uint32_t> cell_labels,
-                      std::span<const ComponentSeeds> components) {
+                      std::span<const ComponentSeeds> components, const PositionChecks& checks) {
   std::string bytes(kMagic, sizeof(kMagic));
   Append(bytes, key);
   Append(bytes, levels);
@@ -82,6 +92,12 @@ void WriteMatchRecord(const std::string& path, const Hash128& key, std::int32_t 
     AppendArray(bytes, c.met_x);
     Append(bytes, c.chosen);
   }
+  AppendArray(bytes, checks.own);
+  AppendArray(bytes, checks.lattice_keys);
+  AppendArray(bytes, checks.max);
+  AppendArray(bytes, checks.sum_squares);
+  AppendArray(bytes, checks.worst);
+  AppendArray(bytes, checks.count);
   if (!WriteCacheRecord(path, std::move(bytes))) return;
   EvictCacheFiles(std::filesystem::path(path).parent_path().string(), kPrefix, kMatchCacheBytes,
                   path);

@@ -64,7 +64,7 @@ Status ChooseMethod(const ExtractOptions& options, ExtractInputs& inputs, Extrac
   MatchOptions match;
   match.threads = report.settings.threads;
   match.face_tables = false;  // the mapping reads the cells
-  match.vertex_uvs = false;
+  match.vertex_homes = false;
   if (interpolate) {  // the bound vector maps take too
     DISPEX_ASSIGN_OR_RETURN(match.max_offset, OffsetBound(options, report.inputs.base_diagonal));
   }
