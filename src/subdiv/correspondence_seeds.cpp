@@ -325,20 +325,36 @@ std::vector<std::uint32_t> Matcher::ClassVertices(int vertex_class, std::uint64_
 Matcher::CandidateList Matcher::Candidates(std::span<const std::uint32_t> class_vertices,
                                            int w) const {
   using Ranked = std::pair<double, std::uint32_t>;
+  const auto keep_best = [](std::vector<Ranked>& list) {
+    const std::size_t kept = std::min<std::size_t>(list.size(), kCandidates);
+    std::partial_sort(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(kept), list.end());
+    list.resize(kept);
+  };
+  // In blocks (a class may be every vertex), each block's best, then the best of those.
+  constexpr std::size_t kBlock = std::size_t{1} << 16;
+  const std::size_t blocks = (class_vertices.size() + kBlock - 1) / kBlock;
+  std::vector<std::vector<Ranked>> best(blocks);
+  std::vector<Ranked> nearest_of(blocks, Ranked{HUGE_VAL, 0});
+  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+    for (std::size_t k = b * kBlock; k < std::min(class_vertices.size(), (b + 1) * kBlock); ++k) {
+      const std::uint32_t x = class_vertices[k];
+      const auto vertex = static_cast<std::int32_t>(x);
+      const double d2 = Distance2(Position(vertex), base_limit_[w]);
+      nearest_of[b] = std::min(nearest_of[b], Ranked{d2, x});
+      if (d2 > offset_limit_ * offset_limit_) continue;
+      best[b].emplace_back(SeedScore(vertex, w), x);
+    }
+    keep_best(best[b]);
+  });
   std::vector<Ranked> ranked;
   Ranked nearest{HUGE_VAL, 0};
-  for (std::uint32_t x : class_vertices) {
-    const auto vertex = static_cast<std::int32_t>(x);
-    const double d2 = Distance2(Position(vertex), base_limit_[w]);
-    nearest = std::min(nearest, Ranked{d2, x});
-    if (d2 > offset_limit_ * offset_limit_) continue;
-    ranked.emplace_back(SeedScore(vertex, w), x);
+  for (std::size_t b = 0; b < blocks; ++b) {
+    ranked.insert(ranked.end(), best[b].begin(), best[b].end());
+    nearest = std::min(nearest, nearest_of[b]);
   }
-  const std::size_t kept = std::min<std::size_t>(ranked.size(), kCandidates);
-  std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(kept),
-                    ranked.end());
+  keep_best(ranked);
   CandidateList out;
-  for (std::size_t k = 0; k < kept; ++k) out.vertices.push_back(ranked[k].second);
+  for (const Ranked& r : ranked) out.vertices.push_back(r.second);
   if (nearest.first < HUGE_VAL) {
     out.nearest = nearest.second;
     out.nearest_distance = std::sqrt(nearest.first);
