@@ -75,8 +75,7 @@ std::optional<std::string> ReadCacheRecord(const std::string& path, std::string_
   return bytes;
 }
 
-bool WriteCacheRecord(const std::string& path, std::string bytes) {
-  Append(bytes, HashBytes(std::as_bytes(std::span(bytes.data(), bytes.size()))));
+bool WriteCacheFile(const std::string& path, std::span<const std::span<const std::byte>> parts) {
   static std::atomic<unsigned> written{0};  // two runs of one process at once
   const std::string temp =
       path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(written.fetch_add(1));
@@ -84,12 +83,21 @@ bool WriteCacheRecord(const std::string& path, std::string bytes) {
   fs::create_directories(fs::path(path).parent_path(), ec);
   bool ok = false;
   if (std::FILE* f = std::fopen(temp.c_str(), "wb")) {
-    ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    ok = true;
+    for (std::span<const std::byte> part : parts) {
+      ok = ok && std::fwrite(part.data(), 1, part.size(), f) == part.size();
+    }
     ok = std::fclose(f) == 0 && ok;
   }
   if (ok) fs::rename(temp, path, ec);
   if (!ok || ec) fs::remove(temp, ec);
   return ok && !ec;
+}
+
+bool WriteCacheRecord(const std::string& path, std::string bytes) {
+  Append(bytes, HashBytes(std::as_bytes(std::span(bytes.data(), bytes.size()))));
+  const std::span<const std::byte> whole = std::as_bytes(std::span(bytes.data(), bytes.size()));
+  return WriteCacheFile(path, std::span(&whole, 1));
 }
 
 }  // namespace dispex

@@ -2,8 +2,10 @@
 // automatic search distance's rays), kept within a size: the least recently used go first.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -19,9 +21,12 @@ void EvictCacheFiles(const std::string& folder, std::string_view prefix, std::ui
 // both. The file's bytes less the hash (the magic first), or nullopt when it is missing, starts
 // with another magic, or fails its hash (cut short by a crash, or changed).
 std::optional<std::string> ReadCacheRecord(const std::string& path, std::string_view magic);
-// Writes `bytes` (the magic first) and their hash beside `path` and renames the file onto it,
-// without syncing: a file a crash cuts short fails its hash. False when it could not be written
-// (a cache not kept only makes the next run slower).
+// Writes `parts` in order to a file beside `path` (its folder made when missing) and renames
+// that onto it, without syncing: the cache files carry a hash of their content, which a file a
+// crash cuts short fails. False when it could not be written (a cache not kept only makes the
+// next run slower); no temporary file is left then.
+bool WriteCacheFile(const std::string& path, std::span<const std::span<const std::byte>> parts);
+// Writes `bytes` (the magic first) and their hash with WriteCacheFile.
 bool WriteCacheRecord(const std::string& path, std::string bytes);
 
 }  // namespace dispex

@@ -43,8 +43,8 @@ struct ProcessedFaces {
   std::vector<std::uint8_t> copied;  // per Ptex face: its first pass taken from the previous map
   std::vector<std::uint8_t> redone;  // per Ptex face: extracted again by the edge pass
   std::int64_t faces_copied = 0;     // taken from the previous map
-  // The map they were taken from, when its faces are encoded as the new map's: a copied face
-  // the edges did not redo is written still encoded (PreviousMap::EncodedAs).
+  // The map they were taken from: a copied face the edges did not redo is written still
+  // encoded where that map encoded it as the new map does (PreviousMap::EncodedAs).
   const PreviousMap* encoded_like = nullptr;
   // Through the mapping: samples it left undecided and the faces they were in, over every face
   // extracted (the edge pass's too).

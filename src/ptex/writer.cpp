@@ -161,7 +161,9 @@ struct PtexWriter::Impl {
   std::uint32_t WriteFaceBlock(const std::uint8_t* data, std::size_t stride, int ures, int vres,
                                std::vector<std::uint8_t>& split,
                                std::vector<std::uint8_t>& out) const;
-  Status AddMeta(const std::string& key, PtexMetaType type, const void* data, std::size_t bytes);
+  // `finishing`: added by Finish() itself, after which no one else may add.
+  Status AddMeta(const std::string& key, PtexMetaType type, const void* data, std::size_t bytes,
+                 bool finishing = false);
   Status WriteFile();
   // WriteFile's steps, in order.
   std::vector<PtexFaceInfo> CloseUnsetFaces();
@@ -535,7 +537,7 @@ Status PtexWriter::SetConstantFace(PtexFaceId face, const PtexFaceInfo& info,
 // ---- Meta data ----------------------------------------------------------------------------
 
 Status PtexWriter::Impl::AddMeta(const std::string& key, PtexMetaType type, const void* data,
-                                 std::size_t bytes) {
+                                 std::size_t bytes, bool finishing) {
   if (key.empty() || key.size() > 254) {
     return Status::Error(path + ": meta data key '" + key.substr(0, 40) + "' has " +
                          std::to_string(key.size()) + " bytes, must have 1..254");
@@ -552,7 +554,7 @@ Status PtexWriter::Impl::AddMeta(const std::string& key, PtexMetaType type, cons
   item.bytes.assign(p, p + bytes);
   item.large = bytes > kMetaDataThreshold;
   std::lock_guard<std::mutex> lock(meta_mutex);
-  if (finished) return Status::Error(path + ": meta data added after Finish()");
+  if (finished && !finishing) return Status::Error(path + ": meta data added after Finish()");
   UpsertMetaItem(meta, std::move(item));
   return Status::Ok();
 }
@@ -617,13 +619,8 @@ Status PtexWriter::Impl::WriteFile() {
           return Status::Ok();
         }));
     const std::string hex = hasher.Digest().Hex();
-    PtexMetaItem item;
-    item.key = options.level_data_hash_key;
-    item.type = PtexMetaType::kString;
-    item.bytes.assign(hex.begin(), hex.end());
-    item.bytes.push_back(0);
-    std::lock_guard<std::mutex> lock(meta_mutex);
-    UpsertMetaItem(meta, std::move(item));
+    DISPEX_RETURN_IF_ERROR(AddMeta(options.level_data_hash_key, PtexMetaType::kString, hex.c_str(),
+                                   hex.size() + 1, /*finishing=*/true));
   }
   CompressMetaData(sections);
   if (sections.OverSectionLimit()) {

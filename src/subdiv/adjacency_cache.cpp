@@ -1,8 +1,5 @@
 #include "subdiv/adjacency_cache.h"
 
-#include <unistd.h>
-
-#include <atomic>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -78,30 +75,19 @@ bool Read(const std::string& path, const Hash128& key, const Mesh& mesh, QuadAdj
   return ContentHash(key, counts, out) == check;
 }
 
-// Written beside its path and renamed onto it, without syncing: a file cut short by a crash
-// fails its hash and is built again.
+// Written without syncing: a file cut short by a crash fails its hash and is built again.
 void Write(const std::string& path, const Hash128& key, const QuadAdjacency& a) {
   const Counts counts{a.opposite.size(), a.first_half_edge.size()};
   const Hash128 check = ContentHash(key, counts, a);
-  static std::atomic<unsigned> written{0};  // two matches of one process at once
-  const std::string temp =
-      path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(written.fetch_add(1));
-  bool ok = false;
-  {
-    File f(std::fopen(temp.c_str(), "wb"));
-    ok = f && std::fwrite(kMagic, sizeof(kMagic), 1, f.get()) == 1 &&
-         std::fwrite(&key, sizeof(key), 1, f.get()) == 1 &&
-         std::fwrite(&counts, sizeof(counts), 1, f.get()) == 1;
-    for (std::span<const std::byte> part :
-         {Bytes(a.opposite), Bytes(a.first_half_edge), Bytes(a.valence), Bytes(a.boundary)}) {
-      ok = ok && (part.empty() || std::fwrite(part.data(), part.size(), 1, f.get()) == 1);
-    }
-    ok = ok && std::fwrite(&check, sizeof(check), 1, f.get()) == 1;
-    if (f) ok = std::fclose(f.release()) == 0 && ok;
-  }
-  std::error_code ec;
-  if (ok) fs::rename(temp, path, ec);
-  if (!ok || ec) fs::remove(temp, ec);
+  const std::span<const std::byte> parts[] = {std::as_bytes(std::span(kMagic)),
+                                              Bytes(std::span(&key, 1)),
+                                              Bytes(std::span(&counts, 1)),
+                                              Bytes(a.opposite),
+                                              Bytes(a.first_half_edge),
+                                              Bytes(a.valence),
+                                              Bytes(a.boundary),
+                                              Bytes(std::span(&check, 1))};
+  WriteCacheFile(path, parts);
 }
 
 }  // namespace

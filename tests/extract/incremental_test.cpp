@@ -450,20 +450,27 @@ TEST(IncrementalMaps, ASculptFaceOfManyCornersIsKeyedByEveryCorner) {
   EXPECT_NE(testing::MapDifference(old_map, full.output_path, /*faces_only=*/true), "");
 }
 
+// Options extracting a sculpt made from Spot's cage (2 levels of `pattern`, in `dir`) to `output`.
+ExtractOptions SpotSculptOptions(const TempDir& dir, Pattern pattern, const std::string& output) {
+  ExtractOptions o;
+  o.base_path = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
+  o.sculpt_path = dir / "sculpt.obj";
+  o.output_path = output;
+  const auto made =
+      MakeSculpt(testing::SculptOptions(o.base_path, o.sculpt_path, 2, pattern, 0.005));
+  EXPECT_TRUE(made.ok()) << made.status().message();
+  return o;
+}
+
 // Copied faces go to the new map still encoded only when the map before encoded them the same
 // way: after the compression level changed, they are encoded again at the new level (copied
 // as they were, the map would differ from a full extraction), and after that, with the level
 // kept, they are copied still encoded.
 TEST(IncrementalMaps, CopiedFacesAreEncodedAgainWhenTheEncodingChanged) {
   TempDir dir;
-  const std::string base = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
-  const std::string sculpt = dir / "sculpt.obj";
-  ASSERT_TRUE(MakeSculpt(testing::SculptOptions(base, sculpt, 2, Pattern::kDetail, 0.005)).ok());
-  ExtractOptions o;
-  o.base_path = base;
-  o.sculpt_path = sculpt;
+  ExtractOptions o = SpotSculptOptions(dir, Pattern::kDetail, dir / "inc.ptx");
+  const std::string sculpt = o.sculpt_path;
   o.search_distance = {SearchDistanceSpec::Kind::kRelative, 0.01};
-  o.output_path = dir / "inc.ptx";
   o.incremental = true;
   o.cache_dir = dir / "cache";
   for (WatertightEdges watertight : {WatertightEdges::kFilter, WatertightEdges::kOff}) {
@@ -493,13 +500,7 @@ TEST(IncrementalMaps, CopiedFacesAreEncodedAgainWhenTheEncodingChanged) {
 
 TEST(IncrementalMaps, AMapNotWrittenByDispexIsIgnoredWithANotice) {
   TempDir dir;
-  const std::string base = DataPath("meshes/keenan_spot/spot_control_mesh.obj");
-  const std::string sculpt = dir / "sculpt.obj";
-  ASSERT_TRUE(MakeSculpt(testing::SculptOptions(base, sculpt, 2, Pattern::kSmooth, 0.005)).ok());
-  ExtractOptions o;
-  o.base_path = base;
-  o.sculpt_path = sculpt;
-  o.output_path = dir / "full.ptx";
+  ExtractOptions o = SpotSculptOptions(dir, Pattern::kSmooth, dir / "full.ptx");
   ASSERT_TRUE(Extract(o).ok());
   for (const std::string& junk :
        {std::string("not a ptex file"), Slurp(DataPath("ptex/quad_float1.ptx"))}) {
