@@ -472,6 +472,9 @@ struct ExtractReport {
     // Of the faces copied, those the watertight edges extracted again: a neighbour's edge
     // changed.
     std::int64_t faces_copied_redone = 0;
+    // With watertight edges: the shared edges whose first measurement was copied from the
+    // previous map (no face around them changed) instead of measured again.
+    std::int64_t edges_copied = 0;
     // Why faces were extracted again: "no previous map", the previous map's notice, or what
     // changed ("base, sculpt, options: tolerance").
     std::string redo_reason;

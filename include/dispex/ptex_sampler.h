@@ -90,9 +90,14 @@ struct PtexEdgeStep {
 // and `texels` as for PtexMapSampler.
 struct PtexEdgeSteps {
   std::size_t edges = 0, skipped_edges = 0;
+  std::size_t known_edges = 0;                // of `edges`, taken from PtexEdgeMeasure::known
   std::vector<float> per_face, across_faces;  // one |step| per point, in edge order
   std::vector<PtexEdgeStep> edge_max;         // per measured edge its largest step
 };
+// PtexEdgeSteps::edge_max laid out as PtexEdgeMeasure::known reads it, for `num_faces` faces.
+std::vector<double> PtexEdgeStepsByFace(std::span<const PtexEdgeStep> edge_max,
+                                        std::size_t num_faces);
+
 // Edges between two faces not in `skip_faces` of which at least one is in `touching`, each
 // counted once (e.g. the edges a measurement left out because a face's data is not held).
 std::size_t CountEdgesTouching(std::span<const PtexFaceInfo> faces,
@@ -104,6 +109,13 @@ struct PtexEdgeMeasure {
   bool keep_points = true;  // fill PtexEdgeSteps::per_face / across_faces
   // Empty: every edge. Else only the edges with a flagged face on either side (one per face).
   std::span<const std::uint8_t> only_faces;
+  // Steps an earlier measurement of the same faces gave: per face, per edge e of it, per_face
+  // and across_faces at [8 face + 2 e] and [8 face + 2 e + 1] (NaN where it measured none,
+  // PtexEdgeStepsByFace). An edge with neither side flagged in `changed` (one per face: the
+  // faces whose edges may step otherwise now, with every face around their corners) takes
+  // them, t = 0, instead of being sampled where they are not NaN (keep_points: no points).
+  std::span<const double> known;
+  std::span<const std::uint8_t> changed;
 };
 PtexEdgeSteps MeasurePtexEdgeSteps(std::span<const PtexFaceInfo> faces,
                                    std::span<const std::vector<float>> texels,
@@ -118,5 +130,12 @@ PtexEdgeSteps MeasurePtexVectorEdgeSteps(
     std::span<const std::vector<std::vector<float>>> components,
     std::span<const std::uint8_t> skip_edges, std::span<const std::uint8_t> skip_faces,
     const PtexEdgeMeasure& measure = {});
+// The faces on either side of the edges MeasurePtex*EdgeSteps samples with these arguments
+// (not those it skips or takes from measure.known), one flag per face: with the faces around
+// their edges' ends, those whose texels it reads.
+std::vector<std::uint8_t> PtexFacesSampled(std::span<const PtexFaceInfo> faces,
+                                           std::span<const std::uint8_t> skip_edges,
+                                           std::span<const std::uint8_t> skip_faces,
+                                           const PtexEdgeMeasure& measure = {});
 
 }  // namespace dispex

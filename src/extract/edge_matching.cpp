@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "dispex/ptex_sampler.h"
+#include "extract/incremental/face_keys.h"
+#include "extract/incremental/previous_map.h"
 #include "extract/parallel_errors.h"
 #include "extract/vector_faces.h"
 
@@ -51,6 +53,7 @@ Status TakeFace(std::size_t f, const ExtractInputs& inputs, const ExtractSetting
   }
   view.faces[f].ulog2 = kept.ulog2;
   view.faces[f].vlog2 = kept.vlog2;
+  if (kept.unread) return Status::Ok();  // until a measurement reads it (LoadFaces)
   const std::size_t channels = view.components.size();
   if (!ComponentsAreChannels(inputs, settings, f)) {
     return VectorObjectComponents(
@@ -74,7 +77,7 @@ Status TakeFace(std::size_t f, const ExtractInputs& inputs, const ExtractSetting
 void ReturnFace(std::size_t f, const ExtractInputs& inputs, const ExtractSettings& settings,
                 ProcessedFaces& processed, EdgeRoundsMap& view) {
   KeptFace& kept = processed.kept[f];
-  if (!kept.kept || !ComponentsAreChannels(inputs, settings, f)) return;
+  if (!kept.kept || kept.unread || !ComponentsAreChannels(inputs, settings, f)) return;
   const std::size_t channels = view.components.size();
   if (channels == 1) {
     kept.texels.swap(view.components[0][f]);
@@ -109,18 +112,53 @@ std::int64_t Texels(const ProcessedFaces& processed, const ExtractInputs& inputs
   for (std::size_t f = 0; f < processed.kept.size(); ++f) {
     if (inputs.surface.is_hole(PtexFaceId(static_cast<int>(f)))) continue;
     const KeptFace& kept = processed.kept[f];
-    total += kept.kept ? static_cast<std::int64_t>(kept.texels.size() /
-                                                   static_cast<std::size_t>(processed.channels))
-                       : 1;
+    total += kept.kept ? std::int64_t{1} << (kept.ulog2 + kept.vlog2) : 1;
   }
   return total;
+}
+
+// The flagged faces and every Ptex face whose base face shares a base vertex with theirs: all
+// the faces around the ends of their edges, whose texels the cross-face reader may take there.
+std::vector<std::uint8_t> WithFacesAround(const ExtractInputs& inputs,
+                                          std::vector<std::uint8_t> flags) {
+  const LimitSurface& surface = inputs.surface;
+  const Mesh& base = inputs.base;
+  std::vector<std::uint8_t> vertex(base.num_vertices(), 0);
+  for (std::size_t f = 0; f < flags.size(); ++f) {
+    if (!flags[f]) continue;
+    const auto b =
+        static_cast<std::size_t>(surface.base_face(PtexFaceId(static_cast<int>(f))).value);
+    for (std::int32_t v : base.face(b)) vertex[static_cast<std::size_t>(v)] = 1;
+  }
+  for (std::size_t f = 0; f < flags.size(); ++f) {
+    if (flags[f]) continue;
+    const auto b =
+        static_cast<std::size_t>(surface.base_face(PtexFaceId(static_cast<int>(f))).value);
+    for (std::int32_t v : base.face(b)) flags[f] |= vertex[static_cast<std::size_t>(v)];
+  }
+  return flags;
+}
+
+// What the previous map lets the first round take: the steps it recorded, for the edges away
+// from the faces whose first pass is not the previous map's (another key, or no previous map).
+FirstRoundBefore StepsBefore(const ExtractInputs& inputs, const ProcessedFaces& faces) {
+  FirstRoundBefore before;
+  if (faces.previous == nullptr || inputs.face_keys == nullptr) return before;
+  before.steps = faces.previous->FirstRoundEdgeSteps(inputs.faces);
+  if (before.steps.empty()) return before;
+  const std::vector<Hash128>& keys = inputs.face_keys->keys;
+  std::vector<std::uint8_t> changed(keys.size(), 0);
+  for (std::size_t f = 0; f < keys.size(); ++f) changed[f] = !faces.previous->SameKey(f, keys[f]);
+  before.changed = WithFacesAround(inputs, std::move(changed));
+  return before;
 }
 
 }  // namespace
 
 Status RaiseEdgeResolutions(const ExtractInputs& inputs, const ExtractSettings& settings,
-                            EdgeRoundsMap& view, const RedoFaces& redo_faces,
-                            ExtractReport& report) {
+                            EdgeRoundsMap& view, const FirstRoundBefore& before,
+                            const LoadFaces& load, const RedoFaces& redo_faces,
+                            std::vector<double>& first_round, ExtractReport& report) {
   const double budget = settings.edge_step_budget;
   const bool per_face = settings.watertight == WatertightEdges::kAll;
   const std::vector<std::uint8_t> sharp = SharpCreaseEdges(inputs.base, inputs.surface);
@@ -135,13 +173,25 @@ Status RaiseEdgeResolutions(const ExtractInputs& inputs, const ExtractSettings& 
   measure.per_face = per_face;
   measure.keep_points = false;
   for (int round = 0;; ++round) {
-    // The first round measures every edge, later ones the edges of the faces just redone.
+    // The first round measures every edge (or takes it from before), later ones the edges of
+    // the faces just redone.
     measure.only_faces = redone;
+    if (round == 0) {
+      measure.known = before.steps;
+      measure.changed = before.changed;
+    } else {
+      measure.known = {};
+      measure.changed = {};
+    }
+    DISPEX_RETURN_IF_ERROR(load(
+        WithFacesAround(inputs, PtexFacesSampled(view.faces, sharp, view.skip_faces, measure))));
     const PtexEdgeSteps steps =
         MeasurePtexVectorEdgeSteps(view.faces, view.components, sharp, view.skip_faces, measure);
     if (round == 0) {
       report.edges.shared = static_cast<std::int64_t>(steps.edges);
       report.edges.sharp = static_cast<std::int64_t>(steps.skipped_edges);
+      report.incremental.edges_copied = static_cast<std::int64_t>(steps.known_edges);
+      first_round = PtexEdgeStepsByFace(steps.edge_max, n);
     }
     for (const PtexEdgeStep& s : steps.edge_max) current[{s.face, s.edge}] = s;
     if (round == kMaxRounds) break;
@@ -235,14 +285,29 @@ Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, Proces
   std::vector<int> all(n);
   std::iota(all.begin(), all.end(), 0);
   DISPEX_RETURN_IF_ERROR(take(all));
+  // Copied faces are read from the previous map once a measurement reads them.
+  auto load = [&](std::span<const std::uint8_t> flags) {
+    std::vector<int> unread;
+    for (std::size_t f = 0; f < n; ++f) {
+      if (flags[f] && faces.kept[f].unread) unread.push_back(static_cast<int>(f));
+    }
+    return ForEachFace(
+        static_cast<int>(unread.size()), [&](int k) { return unread[static_cast<std::size_t>(k)]; },
+        scratches, nullptr,
+        [&](PtexFaceId face, FaceScratch& w) {
+          const auto f = static_cast<std::size_t>(face.value);
+          DISPEX_RETURN_IF_ERROR(faces.previous->ReadTexels(f, faces.kept[f]));
+          return TakeFace(f, inputs, settings, faces, w, view);
+        });
+  };
   const Status raised = RaiseEdgeResolutions(
-      inputs, settings, view,
+      inputs, settings, view, StepsBefore(inputs, faces), load,
       [&](std::span<const int> redo, std::span<const std::array<int, 2>> least, EdgeRoundsMap&) {
         for (int f : redo) ReturnFace(static_cast<std::size_t>(f), inputs, settings, faces, view);
         DISPEX_RETURN_IF_ERROR(ReprocessFaces(inputs, settings, redo, least, faces));
         return take(redo);
       },
-      report);
+      faces.first_round_edge_steps, report);
   DISPEX_RETURN_IF_ERROR(raised);
   for (std::size_t f = 0; f < n; ++f) ReturnFace(f, inputs, settings, faces, view);
   return Status::Ok();

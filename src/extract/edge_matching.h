@@ -30,6 +30,17 @@ struct EdgeRoundsMap {
 using RedoFaces =
     std::function<Status(std::span<const int> faces, std::span<const std::array<int, 2>> least_log2,
                          EdgeRoundsMap& map)>;
+// Brings into the map the texels of the flagged faces (one flag per face) where it does not
+// hold them yet: a map may hold only those a measurement reads.
+using LoadFaces = std::function<Status(std::span<const std::uint8_t> faces)>;
+
+// What the first round may take from the run before (PtexEdgeMeasure::known and changed):
+// per face its edges' first-round steps then (empty: none), and the faces whose edges may step
+// otherwise now.
+struct FirstRoundBefore {
+  std::span<const double> steps;
+  std::vector<std::uint8_t> changed;
+};
 
 // In rounds: measure every shared edge (MeasurePtexVectorEdgeSteps: a vector map's step is the
 // length of the step of D); for each edge over settings.edge_step_budget, raise the resolution
@@ -40,14 +51,21 @@ using RedoFaces =
 // their finest sampling (settings.max_samples_log2), is left as it is and counted. Edges on
 // infinitely sharp creases and faces in map.skip_faces are not held. Fills the report's edge
 // fields but texels_before_edges and the discontinuous ones. Deterministic: decisions depend
-// only on the texels.
+// only on the texels. The first round takes the steps of the edges `before` holds for it
+// instead of measuring them; `first_round` gets that round's steps (PtexEdgeStepsByFace).
+// Before each measurement, `load` is given the faces it reads.
 Status RaiseEdgeResolutions(const ExtractInputs& inputs, const ExtractSettings& settings,
-                            EdgeRoundsMap& map, const RedoFaces& redo, ExtractReport& report);
+                            EdgeRoundsMap& map, const FirstRoundBefore& before,
+                            const LoadFaces& load, const RedoFaces& redo,
+                            std::vector<double>& first_round, ExtractReport& report);
 
 // RaiseEdgeResolutions for the kept faces (ProcessFaces), raised faces run again by
 // ReprocessFaces. A vector map's edges are measured on D in object space (its channels, or
 // VectorObjectComponents for tangent and parametric maps); faces whose data may jump
-// (ListDiscontinuousFaces) are not held.
+// (ListDiscontinuousFaces) are not held. Faces copied from the previous map are read from it
+// only where a measurement reads them; the edges among faces whose first pass is the previous
+// map's (same key), away from the faces that changed, take the steps that map recorded
+// (PreviousMap::FirstRoundEdgeSteps). faces.first_round_edge_steps gets the first round's.
 Status MatchEdges(ExtractInputs& inputs, const ExtractSettings& settings, ProcessedFaces& faces,
                   ExtractReport& report);
 

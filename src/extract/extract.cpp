@@ -61,7 +61,8 @@ Status CommitMap(PtexWriter& writer, const ExtractInputs& inputs,
                  ExtractReport& report) {
   Stopwatch clock;
   DISPEX_RETURN_IF_ERROR(AddExtractMetaData(writer, inputs.base, report, face_keys,
-                                            faces.first_pass, faces.edge_means));
+                                            faces.first_pass, faces.edge_means,
+                                            faces.first_round_edge_steps));
   if (CancelRequested()) return Cancelled();
   DISPEX_RETURN_IF_ERROR(writer.Finish());
   report.times.write = clock.seconds();

@@ -122,7 +122,7 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
   // The face's first pass as the previous map holds it: still encoded when the map's faces are
   // encoded as this one's and nothing needs its texels.
   const std::string encoding = PtexEncodingName(writer.options());
-  if (previous != nullptr && previous->usable()) out.encoded_like = previous;
+  if (previous != nullptr && previous->usable()) out.previous = previous;
   auto copy = [&](PtexFaceId face) -> Status {
     const auto f = static_cast<std::size_t>(face.value);
     const FaceRecord& record = previous->record(f);
@@ -130,15 +130,13 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
     out.edge_means[f] = record.edge_means;
     copied[f] = 1;
     if (record.stats.all_missed) return Status::Ok();
-    if (!keep && previous->EncodedAs(f, encoding)) {
-      return WriteEncoded(writer, inputs, *previous, face);
-    }
-    KeptFace kept;
-    DISPEX_RETURN_IF_ERROR(previous->ReadTexels(f, kept));
     if (keep) {
-      out.kept[f] = std::move(kept);
+      previous->KeepUnread(f, out.kept[f]);
       return Status::Ok();
     }
+    if (previous->EncodedAs(f, encoding)) return WriteEncoded(writer, inputs, *previous, face);
+    KeptFace kept;
+    DISPEX_RETURN_IF_ERROR(previous->ReadTexels(f, kept));
     return WriteTexels(writer, inputs, face, kept.ulog2, kept.vlog2, kept.texels);
   };
   auto process = [&](PtexFaceId face, FaceScratch& w) -> Status {
@@ -260,7 +258,7 @@ Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
 Status WriteKeptFaces(PtexWriter& writer, const ExtractInputs& inputs,
                       const ProcessedFaces& processed) {
   const int num_faces = inputs.surface.num_ptex_faces();
-  const PreviousMap* previous = processed.encoded_like;
+  const PreviousMap* previous = processed.previous;
   const std::string encoding = PtexEncodingName(writer.options());
   FirstError error;
   tbb::parallel_for(0, num_faces, [&](int f) {
@@ -269,10 +267,17 @@ Status WriteKeptFaces(PtexWriter& writer, const ExtractInputs& inputs,
     if (!kept.kept || error.failed()) return;
     const bool as_copied =
         processed.copied[i] && (processed.redone.empty() || !processed.redone[i]);
-    Status s =
-        as_copied && previous != nullptr && previous->EncodedAs(i, encoding)
-            ? WriteEncoded(writer, inputs, *previous, PtexFaceId(f))
-            : WriteTexels(writer, inputs, PtexFaceId(f), kept.ulog2, kept.vlog2, kept.texels);
+    Status s;
+    if (as_copied && previous != nullptr && previous->EncodedAs(i, encoding)) {
+      s = WriteEncoded(writer, inputs, *previous, PtexFaceId(f));
+    } else if (kept.unread) {
+      KeptFace read;
+      s = previous->ReadTexels(i, read);
+      if (s.ok())
+        s = WriteTexels(writer, inputs, PtexFaceId(f), read.ulog2, read.vlog2, read.texels);
+    } else {
+      s = WriteTexels(writer, inputs, PtexFaceId(f), kept.ulog2, kept.vlog2, kept.texels);
+    }
     if (!s.ok()) error.Record(f, s);
   });
   return error.failed() ? error.status() : Status::Ok();

@@ -25,6 +25,7 @@ struct WorkerTotals {
 struct KeptFace {
   std::int8_t ulog2 = 0, vlog2 = 0;
   bool kept = false;          // false: a face that missed entirely (written when filled)
+  bool unread = false;        // copied, its texels still in ProcessedFaces::previous
   std::vector<float> texels;  // ures x vres, or one value for a constant face (per channel)
 };
 
@@ -43,9 +44,13 @@ struct ProcessedFaces {
   std::vector<std::uint8_t> copied;  // per Ptex face: its first pass taken from the previous map
   std::vector<std::uint8_t> redone;  // per Ptex face: extracted again by the edge pass
   std::int64_t faces_copied = 0;     // taken from the previous map
-  // The map they were taken from: a copied face the edges did not redo is written still
+  // The map they were taken from: a kept face's texels are read from it only when the edges
+  // measure them (KeptFace::unread), and a copied face the edges did not redo is written still
   // encoded where that map encoded it as the new map does (PreviousMap::EncodedAs).
-  const PreviousMap* encoded_like = nullptr;
+  const PreviousMap* previous = nullptr;
+  // With watertight edges, per face the first round's steps of its edges
+  // (PtexEdgeStepsByFace), which the map keeps for the next incremental run.
+  std::vector<double> first_round_edge_steps;
   // Through the mapping: samples it left undecided and the faces they were in, over every face
   // extracted (the edge pass's too).
   std::int64_t fallback_samples = 0, fallback_faces = 0;

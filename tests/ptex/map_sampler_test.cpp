@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <span>
 #include <string>
@@ -199,6 +200,69 @@ TEST(PtexEdgeSteps, VectorStepIsTheLengthOfTheComponentsSteps) {
     EXPECT_NEAR(vector.edge_max[e].across_faces, 3 * scalar.edge_max[e].across_faces, 1e-6);
     EXPECT_EQ(vector.edge_max[e].t_across_faces, scalar.edge_max[e].t_across_faces);
   }
+}
+
+// Steps known from before are taken for the edges with no changed face on either side, and
+// those edges only: each taken edge reads its known values back (marked so that a measured one
+// cannot pass for them), every other edge its own measurement, and PtexFacesSampled names the
+// faces of the edges measured. An edge whose known steps are NaN is measured.
+TEST(PtexEdgeSteps, KnownStepsAreTakenForEdgesAwayFromChangedFaces) {
+  std::mt19937 rng(7);
+  std::vector<int> turn(16);
+  std::vector<std::array<int, 2>> res(16);
+  for (int f = 0; f < 16; ++f) {
+    turn[std::size_t(f)] = int(rng() % 4);
+    res[std::size_t(f)] = {int(rng() % 4), int(rng() % 4)};
+  }
+  const Grid g = MakeGrid(4, turn, res, [](double x, double y) { return std::sin(2 * x) * y; });
+  const std::vector<std::uint8_t> none(g.faces.size(), 0);
+  const PtexEdgeSteps all = MeasurePtexEdgeSteps(g.faces, g.texels, none, none);
+  ASSERT_EQ(all.edges, 24u);
+  std::vector<double> known = PtexEdgeStepsByFace(all.edge_max, g.faces.size());
+  std::size_t stored = 0;
+  for (std::size_t i = 0; i < known.size(); ++i) {
+    if (std::isnan(known[i])) continue;
+    known[i] = 100.0 + double(i);  // a step no measurement of this field gives
+    ++stored;
+  }
+  EXPECT_EQ(stored, 2 * all.edge_max.size());
+  const int unknown_face = g.Id(3, 3), unknown_edge = all.edge_max.back().edge;
+  ASSERT_EQ(all.edge_max.back().face, unknown_face - 1);
+  known[8 * std::size_t(unknown_face - 1) + 2 * std::size_t(unknown_edge)] =
+      std::numeric_limits<double>::quiet_NaN();
+
+  std::vector<std::uint8_t> changed(g.faces.size(), 0);
+  changed[std::size_t(g.Id(0, 0))] = changed[std::size_t(g.Id(1, 0))] = 1;
+  PtexEdgeMeasure measure;
+  measure.known = known;
+  measure.changed = changed;
+  const PtexEdgeSteps steps = MeasurePtexEdgeSteps(g.faces, g.texels, none, none, measure);
+  const std::vector<std::uint8_t> sampled = PtexFacesSampled(g.faces, none, none, measure);
+  EXPECT_EQ(steps.edges, 24u);
+  ASSERT_EQ(steps.edge_max.size(), all.edge_max.size());
+  std::vector<std::uint8_t> expect_sampled(g.faces.size(), 0);
+  std::size_t taken = 0;
+  for (std::size_t k = 0; k < steps.edge_max.size(); ++k) {
+    const PtexEdgeStep& s = steps.edge_max[k];
+    const PtexEdgeStep& fresh = all.edge_max[k];
+    ASSERT_EQ(s.face, fresh.face);
+    ASSERT_EQ(s.edge, fresh.edge);
+    const bool near = changed[std::size_t(s.face)] || changed[std::size_t(s.neighbour)];
+    const bool take = !near && !(s.face == unknown_face - 1 && s.edge == unknown_edge);
+    if (take) {
+      ++taken;
+      const std::size_t at = 8 * std::size_t(s.face) + 2 * std::size_t(s.edge);
+      EXPECT_EQ(s.per_face, known[at]) << "edge " << k;
+      EXPECT_EQ(s.across_faces, known[at + 1]) << "edge " << k;
+    } else {
+      EXPECT_EQ(s.per_face, fresh.per_face) << "edge " << k;
+      EXPECT_EQ(s.across_faces, fresh.across_faces) << "edge " << k;
+      expect_sampled[std::size_t(s.face)] = expect_sampled[std::size_t(s.neighbour)] = 1;
+    }
+  }
+  EXPECT_EQ(steps.known_edges, taken);
+  EXPECT_EQ(taken, 24u - 4u - 1u);  // 4 edges touch the two changed faces; one is unknown
+  EXPECT_EQ(sampled, expect_sampled);
 }
 
 // The cage's face table with every face at a random level (rng) or at level 3, sub-faces at 2.

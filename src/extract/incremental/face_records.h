@@ -21,6 +21,10 @@ inline constexpr const char* kVectorFaceRecordsMetaKey = "dispex:vector_face_rec
 // How the map's faces are encoded (PtexEncodingName): a face of a map encoded as the new one
 // is copied into it still encoded.
 inline constexpr const char* kFaceEncodingMetaKey = "dispex:face_encoding";
+// Per face, the first round's steps of its edges when the watertight edges were made
+// (PtexEdgeStepsByFace): an incremental run measures again only the edges near faces that
+// changed.
+inline constexpr const char* kFirstRoundEdgeStepsMetaKey = "dispex:first_round_edge_steps";
 // The hash of the map's face data as it was written (PtexWriterOptions::level_data_hash_key).
 inline constexpr const char* kLevelDataHashMetaKey = "dispex:level_data_hash";
 

@@ -42,6 +42,10 @@ PreviousMap PreviousMap::Open(const std::string& path, std::size_t num_faces, bo
   if (!decoded_keys || !decoded_records) return ignore("has malformed face keys");
   out.keys_ = std::move(*decoded_keys);
   out.records_ = std::move(*decoded_records);
+  if (const PtexMetaItem* steps = file->FindMetaData(kFirstRoundEdgeStepsMetaKey)) {
+    out.first_round_edge_steps_ = steps->AsDouble();
+    if (out.first_round_edge_steps_.size() != 8 * num_faces) out.first_round_edge_steps_.clear();
+  }
   out.AddFile(std::move(*file));
   return out;
 }
@@ -101,12 +105,34 @@ bool PreviousMap::Reusable(std::size_t f, const Hash128& key) const {
   return info.ulog2 == s.ulog2 && info.vlog2 == s.vlog2;
 }
 
+void PreviousMap::KeepUnread(std::size_t f, KeptFace& out) const {
+  const PtexFaceInfo& info = file(f).face_info(PtexFaceId(static_cast<int>(f)));
+  out.ulog2 = info.ulog2;
+  out.vlog2 = info.vlog2;
+  out.kept = out.unread = true;
+  out.texels.clear();
+}
+
+std::span<const double> PreviousMap::FirstRoundEdgeSteps(
+    std::span<const PtexFaceInfo> faces) const {
+  if (first_round_edge_steps_.empty() || files_.size() != 1) return {};
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    const PtexFaceInfo& stored = files_[0].face_info(PtexFaceId(static_cast<int>(f)));
+    if (stored.adjfaces != faces[f].adjfaces || stored.adjedges != faces[f].adjedges ||
+        stored.subface != faces[f].subface) {
+      return {};
+    }
+  }
+  return first_round_edge_steps_;
+}
+
 Status PreviousMap::ReadTexels(std::size_t f, KeptFace& out) const {
   const PtexFaceId face(static_cast<int>(f));
   const PtexFaceInfo& info = file(f).face_info(face);
   out.ulog2 = info.ulog2;
   out.vlog2 = info.vlog2;
   out.kept = true;
+  out.unread = false;
   if (info.ulog2 == 0 && info.vlog2 == 0) {
     out.texels.resize(static_cast<std::size_t>(file(f).header().num_channels));
     file(f).ConstantValue(face, out.texels.data());

@@ -46,6 +46,11 @@ class PreviousMap {
   const FaceRecord& record(std::size_t f) const { return records_[f]; }
   // The face's texels as KeptFace holds them (one value per channel for a constant face).
   Status ReadTexels(std::size_t f, KeptFace& out) const;
+  // The face kept with its resolution, its texels left in the map (KeptFace::unread).
+  void KeepUnread(std::size_t f, KeptFace& out) const;
+  // Per face, the first round's steps of its edges when the map's watertight edges were made
+  // (PtexEdgeStepsByFace), for a map whose faces meet as `faces` say; empty when it has none.
+  std::span<const double> FirstRoundEdgeSteps(std::span<const PtexFaceInfo> faces) const;
   // Whether face f is stored as a writer of `encoding` (PtexEncodingName) would store its
   // texels, so that ReadEncoded's bytes can go to that writer as they are.
   bool EncodedAs(std::size_t f, const std::string& encoding) const {
@@ -64,6 +69,7 @@ class PreviousMap {
   std::vector<std::uint32_t> part_of_;  // per face, its file; empty: one file
   std::vector<Hash128> keys_;
   std::vector<FaceRecord> records_;
+  std::vector<double> first_round_edge_steps_;
   std::string notice_;
 };
 

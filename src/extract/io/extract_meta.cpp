@@ -109,7 +109,8 @@ Hash128 InputsKey(const ExtractReport& report) {
 
 Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractReport& report,
                           std::span<const Hash128> face_keys, std::span<const FaceStats> first_pass,
-                          std::span<const EdgeMeans> edge_means) {
+                          std::span<const EdgeMeans> edge_means,
+                          std::span<const double> first_round_edge_steps) {
   DISPEX_RETURN_IF_ERROR(AddMeshMetaData(writer, base));
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData("dispex:version", report.version));
   if (!report.shape.empty()) {
@@ -144,6 +145,9 @@ Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractRep
   DISPEX_RETURN_IF_ERROR(writer.AddMetaData(
       FaceRecordsMetaKey(channels),
       std::span<const std::int8_t>(EncodeFaceRecords(first_pass, edge_means, channels))));
+  if (!first_round_edge_steps.empty()) {
+    DISPEX_RETURN_IF_ERROR(writer.AddMetaData(kFirstRoundEdgeStepsMetaKey, first_round_edge_steps));
+  }
   if (!vector) return Status::Ok();
   DISPEX_RETURN_IF_ERROR(
       writer.AddMetaData(std::string(kVectorSpaceMetaKey), std::string(VectorSpaceName(*vector))));

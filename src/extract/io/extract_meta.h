@@ -29,11 +29,13 @@ nlohmann::json ExtractStatisticsJson(const ExtractReport& report);
 // ids whose data may jump at their edges; when there are any), and what an incremental
 // extraction re-uses: dispex:inputs_key, dispex:face_keys (16 bytes per face) and
 // dispex:face_records_v1 (each face's first pass; a vector map's dispex:vector_face_records_v1,
-// then its dispex:vector_space, channel names and frame) -- these only when `face_keys` is not
-// empty.
+// then its dispex:vector_space, channel names and frame) and, when the edges were made
+// watertight, dispex:first_round_edge_steps (`first_round_edge_steps`: 8 doubles per face) --
+// these only when `face_keys` is not empty.
 Status AddExtractMetaData(PtexWriter& writer, const Mesh& base, const ExtractReport& report,
                           std::span<const Hash128> face_keys, std::span<const FaceStats> first_pass,
-                          std::span<const EdgeMeans> edge_means);
+                          std::span<const EdgeMeans> edge_means,
+                          std::span<const double> first_round_edge_steps);
 
 // The key of everything the map is made from: version, options, both meshes' content and the
 // names the meta data records.

@@ -24,6 +24,7 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
                         {"faces_copied", r.incremental.faces_copied},
                         {"faces_extracted", r.incremental.faces_extracted},
                         {"faces_copied_redone", r.incremental.faces_copied_redone},
+                        {"edges_copied", r.incremental.edges_copied},
                         {"redo_reason", r.incremental.redo_reason},
                         {"tracer_faces", r.incremental.tracer_faces},
                         {"search_rays_recast", r.incremental.search_rays_recast},
@@ -269,6 +270,10 @@ std::string IncrementalLine(const ExtractReport& r) {
   if (r.incremental.faces_copied_redone > 0) {
     out += fmt::format("; {} copied extracted again for a neighbour's edge",
                        r.incremental.faces_copied_redone);
+  }
+  if (r.incremental.edges_copied > 0) {
+    out += fmt::format("; {} of {} shared edges' steps copied", r.incremental.edges_copied,
+                       r.edges.shared);
   }
   if (r.incremental.tracer_faces > 0) {
     out += fmt::format("; the BVH held the sculpt within reach of {} faces",
