@@ -51,28 +51,23 @@ void EvictCacheFiles(const std::string& folder, std::string_view prefix, std::ui
   }
 }
 
-std::optional<std::string> ReadCacheRecord(const std::string& path, std::string_view magic) {
+std::optional<CacheRecord> ReadCacheRecord(const std::string& path, std::string_view magic) {
   std::error_code ec;
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec) return std::nullopt;
-  std::string bytes(size, '\0');
-  {
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), std::fclose);
-    if (!f || std::fread(bytes.data(), 1, bytes.size(), f.get()) != bytes.size()) {
-      return std::nullopt;
-    }
-  }
+  if (!fs::is_regular_file(path, ec)) return std::nullopt;
+  StatusOr<MappedFile> file = MappedFile::Open(path);
+  if (!file.ok()) return std::nullopt;
+  const std::string_view whole = file->view();
   constexpr std::size_t kCheck = sizeof(Hash128);
-  if (bytes.size() < magic.size() + kCheck || bytes.compare(0, magic.size(), magic) != 0) {
+  if (whole.size() < magic.size() + kCheck || whole.substr(0, magic.size()) != magic) {
     return std::nullopt;
   }
   Hash128 check;
-  std::memcpy(&check, bytes.data() + bytes.size() - kCheck, kCheck);
-  bytes.resize(bytes.size() - kCheck);
+  std::memcpy(&check, whole.data() + whole.size() - kCheck, kCheck);
+  const std::string_view bytes = whole.substr(0, whole.size() - kCheck);
   if (!(HashBytes(std::as_bytes(std::span(bytes.data(), bytes.size()))) == check)) {
     return std::nullopt;
   }
-  return bytes;
+  return CacheRecord{std::move(*file), bytes};
 }
 
 bool WriteCacheFile(const std::string& path, std::span<const std::span<const std::byte>> parts) {

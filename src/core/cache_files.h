@@ -9,6 +9,8 @@
 #include <string>
 #include <string_view>
 
+#include "core/mapped_file.h"
+
 namespace dispex {
 
 // Removes the least recently written files of `folder` named `prefix`... beyond `max_bytes` in
@@ -18,9 +20,15 @@ void EvictCacheFiles(const std::string& folder, std::string_view prefix, std::ui
                      const std::string& keep);
 
 // A cache record file: an 8-byte magic, the record (core/byte_record.h), and the XXH3-128 of
-// both. The file's bytes less the hash (the magic first), or nullopt when it is missing, starts
-// with another magic, or fails its hash (cut short by a crash, or changed).
-std::optional<std::string> ReadCacheRecord(const std::string& path, std::string_view magic);
+// both. Read: the file mapped (never copied whole), and `bytes` its bytes less the hash (the
+// magic first); nullopt when it is missing, starts with another magic, or fails its hash (cut
+// short by a crash, or changed). Cache files are replaced by rename, never rewritten in place,
+// so the mapped bytes stay as they were read.
+struct CacheRecord {
+  MappedFile file;
+  std::string_view bytes;
+};
+std::optional<CacheRecord> ReadCacheRecord(const std::string& path, std::string_view magic);
 // Writes `parts` in order to a file beside `path` (its folder made when missing) and renames
 // that onto it, without syncing: the cache files carry a hash of their content, which a file a
 // crash cuts short fails. False when it could not be written (a cache not kept only makes the

@@ -34,10 +34,10 @@ std::string MatchRecordPath(const std::string& folder, const Hash128& key) {
 
 std::optional<MatchRecord> ReadMatchRecord(const std::string& path, const Hash128& key,
                                            std::size_t num_cells) {
-  const std::optional<std::string> bytes =
+  const std::optional<CacheRecord> read =
       ReadCacheRecord(path, std::string_view(kMagic, sizeof(kMagic)));
-  if (!bytes) return std::nullopt;
-  const std::string_view body(*bytes);
+  if (!read) return std::nullopt;
+  const std::string_view body = read->bytes;
   std::size_t at = sizeof(kMagic);
   Hash128 stored;
   MatchRecord record;

@@ -7,7 +7,9 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
+#include <string_view>
 
 namespace dispex {
 namespace {
@@ -43,8 +45,15 @@ TEST(CacheFiles, LeastRecentlyWrittenGoFirst) {
   fs::remove_all(dir);
 }
 
-// A record reads back as written (a folder made for it); a record cut short, changed in one
-// byte, of another magic or missing reads as none.
+std::optional<std::string> ReadRecord(const std::string& path, std::string_view magic) {
+  const std::optional<CacheRecord> read = ReadCacheRecord(path, magic);
+  if (!read) return std::nullopt;
+  return std::string(read->bytes);
+}
+
+// A record reads back as written (a folder made for it), and stays as it was read when the file
+// is replaced; a record cut short, changed in one byte, of another magic, empty, a folder or
+// missing reads as none.
 TEST(CacheFiles, RecordsReadBackWholeOrNotAtAll) {
   const fs::path dir = fs::path(::testing::TempDir()) / "dispex_cache_records_test";
   fs::remove_all(dir);
@@ -52,19 +61,30 @@ TEST(CacheFiles, RecordsReadBackWholeOrNotAtAll) {
   std::string bytes = "DXTEST01";
   for (int i = 0; i < 1000; ++i) bytes += static_cast<char>(i * 7);
   ASSERT_TRUE(WriteCacheRecord(path, bytes));
-  EXPECT_EQ(ReadCacheRecord(path, "DXTEST01"), bytes);
-  EXPECT_EQ(ReadCacheRecord(path, "DXTEST02"), std::nullopt);
-  EXPECT_EQ(ReadCacheRecord((dir / "missing.bin").string(), "DXTEST01"), std::nullopt);
+  {
+    const std::optional<CacheRecord> read = ReadCacheRecord(path, "DXTEST01");
+    ASSERT_TRUE(read.has_value());
+    EXPECT_EQ(read->bytes, bytes);
+    ASSERT_TRUE(WriteCacheRecord(path, "DXTEST01 another record"));
+    EXPECT_EQ(read->bytes, bytes);
+    EXPECT_EQ(ReadRecord(path, "DXTEST01"), "DXTEST01 another record");
+    ASSERT_TRUE(WriteCacheRecord(path, bytes));
+  }
+  EXPECT_EQ(ReadRecord(path, "DXTEST02"), std::nullopt);
+  EXPECT_EQ(ReadRecord((dir / "missing.bin").string(), "DXTEST01"), std::nullopt);
+  EXPECT_EQ(ReadRecord((dir / "folder").string(), "DXTEST01"), std::nullopt);
+  std::ofstream(dir / "empty.bin").close();
+  EXPECT_EQ(ReadRecord((dir / "empty.bin").string(), "DXTEST01"), std::nullopt);
   const std::uintmax_t size = fs::file_size(path);
   {
     std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
     f.seekp(500);
     f.put('!');
   }
-  EXPECT_EQ(ReadCacheRecord(path, "DXTEST01"), std::nullopt) << "a changed byte";
+  EXPECT_EQ(ReadRecord(path, "DXTEST01"), std::nullopt) << "a changed byte";
   ASSERT_TRUE(WriteCacheRecord(path, bytes));
   fs::resize_file(path, size - 1);
-  EXPECT_EQ(ReadCacheRecord(path, "DXTEST01"), std::nullopt) << "cut short";
+  EXPECT_EQ(ReadRecord(path, "DXTEST01"), std::nullopt) << "cut short";
   // An unwritable place: false, nothing left behind.
   EXPECT_FALSE(WriteCacheRecord((dir / "folder" / "record.bin" / "below.bin").string(), bytes));
   fs::remove_all(dir);

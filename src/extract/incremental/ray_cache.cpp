@@ -193,10 +193,10 @@ std::string RayCachePath(const std::string& folder, const std::string& sculpt_pa
 }
 
 std::optional<RayCache> ReadRayCache(const std::string& path, const Hash128& rays_key) {
-  const std::optional<std::string> bytes =
+  const std::optional<CacheRecord> read =
       ReadCacheRecord(path, std::string_view(kMagic, sizeof(kMagic)));
-  if (!bytes) return std::nullopt;
-  const std::string_view body(*bytes);
+  if (!read) return std::nullopt;
+  const std::string_view body = read->bytes;
   RayCache cache;
   std::size_t at = sizeof(kMagic);
   if (!Take(body, at, cache.rays_key) || !(cache.rays_key == rays_key) ||
