@@ -72,27 +72,31 @@ void Matcher::GridsFromCells(std::vector<Label> cells) {
     AssignTouched(out_.face_cell, num_faces, std::int32_t{-1});
     AssignTouched(out_.face_rotation, num_faces, std::uint8_t{0});
   }
-  tbb::parallel_for(
-      tbb::blocked_range<int>(0, cage_.num_ptex_faces()), [&](const tbb::blocked_range<int>& r) {
-        for (int p = r.begin(); p < r.end(); ++p) {
-          const int n = cage_.grid_size(p);
-          const Label* cell = &cells[static_cast<std::size_t>(cell_offsets_[p])];
-          VertexId* grid = &out_.grid_vertices[out_.grid_offsets[p]];
-          for (int j = 0; j < n; ++j) {
-            for (int i = 0; i < n; ++i) {
-              const Label label = cell[j * n + i];
-              for (int corner = 0; corner < 4; ++corner) {
-                const int gi = i + (corner == 1 || corner == 2), gj = j + (corner >= 2);
-                grid[gj * (n + 1) + gi] = VertexId(VertexAt(label, corner));
-              }
-              if (!options_.face_tables) continue;
-              out_.face_ptex[label / 4] = PtexFaceId(p);
-              out_.face_cell[label / 4] = j * n + i;
-              out_.face_rotation[label / 4] = static_cast<std::uint8_t>(label & 3);
-            }
-          }
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<int>(0, cage_.num_ptex_faces()),
+                    [&](const tbb::blocked_range<int>& r) {
+                      for (int p = r.begin(); p < r.end(); ++p) {
+                        const int n = cage_.grid_size(p);
+                        const Label* cell = &cells[static_cast<std::size_t>(cell_offsets_[p])];
+                        VertexId* grid = &out_.grid_vertices[out_.grid_offsets[p]];
+                        // Each grid vertex from one cell (the cells agree at the corners they
+                        // share: they passed CheckFaces): corner 0 of its own, corners 1-3 along
+                        // the last row and column.
+                        for (int j = 0; j < n; ++j) {
+                          for (int i = 0; i < n; ++i) {
+                            const Label label = cell[j * n + i];
+                            grid[j * (n + 1) + i] = VertexId(VertexAt(label, 0));
+                            if (i == n - 1) grid[j * (n + 1) + n] = VertexId(VertexAt(label, 1));
+                            if (j == n - 1) grid[n * (n + 1) + i] = VertexId(VertexAt(label, 3));
+                            if (i == n - 1 && j == n - 1)
+                              grid[n * (n + 1) + n] = VertexId(VertexAt(label, 2));
+                            if (!options_.face_tables) continue;
+                            out_.face_ptex[label / 4] = PtexFaceId(p);
+                            out_.face_cell[label / 4] = j * n + i;
+                            out_.face_rotation[label / 4] = static_cast<std::uint8_t>(label & 3);
+                          }
+                        }
+                      }
+                    });
   out_.cell_labels = std::move(cells);
 }
 

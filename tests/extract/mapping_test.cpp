@@ -11,6 +11,8 @@
 // still rejects any other triangle (a cell apart is thousands of ulps).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -18,7 +20,9 @@
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <numeric>
 #include <optional>
+#include <random>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -240,6 +244,63 @@ std::size_t PairedAgainstSingleBlocks(const std::string& cage, const std::string
     }
   }
   return differ;
+}
+
+// A face's grid of sculpt vertices read row by row (GridVertices, what the face keys and the
+// vertex displacements read) is the grid vertex by vertex (GridVertex), and every vertex is the
+// same corner of each of the (up to) four cells around it. The sculpt's faces are shuffled and
+// their corners turned, so that cells sit at every rotation: reading the wrong corner of a
+// cell, or a row of the wrong length, fails it.
+TEST(MappingGrids, GridVerticesAreEveryCellsCorners) {
+  TempDir dir;
+  const std::string refined = MakeRefined(dir, Cage("catmark_nonquads.obj"), 3, Pattern::kDetail);
+  auto sculpt = ReadMesh(refined);
+  ASSERT_TRUE(sculpt.ok());
+  std::mt19937 rng(11);
+  std::vector<std::size_t> order(sculpt->num_faces());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::shuffle(order.begin(), order.end(), rng);
+  Mesh turned = *sculpt;
+  turned.face_indices.clear();
+  for (std::size_t f : order) {
+    const auto face = sculpt->face(f);
+    const std::size_t r = rng() % 4;
+    for (std::size_t k = 0; k < 4; ++k) turned.face_indices.push_back(face[(k + r) % 4]);
+  }
+  const std::string path = dir / "turned.obj";
+  ASSERT_TRUE(WriteObj(path, turned).ok());
+  const auto mapped = MapSculpt(Cage("catmark_nonquads.obj"), path);
+  const SculptMapping& mapping = *mapped->mapping;
+  std::array<int, 4> rotations{};
+  std::vector<VertexId> grid;
+  for (int f = 0; f < mapping.num_ptex_faces(); ++f) {
+    const int m = mapping.grid_size(f);
+    if (m == 0) continue;
+    mapping.GridVertices(f, mapped->sculpt, grid);
+    const auto side = static_cast<std::size_t>(m) + 1;
+    ASSERT_EQ(grid.size(), side * side);
+    for (int b = 0; b <= m; ++b) {
+      for (int a = 0; a <= m; ++a) {
+        const VertexId v = grid[static_cast<std::size_t>(b) * side + static_cast<std::size_t>(a)];
+        ASSERT_EQ(v.value, mapping.GridVertex(f, a, b, mapped->sculpt).value)
+            << "face " << f << " vertex " << a << ", " << b;
+        // Cell (i, j)'s corner at (a, b): 0 at (i, j), 1 at (i + 1, j), 2 at (i + 1, j + 1), 3
+        // at (i, j + 1), counted from the cell's rotation.
+        for (int i = std::max(a - 1, 0); i <= std::min(a, m - 1); ++i) {
+          for (int j = std::max(b - 1, 0); j <= std::min(b, m - 1); ++j) {
+            const std::uint32_t cell = mapping.cell(f, i, j);
+            const int k = a == i ? (b == j ? 0 : 3) : (b == j ? 1 : 2);
+            const auto corner = static_cast<std::size_t>(
+                4 * SculptMapping::FaceOf(cell) + ((SculptMapping::RotationOf(cell) + k) & 3));
+            ASSERT_EQ(v.value, mapped->sculpt.face_indices[corner])
+                << "face " << f << " cell " << i << ", " << j << " corner " << k;
+            ++rotations[static_cast<std::size_t>(SculptMapping::RotationOf(cell))];
+          }
+        }
+      }
+    }
+  }
+  for (int r = 0; r < 4; ++r) EXPECT_GT(rotations[std::size_t(r)], 0) << "rotation " << r;
 }
 
 // Rejects a paired kernel that takes a lane's lattice, slots, triangle split or line from the

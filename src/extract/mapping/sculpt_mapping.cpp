@@ -154,15 +154,28 @@ VertexId SculptMapping::GridVertex(int face, int a, int b, const Mesh& sculpt) c
 }
 
 void SculptMapping::GridVertices(int face, const Mesh& sculpt, std::vector<VertexId>& out) const {
-  const int m = grid_size(face);
-  const auto side = static_cast<std::size_t>(m) + 1;
+  // GridVertex row by row: vertex (a, b) is corner 0 of cell (a, b), the last column corner 1
+  // of the row's last cell, the last row corner 3 of the cells below it, (m, m) corner 2.
+  const auto m = static_cast<std::size_t>(grid_size(face));
+  const std::size_t side = m + 1;
   out.resize(side * side);
-  for (int b = 0; b <= m; ++b) {
-    for (int a = 0; a <= m; ++a) {
-      out[static_cast<std::size_t>(b) * side + static_cast<std::size_t>(a)] =
-          GridVertex(face, a, b, sculpt);
-    }
+  const std::uint32_t* cells =
+      cells_.data() + static_cast<std::size_t>(cell_offsets_[static_cast<std::size_t>(face)]);
+  const std::int32_t* corners = sculpt.face_indices.data();
+  auto corner = [&](std::uint32_t c, int k) {
+    return VertexId(corners[4 * static_cast<std::size_t>(FaceOf(c)) +
+                            static_cast<std::size_t>((RotationOf(c) + k) & 3)]);
+  };
+  for (std::size_t b = 0; b < m; ++b) {
+    const std::uint32_t* row = cells + b * m;
+    VertexId* to = out.data() + b * side;
+    for (std::size_t a = 0; a < m; ++a) to[a] = corner(row[a], 0);
+    to[m] = corner(row[m - 1], 1);
   }
+  const std::uint32_t* last = cells + (m - 1) * m;
+  VertexId* to = out.data() + m * side;
+  for (std::size_t a = 0; a < m; ++a) to[a] = corner(last[a], 3);
+  to[m] = corner(last[m - 1], 2);
 }
 
 std::size_t SculptMapping::bytes() const {
