@@ -142,13 +142,20 @@ Status BuildLocalTracer(const ExtractOptions& options, std::vector<std::uint8_t>
                         ExtractInputs& inputs, ExtractReport& report) {
   SetTracerOptions(options, inputs);
   Stopwatch clock;
-  Mesh part = SculptWithinReach(inputs, *inputs.face_keys, traced);
+  // Most faces' samples all hit within the search distance: the sculpt within its reach, and
+  // the retry's only once a face has a miss (WidenToRetryReach). A shard cannot widen: it
+  // releases the rest of the sculpt.
+  const bool first_search = !shard && !inputs.face_keys->first_search_boxes.empty();
+  Mesh part = SculptWithinReach(inputs, *inputs.face_keys, traced, first_search);
   report.times.bvh = clock.seconds();
   report.incremental.tracer_faces = std::count(traced.begin(), traced.end(), 1);
   // A shard needs no more of the sculpt than its part (no stage crosses faces): released
   // before the BVH is built, its memory falls with the shard count.
   if (shard && part.num_faces() > 0) ReleaseSculpt(inputs);
-  return BuildPartTracer(std::move(part), std::move(traced), inputs, report);
+  DISPEX_RETURN_IF_ERROR(BuildPartTracer(std::move(part), std::move(traced), inputs, report));
+  inputs.first_search_only = first_search && inputs.tracer && !inputs.traced.empty();
+  if (inputs.first_search_only) report.tracer += " within the search distance's reach";
+  return Status::Ok();
 }
 
 // Rays over the whole sculpt: one BVH of it when that fits in the memory limit, else the faces
@@ -306,6 +313,9 @@ Status WriteMap(const ExtractOptions& options, ExtractInputs& inputs,
                             inputs.traced_part.num_faces(), report.inputs.sculpt_faces);
     }
     DISPEX_RETURN_IF_ERROR(WriteKeptFaces(writer, inputs, faces));
+  }
+  if (inputs.widened_for_retry) {
+    report.tracer += "; then the retry distance's reach, for faces with samples that missed";
   }
   ListDiscontinuousFaces(inputs, faces, report);
   // The runs' BVHs (a sculpt in parts) are built among the faces, but counted apart.

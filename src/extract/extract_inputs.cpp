@@ -229,20 +229,16 @@ void AddRings(const std::vector<PtexFaceInfo>& faces, int rings, std::vector<int
   }
 }
 
-Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces) {
-  if (inputs.traced.empty()) return Status::Ok();
-  std::vector<int> beyond;
-  for (int f : faces) {
-    if (!inputs.traced[static_cast<std::size_t>(f)]) beyond.push_back(f);
-  }
-  if (beyond.empty()) return Status::Ok();
+namespace {
+
+// The tracer of the sculpt within the whole reach (the retry search's too) of the faces
+// `traced` flags; the whole sculpt's when that is more than half the faces.
+Status TraceWithinReach(ExtractInputs& inputs, std::vector<std::uint8_t> traced) {
   DISPEX_CHECK(inputs.sculpt.num_faces() > 0);  // not after ReleaseSculpt
-  std::vector<std::uint8_t> traced = std::move(inputs.traced);
-  for (int f : beyond) traced[static_cast<std::size_t>(f)] = 1;
-  AddRings(inputs.faces, kLocalRings, std::move(beyond), traced);
-  inputs.widened = true;
-  inputs.tracer.reset();  // before the part it reads
+  inputs.tracer.reset();                        // before the part it reads
   inputs.traced_part = Mesh{};
+  inputs.traced.clear();
+  inputs.first_search_only = false;
   const auto count = static_cast<std::size_t>(std::count(traced.begin(), traced.end(), 1));
   if (2 * count > traced.size() || inputs.face_keys == nullptr) {
     DISPEX_ASSIGN_OR_RETURN(inputs.tracer, MakeEmbreeTracer(inputs.sculpt, inputs.tracer_options));
@@ -255,6 +251,28 @@ Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces) {
       MakeEmbreeTracer(inputs.traced_part.num_faces() > 0 ? inputs.traced_part : inputs.sculpt,
                        inputs.tracer_options));
   return Status::Ok();
+}
+
+}  // namespace
+
+Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces) {
+  if (inputs.traced.empty()) return Status::Ok();
+  std::vector<int> beyond;
+  for (int f : faces) {
+    if (!inputs.traced[static_cast<std::size_t>(f)]) beyond.push_back(f);
+  }
+  if (beyond.empty()) return Status::Ok();
+  std::vector<std::uint8_t> traced = inputs.traced;
+  for (int f : beyond) traced[static_cast<std::size_t>(f)] = 1;
+  AddRings(inputs.faces, kLocalRings, std::move(beyond), traced);
+  inputs.widened = true;
+  return TraceWithinReach(inputs, std::move(traced));
+}
+
+Status WidenToRetryReach(ExtractInputs& inputs) {
+  if (!inputs.first_search_only) return Status::Ok();
+  inputs.widened_for_retry = true;
+  return TraceWithinReach(inputs, inputs.traced);
 }
 
 StatusOr<std::vector<std::vector<int>>> TracedRuns(const ExtractInputs& inputs,

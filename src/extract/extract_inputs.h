@@ -34,6 +34,11 @@ struct ExtractInputs {
   std::vector<std::uint8_t> traced{};
   Mesh traced_part{};    // the part of the sculpt that tracer reads, when it reads a part
   bool widened = false;  // EnsureTraced replaced a part's tracer by a larger one
+  // The part holds the sculpt within reach of the first search only (the search distance, not
+  // the retry's: FaceKeys::first_search_boxes): a face with samples that miss it waits
+  // (FaceResult::needs_tracer) for WidenToRetryReach.
+  bool first_search_only = false;
+  bool widened_for_retry = false;  // WidenToRetryReach did
   TracerOptions tracer_options{};
   // The sculpt as the base refined (ExtractMethod, extract_mapping.h): samples are traced
   // through it, and `tracer` is built only for those it leaves undecided (TraceFallback), over
@@ -107,6 +112,10 @@ void AddRings(const std::vector<PtexFaceInfo>& faces, int rings, std::vector<int
 // reach beyond, a tracer of the part within reach of them, kLocalRings around them and the
 // faces it already served (the whole sculpt's when that is more than half the faces).
 Status EnsureTraced(ExtractInputs& inputs, std::span<const int> faces);
+
+// A part's tracer that holds the first search's reach only (first_search_only) replaced by one of
+// the whole reach of the faces it serves, so that their samples can search the retry distance.
+Status WidenToRetryReach(ExtractInputs& inputs);
 
 // The faces' runs when the sculpt is traced in parts (ExtractInputs::sculpt_parts): `faces` in
 // shard order (ShardOrder, so that a run's faces lie together), cut where the sculpt within

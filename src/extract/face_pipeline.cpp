@@ -128,10 +128,11 @@ void TakeDistances(std::size_t count, FaceScratch& w, FaceStats& stats) {
 // again that far. Returns how many the second search found.
 std::int32_t TraceRays(const Tracer& tracer, const ExtractSettings& settings,
                        std::span<const Float3> origins, std::span<const Float3> normals,
-                       std::span<float> t, std::span<std::uint8_t> flags, FaceScratch& w) {
+                       std::span<float> t, std::span<std::uint8_t> flags, FaceScratch& w,
+                       bool retry) {
   const std::size_t count = origins.size();
   tracer.TraceNormals(origins, normals, settings.query, NormalHits{t, {}, flags}, w.counters);
-  if (!(settings.retry_query.distance > 0)) return 0;
+  if (!retry || !(settings.retry_query.distance > 0)) return 0;
   w.retry_origins.clear();
   w.retry_normals.clear();
   w.retry_index.clear();
@@ -189,8 +190,14 @@ StatusOr<FaceResult> ProcessFace(PtexFaceId face, const ExtractInputs& inputs,
     if (inputs.mapping) {
       r.recovered = TraceMappedSamples(face, n, inputs, settings, count, w, result);
     } else {
+      // A tracer of the first search's reach only answers the retry for no sample: a face
+      // with a miss waits for one of the retry's reach (WidenToRetryReach).
+      const bool first_only = inputs.first_search_only && settings.retry_query.distance > 0;
       r.recovered = TraceRays(*inputs.tracer, settings, AsFloat3(w.positions, count),
-                              AsFloat3(w.normals, count), w.t, w.flags, w);
+                              AsFloat3(w.normals, count), w.t, w.flags, w, !first_only);
+      result.needs_tracer =
+          first_only && std::any_of(w.flags.begin(), w.flags.end(),
+                                    [](std::uint8_t f) { return !(f & HitFlags::kHit); });
     }
     w.cpu_trace += step.seconds();
   }

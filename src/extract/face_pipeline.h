@@ -90,11 +90,12 @@ struct FaceScratch {
   double cpu_limit = 0, cpu_trace = 0, cpu_spectral = 0, cpu_write = 0;  // this thread's seconds
 };
 
-// Rays along +-n from each origin under settings.query; with a retry distance, the samples that
-// missed are searched again that far. Returns how many the second search found.
+// Rays along +-n from each origin under settings.query; with a retry distance (and `retry`), the
+// samples that missed are searched again that far. Returns how many the second search found.
 std::int32_t TraceRays(const Tracer& tracer, const ExtractSettings& settings,
                        std::span<const Float3> origins, std::span<const Float3> normals,
-                       std::span<float> t, std::span<std::uint8_t> flags, FaceScratch& w);
+                       std::span<float> t, std::span<std::uint8_t> flags, FaceScratch& w,
+                       bool retry = true);
 
 // One face of the map: a scalar map's (below), or a vector map's (settings.vector:
 // ProcessVectorFace, vector_faces.h).

@@ -72,6 +72,13 @@ KeptFace Keep(const FaceResult& result, PtexDataType type, int channels) {
   return kept;
 }
 
+// A tracer for the faces that asked for one (FaceResult::needs_tracer): through the mapping, for
+// the samples it left undecided; through rays, of the retry search's reach.
+Status TraceWaiting(ExtractInputs& inputs, std::span<const int> faces) {
+  if (inputs.mapping == nullptr) return WidenToRetryReach(inputs);
+  return TraceFallback(inputs, faces);
+}
+
 }  // namespace
 
 void RoundToDataType(PtexDataType type, std::span<float> texels) {
@@ -177,7 +184,7 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
     if (deferred[static_cast<std::size_t>(f)]) waiting.push_back(f);
   }
   if (status.ok() && !waiting.empty()) {
-    status = TraceFallback(inputs, waiting);
+    status = TraceWaiting(inputs, waiting);
     std::fill(deferred.begin(), deferred.end(), 0);
     if (status.ok()) {
       status = ForEachFace(
@@ -234,7 +241,7 @@ Status ReprocessFaces(ExtractInputs& inputs, const ExtractSettings& settings,
     if (deferred[static_cast<std::size_t>(f)]) waiting.push_back(f);
   }
   if (!waiting.empty()) {
-    DISPEX_RETURN_IF_ERROR(TraceFallback(inputs, waiting));
+    DISPEX_RETURN_IF_ERROR(TraceWaiting(inputs, waiting));
     DISPEX_RETURN_IF_ERROR(ForEachFace(
         static_cast<int>(waiting.size()),
         [&](int k) { return waiting[static_cast<std::size_t>(k)]; }, scratches, nullptr, process));

@@ -293,6 +293,15 @@ TEST_P(Incremental, EveryStepEqualsAFullExtraction) {
     }
   }
 
+  // A bump beyond the search distance, within the retry's: the faces under it miss the first
+  // search, so a tracer of its reach alone is widened to the retry's for them.
+  if (GetParam().local_tracer && GetParam().auto_search_distance) {
+    EditSculptInBall(6, 0.01 * diagonal, 3 * first.settings.search_distance);
+    ExtractReport bumped = Step("a bump beyond the search distance");
+    EXPECT_GT(bumped.sampling.misses_recovered, 0);
+    EXPECT_NE(bumped.tracer.find("retry distance's reach"), std::string::npos) << bumped.tracer;
+  }
+
   // Triangles: the sculpt is no longer the base subdivided, so where the oversampling rule
   // then plans other sample counts the faces are extracted again (a vector map needs the
   // sculpt to be the base refined).

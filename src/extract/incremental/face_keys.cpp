@@ -279,6 +279,9 @@ FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& set
   if (settings.interpolate) return GridFaceKeys(inputs, settings, patches);
   FaceKeys out;
   out.reach_boxes = ReachBoxes(surface, patches, Reach(settings));
+  if (settings.retry_query.distance > settings.query.distance) {
+    out.first_search_boxes = ReachBoxes(surface, patches, settings.query.distance);
+  }
   std::vector<std::uint8_t> skip(num_faces);
   for (std::size_t f = 0; f < num_faces; ++f) skip[f] = surface.is_hole(PtexFaceId(int(f)));
   const std::vector<Hash128> sculpt = SculptReachKeys(inputs.sculpt, out.reach_boxes, skip,
@@ -322,10 +325,11 @@ std::vector<std::uint8_t> SkippedFaces(const LimitSurface& surface,
 }  // namespace
 
 Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
-                       std::span<const std::uint8_t> faces) {
+                       std::span<const std::uint8_t> faces, bool first_search) {
   const LimitSurface& surface = inputs.surface;
   const Mesh& sculpt = inputs.sculpt;
-  const std::vector<Box>& boxes = keys.reach_boxes;
+  const std::vector<Box>& boxes =
+      first_search && !keys.first_search_boxes.empty() ? keys.first_search_boxes : keys.reach_boxes;
   const float half_extent = keys.sculpt_half_extent;
   const std::vector<std::uint8_t> skip = SkippedFaces(surface, faces);
   Mesh part;

@@ -53,6 +53,9 @@ void AddFacePatchKey(Hasher& h, const LimitSurface& surface, std::span<const Bas
 struct FaceKeys {
   std::vector<Hash128> keys;     // per Ptex face
   std::vector<Box> reach_boxes;  // per Ptex face: where its rays can go (empty: no rays)
+  // Per Ptex face, where the rays of its first search can go (the search distance), when the
+  // retry search reaches farther; empty otherwise.
+  std::vector<Box> first_search_boxes;
   float sculpt_half_extent = 0;  // the largest half-size of a sculpt face's bounding box
   // Per Ptex face: the sculpt faces in the grid cells its key sums (about those its rays reach).
   std::vector<std::int64_t> reach_faces;
@@ -61,9 +64,10 @@ FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& set
 
 // The sculpt faces the rays of the flagged Ptex faces can reach (a superset: those ComputeFaceKeys
 // sums for them), their vertices renumbered in ascending order: enough to trace those faces
-// exactly as against the whole sculpt.
+// exactly as against the whole sculpt. `first_search`: those their first search's rays can
+// reach (keys.first_search_boxes; the whole reach when there are none).
 Mesh SculptWithinReach(const ExtractInputs& inputs, const FaceKeys& keys,
-                       std::span<const std::uint8_t> faces);
+                       std::span<const std::uint8_t> faces, bool first_search = false);
 
 // `faces` cut, in their order, into runs whose sculpt within reach -- of the run's faces and
 // `rings` rings of Ptex faces around them, in SculptWithinReach's cells -- holds at most
