@@ -96,6 +96,9 @@ struct SculptCorrespondence {
   // each once, at its home: every vertex of grids up to 8 x 8; on larger grids those on the
   // border and on every (n / 8)-th row and column (a quarter of them on large grids).
   std::size_t checked_vertices = 0;
+  // With labelling_from_cache: the Ptex faces whose checked vertices moved since the match was
+  // kept, measured again (the others take what was measured then).
+  std::size_t faces_checked_again = 0;
   double max_offset = 0, rms_offset = 0;
   VertexId worst_vertex;    // the vertex of max_offset
   double offset_limit = 0;  // the bound in use (MatchOptions::max_offset or its default)

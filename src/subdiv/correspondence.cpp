@@ -76,7 +76,9 @@ Status Matcher::RunSteps() {
     out_.labelling_from_cache = true;
     GridsFromCells(std::move(kept->cell_labels));
     if (options_.vertex_homes) DISPEX_RETURN_IF_ERROR(FindHomes());
-    return CheckPositions(&kept->checks);
+    DISPEX_RETURN_IF_ERROR(CheckPositions(&kept->checks));
+    KeepMatchAgain(*kept);
+    return Status::Ok();
   }
   DISPEX_ASSIGN_OR_RETURN(adjacency_, subdiv::CachedQuadAdjacency(
                                           sculpt_, options_.cache_dir, out_.adjacency_from_cache,
@@ -155,6 +157,13 @@ void Matcher::KeepMatch() const {
   if (!logging_ || seed_logs_.size() != components_.size()) return;
   WriteMatchRecord(MatchRecordPath(options_.cache_dir, match_key_), match_key_, out_.levels,
                    out_.cell_labels, seed_logs_, checks_);
+}
+
+void Matcher::KeepMatchAgain(MatchRecord& kept) {
+  if (16 * out_.faces_checked_again <= static_cast<std::size_t>(cage_.num_ptex_faces())) return;
+  checks_.own = std::move(kept.checks.own);
+  WriteMatchRecord(MatchRecordPath(options_.cache_dir, match_key_), match_key_, out_.levels,
+                   out_.cell_labels, kept.components, checks_);
 }
 
 // ---- 1. Inputs and level ------------------------------------------------------------------

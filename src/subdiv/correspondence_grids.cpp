@@ -378,7 +378,8 @@ Status Matcher::CheckPositions(const PositionChecks* kept) {
   const std::vector<std::size_t> lattice_at =
       keep || kept != nullptr ? LatticeOffsets() : std::vector<std::size_t>();
   now.own.assign(keep ? lattice_at.back() : 0, 0);
-  now.lattice_keys.assign(keep ? faces : 0, Hash128{});
+  now.lattice_keys.assign(keep || kept != nullptr ? faces : 0, Hash128{});
+  std::atomic<std::size_t> checked_again{0};
   FirstError error;
   tbb::parallel_for(tbb::blocked_range<int>(0, num_ptex), [&](const tbb::blocked_range<int>& r) {
     std::vector<float> uv, xyz;
@@ -394,7 +395,7 @@ Status Matcher::CheckPositions(const PositionChecks* kept) {
           points.push_back(sculpt_.positions[GridVertex(p, {i, j}).value]);
         });
         const Hash128 key = HashBytes(std::as_bytes(std::span(points)));
-        if (keep) now.lattice_keys[f] = key;
+        now.lattice_keys[f] = key;
         if (kept != nullptr && kept->lattice_keys[f] == key) {
           now.max[f] = kept->max[f];
           now.sum_squares[f] = kept->sum_squares[f];
@@ -402,6 +403,7 @@ Status Matcher::CheckPositions(const PositionChecks* kept) {
           now.count[f] = kept->count[f];
           continue;
         }
+        if (kept != nullptr) checked_again.fetch_add(1, std::memory_order_relaxed);
       }
       uv.clear();
       vertices.clear();
@@ -437,6 +439,7 @@ Status Matcher::CheckPositions(const PositionChecks* kept) {
     }
   });
   if (error.failed()) return error.status();
+  out_.faces_checked_again = checked_again.load();
   double max = -1, sum_squares = 0;
   std::int32_t worst = -1;
   int worst_face = -1;

@@ -102,6 +102,10 @@ class Matcher {
   // The kept match when it is this sculpt's.
   std::optional<MatchRecord> KeptMatch();
   void KeepMatch() const;
+  // After a kept match was taken: written again with the checks as they are now, when more
+  // than 1/16 of the faces were measured again (so that edits piling up do not make every
+  // later run measure them again).
+  void KeepMatchAgain(MatchRecord& kept);
 
   // ---- 3. Seeds (correspondence_seeds.cpp) --------------------------------------------------
   LimitEvaluator& Evaluator() {
@@ -186,8 +190,8 @@ class Matcher {
   Status FindHomes();
   // The position check, into checks_ and out_. With `kept` (a kept match's checks), a face
   // whose lattice has the positions it had then takes what was measured there, and the others
-  // are measured with the vertices it owned; otherwise each vertex is measured at its home
-  // (FindHomes).
+  // are measured with the vertices it owned (counted in out_.faces_checked_again); otherwise
+  // each vertex is measured at its home (FindHomes).
   Status CheckPositions(const PositionChecks* kept);
   // Per Ptex face, where its lattice's points start in PositionChecks::own; the total last.
   std::vector<std::size_t> LatticeOffsets() const;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
@@ -267,6 +268,7 @@ TEST_P(RefinedSculpts, AKeptMatchIsTheMatchOfTheNewPositions) {
   ASSERT_TRUE(bumped_fresh.ok()) << bumped_fresh.status().message();
   MatchOptions no_homes = cached;
   no_homes.vertex_homes = false;
+  std::size_t checked_again = 0;
   for (const MatchOptions& options : {cached, no_homes}) {
     // The kept match is the one of the sculpt as made: keep it again.
     std::filesystem::remove_all(cached.cache_dir);
@@ -274,7 +276,20 @@ TEST_P(RefinedSculpts, AKeptMatchIsTheMatchOfTheNewPositions) {
     auto bumped_cached = MatchRefinedSculpt(surface, bumped, options);
     ASSERT_TRUE(bumped_cached.ok()) << bumped_cached.status().message();
     ExpectSameMatch(*bumped_cached, *bumped_fresh, "a ball moved", options.vertex_homes);
+    ASSERT_TRUE(bumped_cached->labelling_from_cache);
+    EXPECT_GT(bumped_cached->faces_checked_again, 0u);
+    checked_again = bumped_cached->faces_checked_again;
   }
+  // With more than 1/16 of the faces measured again, the kept match is kept again with the
+  // checks of these positions, so that the same positions once more measure none again; with
+  // fewer the file stays, and they measure the same faces again.
+  auto bumped_again = MatchRefinedSculpt(surface, bumped, no_homes);
+  ASSERT_TRUE(bumped_again.ok()) << bumped_again.status().message();
+  ExpectSameMatch(*bumped_again, *bumped_fresh, "a ball moved, matched again", false);
+  const bool kept_again = 16 * checked_again > static_cast<std::size_t>(surface.num_ptex_faces());
+  EXPECT_EQ(bumped_again->faces_checked_again, kept_again ? 0 : checked_again);
+  std::printf("%s: %zu of %d faces checked again%s\n", GetParam().cage.c_str(), checked_again,
+              surface.num_ptex_faces(), kept_again ? ", kept again" : "");
 }
 
 // A cube refined, its positions turned a quarter about z: the same faces, but every vertex now
