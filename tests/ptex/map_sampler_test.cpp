@@ -160,12 +160,10 @@ TEST(PtexMapSampler, MixedResolutionsKeepConstantsConstant) {
   }
 }
 
-// A vector field's step is the length of its components' steps at each point: components
-// (s, 2s, 2s) of a field s step 3 times as far as s does (the largest component would read 2
-// times, their sum 5), and one component reads as the scalar measure. The grid is turned and of
-// mixed resolutions, so the steps are not zero.
-TEST(PtexEdgeSteps, VectorStepIsTheLengthOfTheComponentsSteps) {
-  std::mt19937 rng(5);
+// A 4 x 4 grid of faces turned and at resolutions drawn from `seed`, holding sin(2x) y: steps
+// that are not zero at its edges.
+Grid TurnedMixedGrid(unsigned seed) {
+  std::mt19937 rng(seed);
   std::vector<int> turn(16);
   std::vector<std::array<int, 2>> res(16);
   for (int f = 0; f < 16; ++f) {
@@ -173,6 +171,15 @@ TEST(PtexEdgeSteps, VectorStepIsTheLengthOfTheComponentsSteps) {
     res[std::size_t(f)] = {int(rng() % 4), int(rng() % 4)};
   }
   const Grid g = MakeGrid(4, turn, res, [](double x, double y) { return std::sin(2 * x) * y; });
+  return g;
+}
+
+// A vector field's step is the length of its components' steps at each point: components
+// (s, 2s, 2s) of a field s step 3 times as far as s does (the largest component would read 2
+// times, their sum 5), and one component reads as the scalar measure. The grid is turned and of
+// mixed resolutions, so the steps are not zero.
+TEST(PtexEdgeSteps, VectorStepIsTheLengthOfTheComponentsSteps) {
+  const Grid g = TurnedMixedGrid(5);
   std::vector<std::vector<std::vector<float>>> components(3, g.texels);
   for (std::size_t c = 1; c < 3; ++c) {
     for (auto& face : components[c]) {
@@ -207,14 +214,7 @@ TEST(PtexEdgeSteps, VectorStepIsTheLengthOfTheComponentsSteps) {
 // cannot pass for them), every other edge its own measurement, and PtexFacesSampled names the
 // faces of the edges measured. An edge whose known steps are NaN is measured.
 TEST(PtexEdgeSteps, KnownStepsAreTakenForEdgesAwayFromChangedFaces) {
-  std::mt19937 rng(7);
-  std::vector<int> turn(16);
-  std::vector<std::array<int, 2>> res(16);
-  for (int f = 0; f < 16; ++f) {
-    turn[std::size_t(f)] = int(rng() % 4);
-    res[std::size_t(f)] = {int(rng() % 4), int(rng() % 4)};
-  }
-  const Grid g = MakeGrid(4, turn, res, [](double x, double y) { return std::sin(2 * x) * y; });
+  const Grid g = TurnedMixedGrid(7);
   const std::vector<std::uint8_t> none(g.faces.size(), 0);
   const PtexEdgeSteps all = MeasurePtexEdgeSteps(g.faces, g.texels, none, none);
   ASSERT_EQ(all.edges, 24u);
