@@ -94,6 +94,17 @@ Status WriteEncoded(PtexWriter& writer, const ExtractInputs& inputs, const Previ
   return writer.SetEncodedFace(face, FaceInfo(inputs, face, encoded.ulog2, encoded.vlog2), encoded);
 }
 
+// A face copied from the previous map as that map holds it: still encoded where it is encoded as
+// `encoding`, else its texels read and encoded again.
+Status WriteCopied(PtexWriter& writer, const ExtractInputs& inputs, const PreviousMap& previous,
+                   PtexFaceId face, const std::string& encoding) {
+  const auto f = static_cast<std::size_t>(face.value);
+  if (previous.EncodedAs(f, encoding)) return WriteEncoded(writer, inputs, previous, face);
+  KeptFace kept;
+  DISPEX_RETURN_IF_ERROR(previous.ReadTexels(f, kept));
+  return WriteTexels(writer, inputs, face, kept.ulog2, kept.vlog2, kept.texels);
+}
+
 PtexFaceInfo FaceInfo(const ExtractInputs& inputs, PtexFaceId face, int ulog2, int vlog2) {
   PtexFaceInfo info = inputs.faces[static_cast<std::size_t>(face.value)];
   info.ulog2 = static_cast<std::int8_t>(ulog2);
@@ -141,10 +152,7 @@ StatusOr<ProcessedFaces> ProcessFaces(ExtractInputs& inputs, const ExtractSettin
       previous->KeepUnread(f, out.kept[f]);
       return Status::Ok();
     }
-    if (previous->EncodedAs(f, encoding)) return WriteEncoded(writer, inputs, *previous, face);
-    KeptFace kept;
-    DISPEX_RETURN_IF_ERROR(previous->ReadTexels(f, kept));
-    return WriteTexels(writer, inputs, face, kept.ulog2, kept.vlog2, kept.texels);
+    return WriteCopied(writer, inputs, *previous, face, encoding);
   };
   auto process = [&](PtexFaceId face, FaceScratch& w) -> Status {
     const auto f = static_cast<std::size_t>(face.value);
@@ -274,17 +282,11 @@ Status WriteKeptFaces(PtexWriter& writer, const ExtractInputs& inputs,
     if (!kept.kept || error.failed()) return;
     const bool as_copied =
         processed.copied[i] && (processed.redone.empty() || !processed.redone[i]);
-    Status s;
-    if (as_copied && previous != nullptr && previous->EncodedAs(i, encoding)) {
-      s = WriteEncoded(writer, inputs, *previous, PtexFaceId(f));
-    } else if (kept.unread) {
-      KeptFace read;
-      s = previous->ReadTexels(i, read);
-      if (s.ok())
-        s = WriteTexels(writer, inputs, PtexFaceId(f), read.ulog2, read.vlog2, read.texels);
-    } else {
-      s = WriteTexels(writer, inputs, PtexFaceId(f), kept.ulog2, kept.vlog2, kept.texels);
-    }
+    // An unread face is a copied one that the edges did not redo.
+    const Status s =
+        kept.unread || (as_copied && previous != nullptr && previous->EncodedAs(i, encoding))
+            ? WriteCopied(writer, inputs, *previous, PtexFaceId(f), encoding)
+            : WriteTexels(writer, inputs, PtexFaceId(f), kept.ulog2, kept.vlog2, kept.texels);
     if (!s.ok()) error.Record(f, s);
   });
   return error.failed() ? error.status() : Status::Ok();

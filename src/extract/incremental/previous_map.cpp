@@ -128,12 +128,9 @@ std::span<const double> PreviousMap::FirstRoundEdgeSteps(
 
 Status PreviousMap::ReadTexels(std::size_t f, KeptFace& out) const {
   const PtexFaceId face(static_cast<int>(f));
-  const PtexFaceInfo& info = file(f).face_info(face);
-  out.ulog2 = info.ulog2;
-  out.vlog2 = info.vlog2;
-  out.kept = true;
+  KeepUnread(f, out);
   out.unread = false;
-  if (info.ulog2 == 0 && info.vlog2 == 0) {
+  if (out.ulog2 == 0 && out.vlog2 == 0) {
     out.texels.resize(static_cast<std::size_t>(file(f).header().num_channels));
     file(f).ConstantValue(face, out.texels.data());
     return Status::Ok();
