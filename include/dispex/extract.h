@@ -475,6 +475,10 @@ struct ExtractReport {
     // With watertight edges: the shared edges whose first measurement was copied from the
     // previous map (no face around them changed) instead of measured again.
     std::int64_t edges_copied = 0;
+    // Interpolated: the Ptex faces whose key of what they read of the sculpt was taken from
+    // cache_dir (none of those sculpt vertices moved since it was kept) instead of gathered
+    // again; -1 when nothing was kept for these grids.
+    std::int64_t fields_kept = -1;
     // Why faces were extracted again: "no previous map", the previous map's notice, or what
     // changed ("base, sculpt, options: tolerance").
     std::string redo_reason;

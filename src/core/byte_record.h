@@ -52,4 +52,19 @@ bool TakeArray(std::string_view bytes, std::size_t& at, std::vector<T>& values) 
   return true;
 }
 
+// Like TakeArray, but the values stay in `bytes` (a mapped file): false where they would not be
+// aligned for T there.
+template <class T>
+requires std::is_trivially_copyable_v<T>
+bool TakeView(std::string_view bytes, std::size_t& at, std::span<const T>& values) {
+  std::uint64_t count = 0;
+  if (!Take(bytes, at, count) || count > (bytes.size() - at) / sizeof(T) ||
+      reinterpret_cast<std::uintptr_t>(bytes.data() + at) % alignof(T) != 0) {
+    return false;
+  }
+  values = std::span<const T>(reinterpret_cast<const T*>(bytes.data() + at), count);
+  at += count * sizeof(T);
+  return true;
+}
+
 }  // namespace dispex

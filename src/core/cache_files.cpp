@@ -90,9 +90,17 @@ bool WriteCacheFile(const std::string& path, std::span<const std::span<const std
 }
 
 bool WriteCacheRecord(const std::string& path, std::string bytes) {
-  Append(bytes, HashBytes(std::as_bytes(std::span(bytes.data(), bytes.size()))));
   const std::span<const std::byte> whole = std::as_bytes(std::span(bytes.data(), bytes.size()));
-  return WriteCacheFile(path, std::span(&whole, 1));
+  return WriteCacheRecord(path, std::span(&whole, 1));
+}
+
+bool WriteCacheRecord(const std::string& path, std::span<const std::span<const std::byte>> parts) {
+  Hasher h;
+  for (std::span<const std::byte> part : parts) h.Add(part);
+  const Hash128 check = h.Digest();
+  std::vector<std::span<const std::byte>> all(parts.begin(), parts.end());
+  all.push_back(std::as_bytes(std::span(&check, 1)));
+  return WriteCacheFile(path, all);
 }
 
 }  // namespace dispex

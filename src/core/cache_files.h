@@ -36,5 +36,7 @@ std::optional<CacheRecord> ReadCacheRecord(const std::string& path, std::string_
 bool WriteCacheFile(const std::string& path, std::span<const std::span<const std::byte>> parts);
 // Writes `bytes` (the magic first) and their hash with WriteCacheFile.
 bool WriteCacheRecord(const std::string& path, std::string bytes);
+// The same of `parts` in order (the magic first), none of them copied.
+bool WriteCacheRecord(const std::string& path, std::span<const std::span<const std::byte>> parts);
 
 }  // namespace dispex

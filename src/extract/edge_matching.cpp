@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "dispex/ptex_sampler.h"
+#include "extract/faces_around.h"
 #include "extract/incremental/face_keys.h"
 #include "extract/incremental/previous_map.h"
 #include "extract/parallel_errors.h"
@@ -115,28 +116,6 @@ std::int64_t Texels(const ProcessedFaces& processed, const ExtractInputs& inputs
     total += kept.kept ? std::int64_t{1} << (kept.ulog2 + kept.vlog2) : 1;
   }
   return total;
-}
-
-// The flagged faces and every Ptex face whose base face shares a base vertex with theirs: all
-// the faces around the ends of their edges, whose texels the cross-face reader may take there.
-std::vector<std::uint8_t> WithFacesAround(const ExtractInputs& inputs,
-                                          std::vector<std::uint8_t> flags) {
-  const LimitSurface& surface = inputs.surface;
-  const Mesh& base = inputs.base;
-  std::vector<std::uint8_t> vertex(base.num_vertices(), 0);
-  for (std::size_t f = 0; f < flags.size(); ++f) {
-    if (!flags[f]) continue;
-    const auto b =
-        static_cast<std::size_t>(surface.base_face(PtexFaceId(static_cast<int>(f))).value);
-    for (std::int32_t v : base.face(b)) vertex[static_cast<std::size_t>(v)] = 1;
-  }
-  for (std::size_t f = 0; f < flags.size(); ++f) {
-    if (flags[f]) continue;
-    const auto b =
-        static_cast<std::size_t>(surface.base_face(PtexFaceId(static_cast<int>(f))).value);
-    for (std::int32_t v : base.face(b)) flags[f] |= vertex[static_cast<std::size_t>(v)];
-  }
-  return flags;
 }
 
 // What the previous map lets the first round take: the steps it recorded, for the edges away

@@ -257,15 +257,14 @@ Status CheckPlacementIfAsked(const ExtractOptions& options, const ExtractInputs&
 }
 
 // What each face is made from (face_keys.h; a vector map's: VectorFaceKeys).
-FaceKeys KeyFaces(const ExtractInputs& inputs, const ExtractSettings& settings,
-                  ExtractReport& report) {
+// An incremental run keeps interpolated faces' field keys in the cache folder (field_keys.h).
+FaceKeys KeyFaces(const ExtractOptions& options, const ExtractInputs& inputs,
+                  const ExtractSettings& settings, ExtractReport& report) {
   Stopwatch clock;
-  FaceKeys keys;
-  if (settings.vector) {
-    keys.keys = VectorFaceKeys(inputs, settings);
-  } else {
-    keys = ComputeFaceKeys(inputs, settings);
-  }
+  const std::string folder = options.incremental ? CacheFolder(options) : std::string();
+  FaceKeys keys = settings.vector ? VectorFaceKeys(inputs, settings, folder)
+                                  : ComputeFaceKeys(inputs, settings, folder);
+  report.incremental.fields_kept = keys.fields_kept;
   report.times.keys = clock.seconds();
   return keys;
 }
@@ -429,7 +428,7 @@ StatusOr<ExtractReport> ExtractShape(const ExtractOptions& options, ExtractInput
   }
   DISPEX_ASSIGN_OR_RETURN(ExtractSettings settings, ResolveSettings(options, inputs, report));
   DISPEX_RETURN_IF_ERROR(CheckPlacementIfAsked(options, inputs, settings, report));
-  const FaceKeys face_keys = KeyFaces(inputs, settings, report);
+  const FaceKeys face_keys = KeyFaces(options, inputs, settings, report);
   inputs.face_keys = &face_keys;
   // A shard runs its faces' first pass only, no stage that crosses faces (the merge runs them).
   const std::vector<std::uint8_t> in_shard =

@@ -15,7 +15,7 @@
 #include "dispex/correspondence.h"
 #include "dispex/spectral.h"
 #include "dispex/vector_space.h"
-#include "extract/incremental/face_keys.h"
+#include "extract/incremental/field_keys.h"
 #include "extract/mapping/extract_mapping.h"
 #include "extract/mapping/vertex_displacements.h"
 #include "extract/process_faces.h"
@@ -188,7 +188,8 @@ StatusOr<FaceResult> ProcessVectorFace(PtexFaceId face, const ExtractInputs& inp
   return result;
 }
 
-std::vector<Hash128> VectorFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings) {
+FaceKeys VectorFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings,
+                        const std::string& cache_folder) {
   const LimitSurface& surface = inputs.surface;
   const SculptCorrespondence& correspondence = *inputs.correspondence;
   const std::vector<BaseFacePatch> patches = BaseFacePatches(surface);
@@ -197,28 +198,26 @@ std::vector<Hash128> VectorFaceKeys(const ExtractInputs& inputs, const ExtractSe
       .Add(std::string_view("vector"))
       .Add(VectorSpaceName(*settings.vector));
   const Hash128 settings_key = global.Digest();
-  std::vector<Hash128> keys(static_cast<std::size_t>(surface.num_ptex_faces()));
-  struct Scratch {
-    std::vector<VertexId> ids;
-    std::vector<int> faces;
-    std::vector<Float3> points;
-  };
-  tbb::enumerable_thread_specific<Scratch> scratches;
-  tbb::parallel_for(std::size_t{0}, keys.size(), [&](std::size_t f) {
+  FieldKeys fields;
+  if (settings.interpolate) fields = ComputeFieldKeys(inputs, patches, cache_folder);
+  FaceKeys out;
+  out.keys.resize(static_cast<std::size_t>(surface.num_ptex_faces()));
+  out.fields_kept = fields.kept;
+  tbb::enumerable_thread_specific<std::vector<Float3>> scratches;
+  tbb::parallel_for(std::size_t{0}, out.keys.size(), [&](std::size_t f) {
     Hasher h;
     h.Add(settings_key);
     AddFacePatchKey(h, surface, patches, settings, f);
     const PtexFaceId face(static_cast<int>(f));
-    Scratch& w = scratches.local();
     if (settings.interpolate) {
-      AddFieldKey(h, inputs, patches, face.value, w.ids, w.faces, w.points);
+      h.Add(fields.keys[f]);
     } else {
       AddGridKey(h, inputs.sculpt, correspondence.grid_size(face), correspondence.grid(face),
-                 w.points);
+                 scratches.local());
     }
-    keys[f] = h.Digest();
+    out.keys[f] = h.Digest();
   });
-  return keys;
+  return out;
 }
 
 Status VectorObjectComponents(PtexFaceId face, VectorSpace space, int ulog2, int vlog2,

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <span>
+#include <string>
 #include <vector>
 
 #include "core/hash128.h"
@@ -15,6 +16,7 @@
 #include "extract/extract_inputs.h"
 #include "extract/extract_settings.h"
 #include "extract/face_pipeline.h"
+#include "extract/incremental/face_keys.h"
 
 namespace dispex::extract {
 
@@ -34,8 +36,10 @@ StatusOr<FaceResult> ProcessVectorFace(PtexFaceId face, const ExtractInputs& inp
 
 // Per Ptex face, what its texels are made from: the settings (SettingsKey) and vector space,
 // its limit patch and sub-face, its planned samples, and the positions of its grid of sculpt
-// vertices in grid order (a face reads the sculpt only inside its own cells, SculptPointAt).
-std::vector<Hash128> VectorFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings);
+// vertices in grid order (a face reads the sculpt only inside its own cells, SculptPointAt);
+// interpolated, its field's key instead (ComputeFieldKeys, kept in `cache_folder` when given).
+FaceKeys VectorFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings,
+                        const std::string& cache_folder);
 
 // A face of a tangent or parametric map (ulog2 x vlog2 texels, 3 interleaved channels; one
 // texel: constant) as D in object space at its texel centres, one array per component: the

@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "dispex/version.h"
+#include "extract/incremental/field_keys.h"
 #include "extract/incremental/sculpt_face_bounds.h"
 
 namespace dispex::extract {
@@ -242,28 +243,23 @@ void AddFieldKey(Hasher& h, const ExtractInputs& inputs, std::span<const BaseFac
 namespace {
 
 // Interpolated (ExtractSettings::interpolate), a face reads its grid of sculpt vertices and the
-// row beyond each edge: its key holds their positions (AddGridKey). No rays: no reach boxes.
+// row beyond each edge: its key holds their key (ComputeFieldKeys). No rays: no reach boxes.
 FaceKeys GridFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings,
-                      const std::vector<BaseFacePatch>& patches) {
+                      const std::vector<BaseFacePatch>& patches, const std::string& cache_folder) {
   const LimitSurface& surface = inputs.surface;
   const auto num_faces = static_cast<std::size_t>(surface.num_ptex_faces());
   const Hash128 settings_key = SettingsKey(settings);
+  const FieldKeys fields = ComputeFieldKeys(inputs, patches, cache_folder);
   FaceKeys out;
   out.keys.resize(num_faces);
   out.reach_faces.resize(num_faces);
-  struct Scratch {
-    std::vector<VertexId> ids;
-    std::vector<int> faces;
-    std::vector<Float3> points;
-  };
-  tbb::enumerable_thread_specific<Scratch> scratches;
+  out.fields_kept = fields.kept;
   tbb::parallel_for(std::size_t{0}, num_faces, [&](std::size_t f) {
     Hasher h;
     h.Add(settings_key);
     AddFacePatchKey(h, surface, patches, settings, f);
+    h.Add(fields.keys[f]);
     const int m = inputs.grids->grid_size(static_cast<int>(f));
-    Scratch& w = scratches.local();
-    AddFieldKey(h, inputs, patches, static_cast<int>(f), w.ids, w.faces, w.points);
     out.reach_faces[f] = std::int64_t{m} * m;
     out.keys[f] = h.Digest();
   });
@@ -272,11 +268,12 @@ FaceKeys GridFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settin
 
 }  // namespace
 
-FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings) {
+FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings,
+                         const std::string& cache_folder) {
   const LimitSurface& surface = inputs.surface;
   const auto num_faces = static_cast<std::size_t>(surface.num_ptex_faces());
   const std::vector<BaseFacePatch> patches = BaseFacePatches(surface);
-  if (settings.interpolate) return GridFaceKeys(inputs, settings, patches);
+  if (settings.interpolate) return GridFaceKeys(inputs, settings, patches, cache_folder);
   FaceKeys out;
   out.reach_boxes = ReachBoxes(surface, patches, Reach(settings));
   if (settings.retry_query.distance > settings.query.distance) {

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "core/hash128.h"
@@ -46,8 +47,9 @@ void AddFacePatchKey(Hasher& h, const LimitSurface& surface, std::span<const Bas
 // those whose bounding box meets the face's reach box (the patch's box grown by the longest search
 // distance and a margin), as an order-free sum of each sculpt face's key (its corners' positions,
 // in order). Interpolated (ExtractSettings::interpolate), the sculpt part is the face's grid of
-// sculpt vertices and its apron (AddGridKey, FaceFieldVertices), reach_faces its cells, and
-// there are no reach boxes.
+// sculpt vertices and its apron (the key of AddFieldKey, ComputeFieldKeys, which with a
+// `cache_folder` keeps them there for the next run), reach_faces its cells, and there are no
+// reach boxes.
 // The keys do not depend on the thread count.
 
 struct FaceKeys {
@@ -59,8 +61,11 @@ struct FaceKeys {
   float sculpt_half_extent = 0;  // the largest half-size of a sculpt face's bounding box
   // Per Ptex face: the sculpt faces in the grid cells its key sums (about those its rays reach).
   std::vector<std::int64_t> reach_faces;
+  // Interpolated: the faces whose field key the cache folder kept (FieldKeys::kept; -1: none).
+  std::int64_t fields_kept = -1;
 };
-FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings);
+FaceKeys ComputeFaceKeys(const ExtractInputs& inputs, const ExtractSettings& settings,
+                         const std::string& cache_folder);
 
 // The sculpt faces the rays of the flagged Ptex faces can reach (a superset: those ComputeFaceKeys
 // sums for them), their vertices renumbered in ascending order: enough to trace those faces

@@ -25,6 +25,7 @@ nlohmann::json ExtractReportObject(const ExtractReport& r) {
                         {"faces_extracted", r.incremental.faces_extracted},
                         {"faces_copied_redone", r.incremental.faces_copied_redone},
                         {"edges_copied", r.incremental.edges_copied},
+                        {"fields_kept", r.incremental.fields_kept},
                         {"redo_reason", r.incremental.redo_reason},
                         {"tracer_faces", r.incremental.tracer_faces},
                         {"search_rays_recast", r.incremental.search_rays_recast},
@@ -274,6 +275,9 @@ std::string IncrementalLine(const ExtractReport& r) {
   if (r.incremental.edges_copied > 0) {
     out += fmt::format("; {} of {} shared edges' steps copied", r.incremental.edges_copied,
                        r.edges.shared);
+  }
+  if (r.incremental.fields_kept >= 0) {
+    out += fmt::format("; {} faces' sculpt keys kept", r.incremental.fields_kept);
   }
   if (r.incremental.tracer_faces > 0) {
     out += fmt::format("; the BVH held the sculpt within reach of {} faces",

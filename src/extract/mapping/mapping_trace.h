@@ -82,6 +82,8 @@ class SculptMapping {
     return cells_[static_cast<std::size_t>(cell_offsets_[static_cast<std::size_t>(face)] +
                                            std::int64_t{j} * grid_size(face) + i)];
   }
+  // Every face's cells, the faces in order and each grid row by row.
+  std::span<const std::uint32_t> cells() const { return cells_; }
   static int FaceOf(std::uint32_t cell) { return static_cast<int>(cell & 0x3fffffffu); }
   static int RotationOf(std::uint32_t cell) { return static_cast<int>(cell >> 30); }
   // The (m + 1)^2 sculpt vertices of face `face`'s grid (m = grid_size(face) > 0) row by row,
