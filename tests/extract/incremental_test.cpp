@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -19,6 +20,7 @@
 #include <random>
 #include <string>
 
+#include "core/hash128.h"
 #include "dispex/extract.h"
 #include "dispex/mesh.h"
 #include "dispex/ptex.h"
@@ -520,6 +522,58 @@ TEST(IncrementalMaps, CopiedFacesAreEncodedAgainWhenTheEncodingChanged) {
           << WatertightEdgesName(watertight) << ", level " << level << ": "
           << testing::MapDifference(o.output_path, full.output_path);
     }
+  }
+}
+
+// The sculpt keys an incremental run keeps in the cache folder (field_keys.h) are a file on the
+// user's disk: one whose homes name a face that is not there (its content hash made to match)
+// is not trusted, every face is keyed again, the map is still a full extraction's, and the
+// record written then serves the next run. Without the check, the homes index past the faces.
+TEST(IncrementalMaps, AFieldRecordNamingNoFaceIsNotTrusted) {
+  TempDir dir;
+  ExtractOptions o = SpotSculptOptions(dir, Pattern::kDetail, dir / "inc.ptx");
+  const std::string sculpt = o.sculpt_path;
+  o.incremental = true;
+  o.cache_dir = dir / "cache";
+  auto first = Extract(o);
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  ASSERT_EQ(first->method.used, ExtractMethod::kInterpolate);
+  EXPECT_EQ(first->incremental.fields_kept, -1);
+  std::string record;
+  for (const auto& entry : std::filesystem::directory_iterator(o.cache_dir)) {
+    if (entry.path().filename().string().rfind("fields-", 0) == 0) record = entry.path();
+  }
+  ASSERT_FALSE(record.empty());
+  // The homes are the record's last array (one int32 per sculpt vertex), before its hash.
+  std::string bytes = Slurp(record);
+  const std::size_t vertices = first->inputs.sculpt_vertices;
+  ASSERT_GT(bytes.size(), sizeof(Hash128) + 4 * vertices);
+  const std::size_t homes = bytes.size() - sizeof(Hash128) - 4 * vertices;
+  const std::int32_t nowhere = 1 << 30;
+  for (std::size_t v = 0; v < vertices; ++v) std::memcpy(&bytes[homes + 4 * v], &nowhere, 4);
+  const Hash128 check =
+      HashBytes(std::as_bytes(std::span(bytes.data(), bytes.size() - sizeof(Hash128))));
+  std::memcpy(&bytes[bytes.size() - sizeof(Hash128)], &check, sizeof(Hash128));
+  std::ofstream(record, std::ios::binary) << bytes;
+
+  for (const std::int64_t expect_kept : {std::int64_t{-1}, std::int64_t{1}}) {
+    auto mesh = ReadMesh(sculpt);
+    ASSERT_TRUE(mesh.ok());
+    mesh->positions[mesh->num_vertices() / 3].x += 1e-4f;
+    ASSERT_TRUE(WriteObj(sculpt, *mesh).ok());
+    auto r = Extract(o);
+    ASSERT_TRUE(r.ok()) << r.status().message();
+    if (expect_kept < 0) {
+      EXPECT_EQ(r->incremental.fields_kept, -1) << "the record was trusted";
+    } else {
+      EXPECT_GT(r->incremental.fields_kept, static_cast<std::int64_t>(r->inputs.ptex_faces / 2));
+    }
+    ExtractOptions full = o;
+    full.incremental = false;
+    full.output_path = dir / "full.ptx";
+    ASSERT_TRUE(Extract(full).ok());
+    EXPECT_TRUE(Slurp(o.output_path) == Slurp(full.output_path))
+        << testing::MapDifference(o.output_path, full.output_path);
   }
 }
 
