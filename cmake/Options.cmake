@@ -3,6 +3,10 @@ add_library(dispex_warnings INTERFACE)
 target_compile_options(dispex_warnings INTERFACE -Wall -Wextra -Wpedantic -Wshadow
   -Wnon-virtual-dtor -Wcast-align -Wunused -Woverloaded-virtual
   -Wimplicit-fallthrough)
+# A precompiled header that does not match a target's flags is silently parsed again: say so.
+if(DISPEX_PRECOMPILED_HEADERS)
+  target_compile_options(dispex_warnings INTERFACE -Winvalid-pch)
+endif()
 if(DISPEX_WERROR)
   target_compile_options(dispex_warnings INTERFACE -Werror)
 endif()
@@ -25,6 +29,13 @@ if(DISPEX_TSAN)
   target_compile_options(dispex_options INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
   target_link_options(dispex_options INTERFACE -fsanitize=thread)
 endif()
+
+# dispex_test_options: the tests' own code is compiled at -O1 in Release builds. The code under
+# test is the libraries', at the build's level (-O3); at -O1 a test source compiles 30-40%
+# faster (tests/ptex/round_trip_test.cpp 7.1 -> 4.2 s), which is most of what `make test`
+# compiles.
+add_library(dispex_test_options INTERFACE)
+target_compile_options(dispex_test_options INTERFACE $<$<CONFIG:Release>:-O1>)
 
 # dispex_add_library(NAME SOURCES... ) : one static library per src/ folder, alias dispex::NAME,
 # plus dispex::NAME_internal, an interface target that puts the module's own headers
@@ -52,4 +63,5 @@ function(dispex_add_library name)
   endif()
   target_link_libraries(dispex_${name} PRIVATE dispex_warnings dispex_${name}_internal
                         PUBLIC dispex_options)
+  dispex_precompiled_headers(dispex_${name} library)
 endfunction()

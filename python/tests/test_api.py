@@ -430,6 +430,10 @@ def test_the_plan_says_what_a_run_will_do_and_writes_nothing(tmp_path, sculpts):
     assert planned["redo_reason"] == "options: tolerance"
     assert planned["faces"]["extracted"] == done["incremental"]["faces_extracted"]
     assert planned["faces"]["copied"] == done["incremental"]["faces_copied"]
+    # The automatic memory limit follows the machine's available memory, which moves between
+    # the two calls; the rest of the plan must not.
+    for p in (planned, done["plan"]):
+        assert p["memory"].pop("limit_bytes") > 0
     assert done["plan"] == planned
     part = dispex.extract(CUBE, sculpt, tmp_path / "p.ptx", plan_only=True, shard="1/2")["plan"]
     assert part["output"] == "shard part"

@@ -25,7 +25,7 @@ namespace dispex::testing {
 namespace fs = std::filesystem;
 
 inline std::string DataPath(const std::string& relative) {
-  return std::string(DISPEX_TEST_DATA_DIR) + "/" + relative;
+  return (fs::path(DISPEX_TEST_DATA_DIR) / relative).string();
 }
 
 // A ground-truth sculpt of `cage`: refined `levels` times, displaced by `pattern`.

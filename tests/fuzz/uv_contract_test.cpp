@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <utility>
@@ -93,7 +94,7 @@ TEST(UvContract, ReaderKeepsItOnFilesWithUvs) {
   for (const char* file :
        {"meshes/keenan_spot/spot_control_mesh.obj", "meshes/opensubdiv/catmark_nonquads.obj",
         "image_pattern/wavy_plane.obj"}) {
-    const std::string path = std::string(DISPEX_TEST_DATA_DIR) + "/" + file;
+    const std::string path = (std::filesystem::path(DISPEX_TEST_DATA_DIR) / file).string();
     StatusOr<Mesh> mesh = ReadObj(path);
     ASSERT_TRUE(mesh.ok()) << mesh.status().message();
     EXPECT_TRUE(mesh->has_uvs()) << file;

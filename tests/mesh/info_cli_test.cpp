@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -45,7 +46,7 @@ CliRun Dispex(const std::string& args) {
 }
 
 std::string Data(const std::string& relative) {
-  return std::string(DISPEX_TEST_DATA_DIR) + "/" + relative;
+  return (std::filesystem::path(DISPEX_TEST_DATA_DIR) / relative).string();
 }
 
 TEST(InfoCli, TextSummary) {

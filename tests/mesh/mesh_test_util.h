@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <string_view>
 
@@ -13,7 +14,7 @@
 namespace dispex::testing {
 
 inline std::string DataPath(const std::string& relative) {
-  return std::string(DISPEX_TEST_DATA_DIR) + "/" + relative;
+  return (std::filesystem::path(DISPEX_TEST_DATA_DIR) / relative).string();
 }
 
 // A temporary file name unique to the running test and process (ctest runs tests in parallel,

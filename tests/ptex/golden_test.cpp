@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -21,7 +22,7 @@ namespace dispex {
 namespace {
 
 std::string GoldenPath(const std::string& name) {
-  return std::string(DISPEX_TEST_DATA_DIR) + "/ptex-golden/" + name + ".txt";
+  return (std::filesystem::path(DISPEX_TEST_DATA_DIR) / "ptex-golden" / (name + ".txt")).string();
 }
 
 std::string Dump(const PtexFile& file) {

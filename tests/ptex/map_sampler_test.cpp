@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <random>
 #include <span>
@@ -285,7 +286,7 @@ TEST(PtexMapSampler, RealCagesAreContinuousBetweenEqualResolutions) {
        {"meshes/opensubdiv/catmark_fan.obj", "meshes/keenan_spot/spot_control_mesh.obj",
         "meshes/opensubdiv/catmark_car.obj"}) {
     SCOPED_TRACE(cage);
-    auto mesh = ReadMesh(std::string(DISPEX_TEST_DATA_DIR) + "/" + cage);
+    auto mesh = ReadMesh((std::filesystem::path(DISPEX_TEST_DATA_DIR) / cage).string());
     ASSERT_TRUE(mesh.ok()) << mesh.status().message();
     auto surface = LimitSurface::Build(*mesh);
     ASSERT_TRUE(surface.ok()) << surface.status().message();

@@ -21,7 +21,7 @@ namespace dispex::ptex_test {
 namespace fs = std::filesystem;
 
 inline std::string FixturePath(const std::string& name) {
-  return std::string(DISPEX_TEST_DATA_DIR) + "/ptex/" + name;
+  return (fs::path(DISPEX_TEST_DATA_DIR) / "ptex" / name).string();
 }
 
 inline std::vector<std::uint8_t> ReadBytes(const fs::path& path) {

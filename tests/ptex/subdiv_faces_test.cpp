@@ -121,7 +121,7 @@ OsdPtex OpenSubdivPtex(const Far::TopologyRefiner& refiner, const Mesh& mesh) {
 std::vector<fs::path> Cages() {
   std::vector<fs::path> paths;
   for (const auto& entry :
-       fs::recursive_directory_iterator(std::string(DISPEX_TEST_DATA_DIR) + "/meshes")) {
+       fs::recursive_directory_iterator(fs::path(DISPEX_TEST_DATA_DIR) / "meshes")) {
     if (entry.path().extension() == ".obj") paths.push_back(entry.path());
   }
   std::sort(paths.begin(), paths.end());

@@ -10,6 +10,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -28,7 +29,7 @@ using subdiv_test::OracleComparison;
 using ::testing::HasSubstr;
 
 std::string DataPath(const std::string& relative) {
-  return std::string(DISPEX_TEST_DATA_DIR) + "/meshes/" + relative;
+  return (std::filesystem::path(DISPEX_TEST_DATA_DIR) / "meshes" / relative).string();
 }
 
 Mesh ReadOrDie(const std::string& relative) {

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <queue>
 #include <string>
@@ -23,7 +24,7 @@ namespace dispex {
 namespace {
 
 std::string DataPath(const std::string& relative) {
-  return std::string(DISPEX_TEST_DATA_DIR) + "/meshes/" + relative;
+  return (std::filesystem::path(DISPEX_TEST_DATA_DIR) / "meshes" / relative).string();
 }
 
 // Directed edge (a, b) -> (face, corner of a) for a mesh of quads.

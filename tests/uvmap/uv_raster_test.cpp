@@ -16,7 +16,7 @@ namespace dispex {
 namespace {
 
 std::string DataPath(const std::string& relative) {
-  return std::string(DISPEX_TEST_DATA_DIR) + "/" + relative;
+  return (std::filesystem::path(DISPEX_TEST_DATA_DIR) / relative).string();
 }
 
 // A mesh from OBJ text, through a temporary file.

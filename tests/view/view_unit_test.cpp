@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <set>
 #include <sstream>
 
@@ -19,7 +20,7 @@ namespace dispex::view {
 namespace {
 
 std::string DataPath(const std::string& relative) {
-  return std::string(DISPEX_TEST_DATA_DIR) + "/" + relative;
+  return (std::filesystem::path(DISPEX_TEST_DATA_DIR) / relative).string();
 }
 
 TEST(ViewPageData, Base64OfKnownBytes) {
