@@ -4,7 +4,6 @@
 #include <sys/wait.h>
 
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -70,8 +69,7 @@ TEST(PtexInfoCli, FacesMatchTheGoldenDump) {
   ASSERT_TRUE(w->Finish().ok());
   CliResult r = Dispex("info --faces " + path, dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  std::ifstream in(std::filesystem::path(DISPEX_TEST_DATA_DIR) / "ptex-golden" /
-                   (std::string(c.name) + ".txt"));
+  std::ifstream in(ptex_test::GoldenDumpPath(c.name));
   std::stringstream golden;
   golden << in.rdbuf();
   const std::string g = golden.str();

@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
-#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -20,10 +19,6 @@
 
 namespace dispex {
 namespace {
-
-std::string GoldenPath(const std::string& name) {
-  return (std::filesystem::path(DISPEX_TEST_DATA_DIR) / "ptex-golden" / (name + ".txt")).string();
-}
 
 std::string Dump(const PtexFile& file) {
   std::string faces, structure;
@@ -39,6 +34,7 @@ class Golden : public ::testing::TestWithParam<ptex_test::GoldenCase> {};
 TEST_P(Golden, DumpMatchesTheCheckedInFile) {
   const ptex_test::GoldenCase& c = GetParam();
   ptex_test::TempDir dir;
+  const std::string golden_path = ptex_test::GoldenDumpPath(c.name);
   for (PtexCompressor comp : {PtexCompressor::kLibdeflate, PtexCompressor::kZlib}) {
     const std::string path = (dir / (c.name + ".ptx")).string();
     PtexWriterOptions options = c.options;
@@ -53,14 +49,13 @@ TEST_P(Golden, DumpMatchesTheCheckedInFile) {
     const std::string dump = Dump(*file);
     const char* update = std::getenv("DISPEX_UPDATE_GOLDEN");
     if (update && std::string(update) == "1" && comp == PtexCompressor::kLibdeflate) {
-      std::ofstream(GoldenPath(c.name), std::ios::binary) << dump;
+      std::ofstream(golden_path, std::ios::binary) << dump;
     }
-    std::ifstream in(GoldenPath(c.name), std::ios::binary);
-    ASSERT_TRUE(in.good()) << "missing " << GoldenPath(c.name)
-                           << " (DISPEX_UPDATE_GOLDEN=1 writes it)";
+    std::ifstream in(golden_path, std::ios::binary);
+    ASSERT_TRUE(in.good()) << "missing " << golden_path << " (DISPEX_UPDATE_GOLDEN=1 writes it)";
     std::stringstream golden;
     golden << in.rdbuf();
-    EXPECT_EQ(dump, golden.str()) << c.name << " differs from " << GoldenPath(c.name);
+    EXPECT_EQ(dump, golden.str()) << c.name << " differs from " << golden_path;
   }
 }
 

@@ -24,6 +24,11 @@ inline std::string FixturePath(const std::string& name) {
   return (fs::path(DISPEX_TEST_DATA_DIR) / "ptex" / name).string();
 }
 
+// The stored `dispex info --faces` and structure dump of golden case `name` (golden_cases.h).
+inline std::string GoldenDumpPath(const std::string& name) {
+  return (fs::path(DISPEX_TEST_DATA_DIR) / "ptex-golden" / (name + ".txt")).string();
+}
+
 inline std::vector<std::uint8_t> ReadBytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::stringstream ss;
