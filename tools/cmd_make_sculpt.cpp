@@ -1,5 +1,6 @@
 // dispex make-sculpt CAGE --levels L | --layout jittered --density N --pattern P|image:FILE.png
-//   [--amplitude A] -o SCULPT.obj   (P: smooth, detail, ridges, noise, none, sideways, overhang)
+//   [--amplitude A] [--stream] -o SCULPT.obj   (P: smooth, detail, ridges, noise, none, sideways,
+//   overhang)
 #include <fmt/format.h>
 
 #include "command.h"
@@ -11,7 +12,8 @@ namespace {
 
 constexpr FlagName kMakeSculptFlags[] = {
     {"output_path", "-o"},        {"levels", "--levels"},   {"density", "--density"},
-    {"amplitude", "--amplitude"}, {"threads", "--threads"},
+    {"amplitude", "--amplitude"}, {"threads", "--threads"}, {"streamed", "--stream"},
+    {"truth_path", "--truth"},
 };
 
 struct MakeSculptArgs {
@@ -40,18 +42,32 @@ int RunMakeSculpt(MakeSculptArgs& args) {
     return ReportFailure(
         Status::Error(fmt::format("--density {}: must be 2..256", args.options.density)), 2);
   }
+  if (args.options.streamed && *layout != SculptLayout::kRefined) {
+    return ReportFailure(Status::Error("--stream needs --layout refined"), 2);
+  }
+  if (args.options.streamed && !args.options.truth_path.empty()) {
+    return ReportFailure(Status::Error("--stream writes no truth file: leave out --truth"), 2);
+  }
   const Status outputs = CheckOutputs({{"-o", args.options.output_path}});
   if (!outputs.ok()) return ReportFailure(outputs, 2);
   auto report = MakeSculpt(args.options);
   if (!report.ok()) return ReportFailure(report.status(), kMakeSculptFlags);
   if (!args.quiet) {
     for (const std::string& w : report->warnings) fmt::print(stderr, "dispex: warning: {}\n", w);
-    std::string truth = args.options.truth_path.empty() ? args.options.output_path + ".truth"
-                                                        : args.options.truth_path;
     const std::string vector = IsVectorPattern(args.options.pattern)
                                    ? fmt::format(", max |D| {:.4g}, max tangential |D| {:.4g}",
                                                  report->max_displacement, report->max_tangential)
                                    : "";
+    if (args.options.streamed) {
+      fmt::print(stderr,
+                 "dispex: {} ({} vertices, {} quads; pattern {}, amplitude {:.4g}, h in "
+                 "[{:.4g}, {:.4g}]{}; streamed, no truth file) in {:.2f}s\n",
+                 args.options.output_path, report->vertices, report->faces, args.pattern,
+                 report->amplitude, report->h_min, report->h_max, vector, report->seconds);
+      return 0;
+    }
+    std::string truth = args.options.truth_path.empty() ? args.options.output_path + ".truth"
+                                                        : args.options.truth_path;
     fmt::print(stderr,
                "dispex: {} ({} vertices, {} {}; pattern {}, amplitude {:.4g}, h in "
                "[{:.4g}, {:.4g}]{}, piecewise-linear error {:.3g}, {} folded faces) and {} in "
@@ -100,6 +116,9 @@ void SetupMakeSculpt(CLI::App& app, int& exit_code) {
   cmd->add_option("--threads", o.threads, "worker threads (0: all cores)")
       ->check(NonNegative())
       ->capture_default_str();
+  cmd->add_flag("--stream", o.streamed,
+                "write the refined sculpt as it is evaluated, in memory that grows with the cage "
+                "(film-scale benchmark sculpts): a cage of quads only, PLY, no truth file");
   cmd->add_flag("-q,--quiet", args->quiet, "no summary");
   cmd->callback([args, &exit_code] { exit_code = RunMakeSculpt(*args); });
 }

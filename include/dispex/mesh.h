@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -196,6 +197,32 @@ Status WriteObj(const std::string& path, const Mesh& mesh, const std::string& he
 // gives back the same positions and faces bit for bit. PLY holds neither UVs, nor
 // subdivision tags, nor groups: they are not written.
 Status WritePly(const std::string& path, const Mesh& mesh, std::string_view comment = {});
+
+// A binary little-endian PLY written as it is made, for meshes too large to hold (WritePly
+// writes through it): the counts go in the header first, then the vertices in order, then the
+// faces. The file appears on Commit, and only when exactly the declared counts were written;
+// destroyed before that, it leaves nothing (and a file already at `path` as it was).
+class PlyStreamWriter {
+ public:
+  // `largest_face`: the most corners a face will have (255 or fewer: one-byte corner counts).
+  // `comment`'s line ends become blanks.
+  static StatusOr<PlyStreamWriter> Create(const std::string& path, std::size_t vertices,
+                                          std::size_t faces, int largest_face,
+                                          std::string_view comment = {});
+  PlyStreamWriter(PlyStreamWriter&&) noexcept;
+  PlyStreamWriter& operator=(PlyStreamWriter&&) noexcept;
+  ~PlyStreamWriter();
+
+  Status AddVertex(float x, float y, float z);
+  // After the last vertex.
+  Status AddFace(std::span<const std::int32_t> corners);
+  Status Commit();
+
+ private:
+  struct Impl;
+  PlyStreamWriter();
+  std::unique_ptr<Impl> impl_;
+};
 
 // WritePly or WriteObj by MeshFormatOfName(path) (an unknown name is an error), with
 // `comment` as one comment line.

@@ -125,6 +125,10 @@ struct MakeSculptOptions {
   std::string image_path;  // Pattern::kImage: the height image (PNG)
   double amplitude = 0;    // object units; 0: 1% of the base's bounding-box diagonal
   std::uint32_t seed = 1;  // the noise pattern's and the jittered layout's
+  // kRefined on a cage of quads only: the sculpt written (PLY) as it is evaluated, in memory
+  // that grows with the cage, not the sculpt (film-scale assets); the same surface with the
+  // vertices in another order. No truth file, no linear error, no folded faces counted.
+  bool streamed = false;
   int threads = 0;
 };
 
@@ -141,7 +145,7 @@ struct MakeSculptReport {
   // centre (a quad's against the midpoints of both diagonals, where a ray tracer's triangles
   // put it; a triangle's centroid). A map extracted from the sculpt cannot be closer to the truth
   // than this. The truth file holds it per vertex, over the faces near the vertex (GroundTruth).
-  double linear_error = 0;
+  double linear_error = 0;  // NaN: not measured (streamed)
   // Sculpt faces turned inside out against the limit normal: the displaced surface folds there
   // (|h| x curvature >= 1), so rays along the limit normal can miss it or meet another sheet.
   // Expected of kOverhang (the part of each wave that runs back), where they are no fault.

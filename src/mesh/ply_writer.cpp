@@ -1,4 +1,5 @@
-// WritePly and WriteMesh (dispex/mesh.h): binary little-endian PLY, written atomically.
+// PlyStreamWriter, WritePly and WriteMesh (dispex/mesh.h): binary little-endian PLY, written
+// atomically.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -25,14 +26,37 @@ void Append(std::vector<char>& out, T value) {
   std::memcpy(out.data() + at, &value, sizeof(T));
 }
 
+constexpr std::size_t kFlushBytes = 1 << 20;
+
 }  // namespace
 
-Status WritePly(const std::string& path, const Mesh& mesh, std::string_view comment) {
-  int largest_face = 0;
-  for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
-    largest_face = std::max(largest_face, mesh.face_size(f));
+struct PlyStreamWriter::Impl {
+  Status Flush() {
+    Status written = out.Write(buffer.data(), buffer.size());
+    buffer.clear();
+    return written;
   }
-  const bool byte_counts = largest_face <= 255;
+
+  AtomicOutput out;
+  std::size_t vertices = 0, faces = 0;  // declared
+  std::size_t vertices_added = 0, faces_added = 0;
+  bool byte_counts = true;
+  std::vector<char> buffer;
+};
+
+PlyStreamWriter::PlyStreamWriter() : impl_(std::make_unique<Impl>()) {}
+PlyStreamWriter::PlyStreamWriter(PlyStreamWriter&&) noexcept = default;
+PlyStreamWriter& PlyStreamWriter::operator=(PlyStreamWriter&&) noexcept = default;
+PlyStreamWriter::~PlyStreamWriter() = default;
+
+StatusOr<PlyStreamWriter> PlyStreamWriter::Create(const std::string& path, std::size_t vertices,
+                                                  std::size_t faces, int largest_face,
+                                                  std::string_view comment) {
+  PlyStreamWriter writer;
+  Impl& w = *writer.impl_;
+  w.vertices = vertices;
+  w.faces = faces;
+  w.byte_counts = largest_face <= 255;
   std::string header = "ply\nformat binary_little_endian 1.0\n";
   if (!comment.empty()) {
     std::string line(comment);
@@ -43,35 +67,70 @@ Status WritePly(const std::string& path, const Mesh& mesh, std::string_view comm
   header += fmt::format(
       "element vertex {}\nproperty float x\nproperty float y\nproperty float z\n"
       "element face {}\nproperty list {} int vertex_indices\nend_header\n",
-      mesh.num_vertices(), mesh.num_faces(), byte_counts ? "uchar" : "uint");
+      vertices, faces, w.byte_counts ? "uchar" : "uint");
+  DISPEX_ASSIGN_OR_RETURN(w.out, AtomicOutput::Create(path));
+  DISPEX_RETURN_IF_ERROR(w.out.Write(header.data(), header.size()));
+  w.buffer.reserve(kFlushBytes + 4096);
+  return writer;
+}
 
-  DISPEX_ASSIGN_OR_RETURN(AtomicOutput out, AtomicOutput::Create(path));
-  DISPEX_RETURN_IF_ERROR(out.Write(header.data(), header.size()));
-  constexpr std::size_t kChunk = 1 << 16;
-  std::vector<char> buffer;
-  for (std::size_t begin = 0; begin < mesh.num_vertices(); begin += kChunk) {
-    buffer.clear();
-    const std::size_t end = std::min(mesh.num_vertices(), begin + kChunk);
-    for (std::size_t v = begin; v < end; ++v) {
-      Append(buffer, mesh.positions[v].x);
-      Append(buffer, mesh.positions[v].y);
-      Append(buffer, mesh.positions[v].z);
-    }
-    DISPEX_RETURN_IF_ERROR(out.Write(buffer.data(), buffer.size()));
+Status PlyStreamWriter::AddVertex(float x, float y, float z) {
+  Impl& w = *impl_;
+  if (w.vertices_added == w.vertices) {
+    return Status::Error(
+        fmt::format("{}: more than the {} vertices declared", w.out.target(), w.vertices));
   }
-  for (std::size_t begin = 0; begin < mesh.num_faces(); begin += kChunk) {
-    buffer.clear();
-    const std::size_t end = std::min(mesh.num_faces(), begin + kChunk);
-    for (std::size_t f = begin; f < end; ++f) {
-      const auto size = static_cast<std::uint32_t>(mesh.face_size(f));
-      if (byte_counts) {
-        Append(buffer, static_cast<std::uint8_t>(size));
-      } else {
-        Append(buffer, size);
-      }
-      for (std::int32_t v : mesh.face(f)) Append(buffer, v);
-    }
-    DISPEX_RETURN_IF_ERROR(out.Write(buffer.data(), buffer.size()));
+  ++w.vertices_added;
+  Append(w.buffer, x);
+  Append(w.buffer, y);
+  Append(w.buffer, z);
+  return w.buffer.size() >= kFlushBytes ? w.Flush() : Status::Ok();
+}
+
+Status PlyStreamWriter::AddFace(std::span<const std::int32_t> corners) {
+  Impl& w = *impl_;
+  if (w.vertices_added != w.vertices) {
+    return Status::Error(
+        fmt::format("{}: face {} added before the last of the {} vertices ({} so far)",
+                    w.out.target(), w.faces_added, w.vertices, w.vertices_added));
+  }
+  if (w.faces_added == w.faces) {
+    return Status::Error(
+        fmt::format("{}: more than the {} faces declared", w.out.target(), w.faces));
+  }
+  ++w.faces_added;
+  const auto size = static_cast<std::uint32_t>(corners.size());
+  if (w.byte_counts) {
+    Append(w.buffer, static_cast<std::uint8_t>(size));
+  } else {
+    Append(w.buffer, size);
+  }
+  for (std::int32_t v : corners) Append(w.buffer, v);
+  return w.buffer.size() >= kFlushBytes ? w.Flush() : Status::Ok();
+}
+
+Status PlyStreamWriter::Commit() {
+  Impl& w = *impl_;
+  if (w.vertices_added != w.vertices || w.faces_added != w.faces) {
+    return Status::Error(
+        fmt::format("{}: {} vertices and {} faces written of the {} and {} declared",
+                    w.out.target(), w.vertices_added, w.faces_added, w.vertices, w.faces));
+  }
+  DISPEX_RETURN_IF_ERROR(w.Flush());
+  return w.out.Commit();
+}
+
+Status WritePly(const std::string& path, const Mesh& mesh, std::string_view comment) {
+  int largest_face = 0;
+  for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+    largest_face = std::max(largest_face, mesh.face_size(f));
+  }
+  DISPEX_ASSIGN_OR_RETURN(
+      PlyStreamWriter out,
+      PlyStreamWriter::Create(path, mesh.num_vertices(), mesh.num_faces(), largest_face, comment));
+  for (const Float3& p : mesh.positions) DISPEX_RETURN_IF_ERROR(out.AddVertex(p.x, p.y, p.z));
+  for (std::size_t f = 0; f < mesh.num_faces(); ++f) {
+    DISPEX_RETURN_IF_ERROR(out.AddFace(mesh.face(f)));
   }
   return out.Commit();
 }

@@ -23,6 +23,7 @@
 #include "dispex/subdiv.h"
 #include "dispex/verify.h"
 #include "verify/pattern_field.h"
+#include "verify/streamed_sculpt.h"
 
 namespace dispex {
 
@@ -536,6 +537,16 @@ Status CheckMakeSculptOptions(const MakeSculptOptions& options) {
   if (options.pattern == Pattern::kImage && options.image_path.empty()) {
     return Status::Error("the image pattern needs a height image (image:FILE.png)");
   }
+  if (options.streamed) {
+    if (jittered) return Status::Error("streamed: only the refined layout is streamed");
+    if (MeshFormatOfName(options.output_path) != MeshFormat::kPly) {
+      return Status::Error(
+          fmt::format("{}: a streamed sculpt is written as PLY (.ply)", options.output_path));
+    }
+    if (!options.truth_path.empty()) {
+      return Status::Error("streamed: a streamed sculpt has no truth file (truth_path)");
+    }
+  }
   return Status::Ok();
 }
 
@@ -614,9 +625,8 @@ GroundTruth Displace(SculptLayoutMesh& layout, const verify::PatternField& patte
   return truth;
 }
 
-// The sculpt, its first line saying how it was made, and its truth file.
-Status WriteSculpt(const MakeSculptOptions& options, const PatternFrame& frame, const Mesh& sculpt,
-                   const GroundTruth& truth) {
+// The sculpt's first line: how it was made.
+std::string SculptComment(const MakeSculptOptions& options, const PatternFrame& frame) {
   const bool jittered = options.layout == SculptLayout::kJittered;
   const std::string pattern_name = options.pattern == Pattern::kImage
                                        ? "image:" + options.image_path
@@ -624,10 +634,14 @@ Status WriteSculpt(const MakeSculptOptions& options, const PatternFrame& frame, 
   const std::string how =
       jittered ? fmt::format("jittered {}x{} per Ptex face", options.density, options.density)
                : fmt::format("refined {} times", options.levels);
-  const std::string comment =
-      fmt::format("dispex make-sculpt: {} {}, pattern {}, amplitude {}, seed {}", options.cage_path,
-                  how, pattern_name, frame.amplitude, options.seed);
-  DISPEX_RETURN_IF_ERROR(WriteMesh(options.output_path, sculpt, comment));
+  return fmt::format("dispex make-sculpt: {} {}, pattern {}, amplitude {}, seed {}",
+                     options.cage_path, how, pattern_name, frame.amplitude, options.seed);
+}
+
+// The sculpt and its truth file.
+Status WriteSculpt(const MakeSculptOptions& options, const PatternFrame& frame, const Mesh& sculpt,
+                   const GroundTruth& truth) {
+  DISPEX_RETURN_IF_ERROR(WriteMesh(options.output_path, sculpt, SculptComment(options, frame)));
   std::string truth_path =
       options.truth_path.empty() ? options.output_path + ".truth" : options.truth_path;
   return WriteGroundTruth(truth_path, truth);
@@ -650,6 +664,33 @@ void ReportDisplacement(const GroundTruth& truth, const std::vector<float>& tang
   }
 }
 
+// MakeSculpt with options.streamed: the refinement written as it is evaluated, without truth.
+StatusOr<MakeSculptReport> MakeStreamedSculpt(const MakeSculptOptions& options, const Mesh& cage,
+                                              const LimitSurface& surface,
+                                              const PatternFrame& frame,
+                                              const verify::PatternField& pattern,
+                                              const Stopwatch& clock) {
+  DISPEX_ASSIGN_OR_RETURN(
+      verify::StreamedSculpt sculpt,
+      verify::WriteStreamedRefinement(cage, surface, options.levels, pattern, options.output_path,
+                                      SculptComment(options, frame)));
+  MakeSculptReport report;
+  report.vertices = sculpt.vertices;
+  report.faces = sculpt.faces;
+  report.amplitude = frame.amplitude;
+  report.diagonal = frame.diagonal;
+  report.edge = frame.edge;
+  report.frame = frame;
+  report.h_min = sculpt.h_min;
+  report.h_max = sculpt.h_max;
+  report.max_displacement = sculpt.max_displacement;
+  report.max_tangential = sculpt.max_tangential;
+  report.linear_error = std::numeric_limits<double>::quiet_NaN();
+  report.warnings = IgnoredTagWarnings(cage);
+  report.seconds = clock.seconds();
+  return report;
+}
+
 }  // namespace
 
 StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
@@ -667,6 +708,7 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   DISPEX_ASSIGN_OR_RETURN(
       verify::PatternField pattern,
       verify::PatternField::Create(options.pattern, options.image_path, frame, cage, surface));
+  if (options.streamed) return MakeStreamedSculpt(options, cage, surface, frame, pattern, clock);
   DISPEX_ASSIGN_OR_RETURN(SculptLayoutMesh layout, BuildLayout(cage, surface, options));
 
   std::vector<float> tangential;

@@ -85,6 +85,35 @@ TEST(PlyWriter, FacesOfMoreThan255CornersCountInUint) {
   std::filesystem::remove(path);
 }
 
+// WritePly goes through PlyStreamWriter; what it refuses is written nowhere.
+TEST(PlyStreamWriter, WritesOnlyTheCountsItDeclared) {
+  const Mesh mesh = MixedMesh();
+  const std::string path = TempPath(".ply");
+  {
+    auto out = PlyStreamWriter::Create(path, mesh.num_vertices(), mesh.num_faces(), 5, "");
+    ASSERT_TRUE(out.ok());
+    for (std::size_t v = 0; v + 1 < mesh.num_vertices(); ++v) {
+      const Float3 p = mesh.positions[v];
+      ASSERT_TRUE(out->AddVertex(p.x, p.y, p.z).ok());
+    }
+    const Status early = out->AddFace(mesh.face(0));
+    EXPECT_NE(early.message().find("face 0 added before the last of the 6 vertices (5 so far)"),
+              std::string::npos)
+        << early.message();
+    const Float3 last = mesh.positions.back();
+    ASSERT_TRUE(out->AddVertex(last.x, last.y, last.z).ok());
+    const Status extra = out->AddVertex(last.x, last.y, last.z);
+    EXPECT_NE(extra.message().find("more than the 6 vertices declared"), std::string::npos)
+        << extra.message();
+    ASSERT_TRUE(out->AddFace(mesh.face(0)).ok());
+    const Status short_by_two = out->Commit();
+    EXPECT_NE(short_by_two.message().find("6 vertices and 1 faces written of the 6 and 3"),
+              std::string::npos)
+        << short_by_two.message();
+  }
+  EXPECT_FALSE(std::filesystem::exists(path));
+}
+
 TEST(WriteMesh, TheNameChoosesTheFormat) {
   const Mesh mesh = MixedMesh();
   const std::string ply = TempPath(".PLY");
