@@ -112,8 +112,7 @@ MemoryNeed MemoryNeedOf(const ExtractOptions& options, const MeshesRead& meshes)
                                    static_cast<std::uint64_t>(options.max_oversample);
   const Mesh& sculpt = meshes.sculpt;
   return EstimateMemory(sculpt.num_vertices(), sculpt.num_faces(), sculpt.face_indices.size(),
-                        std::min(max_texels, kMaxEstimatedTexels),
-                        options.vector.has_value() || options.method != ExtractMethod::kRays);
+                        std::min(max_texels, kMaxEstimatedTexels), MatchesSculpt(options));
 }
 
 StatusOr<ExtractInputs> FinishInputs(const ExtractOptions& options, MeshesRead meshes,

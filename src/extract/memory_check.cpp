@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "dispex/extract.h"
+#include "dispex/mesh.h"
 
 namespace dispex::extract {
 
@@ -60,7 +61,26 @@ Status CheckMemoryBeforeReading(const ExtractOptions& options, std::uint64_t lim
   if (need > limit) {
     return TooBig(need, limit, options.max_memory > 0, "reading " + options.sculpt_path);
   }
+  // A PLY sculpt's header gives its counts: what every plan needs of them at least (arrays of
+  // 3 corners a face, the correspondence), before seconds of reading.
+  if (options.sculpt_mesh || DetectMeshFormat(options.sculpt_path) != MeshFormat::kPly) {
+    return Status::Ok();
+  }
+  const StatusOr<MeshSize> size = CountMeshElements(options.sculpt_path);
+  if (!size.ok()) return Status::Ok();  // the reader says what is wrong
+  const MemoryNeed least =
+      EstimateMemory(size->vertices, size->faces, 3 * size->faces, 0, MatchesSculpt(options));
+  if (least.arrays + least.match > limit) {
+    return TooBig(
+        least.arrays + least.match, limit, options.max_memory > 0,
+        fmt::format("{}: a sculpt of {} faces ({}arrays, from its header)", options.sculpt_path,
+                    size->faces, least.match > 0 ? "its correspondence, " : ""));
+  }
   return Status::Ok();
+}
+
+bool MatchesSculpt(const ExtractOptions& options) {
+  return options.vector.has_value() || options.method != ExtractMethod::kRays;
 }
 
 MemoryNeed EstimateMemory(std::size_t sculpt_vertices, std::size_t sculpt_faces,

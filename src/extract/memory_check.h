@@ -15,8 +15,11 @@ namespace dispex::extract {
 // the correspondence's peak where a method matches it, a BVH over it (about 80 bytes per
 // primitive at medium quality, with its build) and the output's compressed blocks. A check
 // fails with a message giving the estimate and the limit; `given`: the limit is max_memory's,
-// else what the machine has available.
+// else what the machine has available. Before reading, a PLY sculpt is also checked by its
+// header's counts.
 Status CheckMemoryBeforeReading(const ExtractOptions& options, std::uint64_t limit);
+// Whether the run's method matches the sculpt to the base (counting the correspondence's peak).
+bool MatchesSculpt(const ExtractOptions& options);
 // Reading's peak as CheckMemoryBeforeReading estimates it, from the files' sizes.
 std::uint64_t ReadPeakBytes(const ExtractOptions& options);
 

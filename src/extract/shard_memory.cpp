@@ -13,7 +13,7 @@ namespace dispex {
 StatusOr<ShardMemoryPlan> PlanShardMemory(const ExtractOptions& options,
                                           std::uint64_t node_memory) {
   DISPEX_ASSIGN_OR_RETURN(const MeshSize sculpt, CountMeshElements(options.sculpt_path));
-  const bool matches = options.method != ExtractMethod::kRays;
+  const bool matches = extract::MatchesSculpt(options);
   const bool may_trace =
       options.method != ExtractMethod::kMapping && options.method != ExtractMethod::kInterpolate;
   // The output's bound as the run's, less the base's faces it does not know yet.

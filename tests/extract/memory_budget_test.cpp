@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 
@@ -156,6 +157,43 @@ TEST(MemoryBudgetRefusal, BelowWhatEveryPlanNeedsNothingIsDoneAndNothingWritten)
   EXPECT_EQ(refused.status().code(), StatusCode::kOverBudget);
   EXPECT_NE(refused.status().message().find("max_memory"), std::string::npos)
       << refused.status().message();
+  EXPECT_FALSE(fs::exists(o.output_path));
+}
+
+// A PLY sculpt is refused by its header's counts before it is read: here 200K quads whose
+// corners are all -1, so a run that read the file would fail on the first face instead.
+TEST(MemoryBudgetRefusal, APlySculptOverTheBudgetIsRefusedByItsHeader) {
+  TempDir dir;
+  ExtractOptions o = RaysOnSpot(dir);
+  constexpr int kQuads = 200000;
+  {
+    std::ofstream out(o.sculpt_path, std::ios::binary | std::ios::trunc);
+    out << "ply\nformat binary_little_endian 1.0\nelement vertex " << kQuads
+        << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << kQuads
+        << "\nproperty list uchar int vertex_indices\nend_header\n";
+    out << std::string(12 * kQuads, '\0');
+    const std::string face = std::string(1, '\4') + std::string(16, '\xff');
+    for (int f = 0; f < kQuads; ++f) out << face;
+  }
+  // The arrays alone take 12 + 4 + 12 bytes a quad at least (5.6 MB), more than reading the
+  // 5.8 MB file is estimated at; the correspondence 40 more.
+  o.max_memory = 5'000'000;
+  for (ExtractMethod method : {ExtractMethod::kRays, ExtractMethod::kAuto}) {
+    o.method = method;
+    auto refused = Extract(o);
+    ASSERT_FALSE(refused.ok());
+    EXPECT_EQ(refused.status().code(), StatusCode::kOverBudget) << refused.status().message();
+    EXPECT_NE(refused.status().message().find("a sculpt of 200000 faces"), std::string::npos)
+        << refused.status().message();
+    EXPECT_EQ(refused.status().message().find("its correspondence") != std::string::npos,
+              method == ExtractMethod::kAuto)
+        << refused.status().message();
+  }
+  // Within the budget the reader is reached, and says what is wrong with the file.
+  o.max_memory = 64'000'000;
+  auto read = Extract(o);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.status().code(), StatusCode::kOverBudget) << read.status().message();
   EXPECT_FALSE(fs::exists(o.output_path));
 }
 
