@@ -326,6 +326,9 @@ struct ExtractPlan {
   // what it is estimated to need at its peak (bytes); the runs of kInParts (0 otherwise).
   std::uint64_t memory_limit = 0, memory_estimate = 0;
   int sculpt_parts = 0;
+  // kWholeSculpt built compact at medium quality: the BVH at the asked quality does not fit in
+  // max_memory (the map is the same).
+  bool compact_bvh = false;
   // The parts the sculpt's automatic search distance is estimated in, one BVH at a time (0: by
   // one BVH of the whole sculpt, or through the correspondence, or none to estimate).
   int search_estimate_parts = 0;

@@ -158,7 +158,8 @@ Status BuildLocalTracer(const ExtractOptions& options, std::vector<std::uint8_t>
   return Status::Ok();
 }
 
-// Rays over the whole sculpt: one BVH of it when that fits in the memory limit, else the faces
+// Rays over the whole sculpt: one BVH of it when that fits in the memory limit (built compact
+// when only that fits), else the faces
 // traced in runs, a BVH of the sculpt within reach of one at a time (kInParts: the same map,
 // built again for each run); refused before any ray when not even that fits.
 Status PlanSculptParts(const ExtractOptions& options, ExtractInputs& inputs,
@@ -168,6 +169,14 @@ Status PlanSculptParts(const ExtractOptions& options, ExtractInputs& inputs,
       const SculptParts parts,
       SculptPartsWithin(inputs.memory, report.inputs.sculpt_faces, inputs.memory_limit,
                         options.max_memory > 0, &plan.memory_estimate));
+  if (parts.compact_bvh) {
+    inputs.compact_bvh = plan.compact_bvh = true;
+    report.warnings.push_back(fmt::format(
+        "{}: a BVH of the whole sculpt at {} quality is estimated to need more than the {} memory "
+        "limit: built compact at medium quality instead (about half the memory, the same map)",
+        options.sculpt_path, BuildQualityName(options.bvh_quality),
+        MemorySize(inputs.memory_limit)));
+  }
   if (parts.parts == 1) return Status::Ok();
   inputs.sculpt_parts = parts.parts;
   inputs.part_faces = parts.part_faces;

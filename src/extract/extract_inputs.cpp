@@ -162,7 +162,8 @@ float TracerScale(const Mesh& base) {
 }
 
 void SetTracerOptions(const ExtractOptions& options, ExtractInputs& inputs) {
-  inputs.tracer_options.quality = options.bvh_quality;
+  inputs.tracer_options.quality = inputs.compact_bvh ? BuildQuality::kMedium : options.bvh_quality;
+  inputs.tracer_options.compact = inputs.compact_bvh;
   inputs.tracer_options.isa = options.embree_isa;
   inputs.tracer_options.scale = TracerScale(inputs.base);
 }

@@ -61,6 +61,7 @@ struct ExtractInputs {
   MemoryNeed memory;
   int sculpt_parts = 1;
   std::size_t part_faces = 0;  // with sculpt_parts > 1: the sculpt faces a run's BVH may hold
+  bool compact_bvh = false;    // the BVHs built compact at medium quality (SculptParts)
   // Without a tracer of the whole sculpt: the parts its automatic search distance is estimated
   // in (NearestHitsInParts), at least sculpt_parts.
   int estimate_parts = 1;

@@ -36,9 +36,9 @@ std::string ExtractPlanSummary(const ExtractPlan& plan) {
     return "plan: nothing to do, the map is up to date\n";
   }
   std::string out =
-      fmt::format("plan: a {} ({}), method {}, BVH: {}\n", ExtractPlanOutputName(plan.output),
+      fmt::format("plan: a {} ({}), method {}, BVH: {}{}\n", ExtractPlanOutputName(plan.output),
                   plan.channels == 3 ? "vector" : "scalar", ExtractMethodName(plan.method),
-                  ExtractPlanTracerName(plan.tracer));
+                  ExtractPlanTracerName(plan.tracer), plan.compact_bvh ? ", compact" : "");
   if (plan.faces_run >= 0) {
     out += fmt::format("  Ptex faces: {} of {} extracted", plan.faces_run, plan.faces);
     if (plan.faces_copied > 0) {
@@ -53,6 +53,12 @@ std::string ExtractPlanSummary(const ExtractPlan& plan) {
         "  the sculpt's BVH in {} parts, one at a time: the whole is estimated at "
         "more than the {} memory limit\n",
         plan.sculpt_parts, MemorySize(plan.memory_limit));
+  }
+  if (plan.compact_bvh) {
+    out += fmt::format(
+        "  the sculpt's BVH built compact at medium quality: at the asked quality it is "
+        "estimated at more than the {} memory limit\n",
+        MemorySize(plan.memory_limit));
   }
   if (plan.search_estimate_parts > 0) {
     out += fmt::format("  the automatic search distance estimated over the sculpt in {} parts\n",
@@ -117,6 +123,7 @@ nlohmann::json ExtractPlanJson(const ExtractPlan& plan) {
   j["memory"] = {{"limit_bytes", plan.memory_limit},
                  {"estimate_bytes", plan.memory_estimate},
                  {"sculpt_parts", plan.sculpt_parts},
+                 {"compact_bvh", plan.compact_bvh},
                  {"search_estimate_parts", plan.search_estimate_parts}};
   return j;
 }

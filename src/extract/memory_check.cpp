@@ -20,6 +20,11 @@ constexpr double kArraysPerFileByte = 0.5;
 constexpr double kReadPeakFactor = 1.5;
 // Embree's BVH over quads at medium quality, per primitive (incl. its build scratch).
 constexpr double kBvhBytesPerPrimitive = 80;
+// The same built compact (RTC_SCENE_FLAG_COMPACT, medium quality). Measured through rays with
+// the whole sculpt's BVH (bench/film-scale's sculpts, peak less the sculpt's arrays): 72 bytes
+// a quad on the body (16.9M quads), 69 on 135.3M quads, against 143 without compact; per
+// primitive as counted here (2 a quad), 36 and 72.
+constexpr double kCompactBvhBytesPerPrimitive = 40;
 // MatchRefinedSculpt's peak per sculpt face, its half-edge adjacency (dispex/correspondence.h).
 constexpr std::uint64_t kMatchBytesPerFace = 40;
 // The parts a sculpt is planned in against how many faces one holds: the search distance's
@@ -62,8 +67,11 @@ Status CheckMemoryBeforeReading(const ExtractOptions& options, std::uint64_t lim
     return TooBig(need, limit, options.max_memory > 0, "reading " + options.sculpt_path);
   }
   // A PLY sculpt's header gives its counts: what every plan needs of them at least (arrays of
-  // 3 corners a face, the correspondence), before seconds of reading.
-  if (options.sculpt_mesh || DetectMeshFormat(options.sculpt_path) != MeshFormat::kPly) {
+  // 3 corners a face, the correspondence), before seconds of reading. Only a regular file is
+  // opened here (a FIFO would block); the reader says what is wrong with anything else.
+  std::error_code ec;
+  if (options.sculpt_mesh || !std::filesystem::is_regular_file(options.sculpt_path, ec) ||
+      DetectMeshFormat(options.sculpt_path) != MeshFormat::kPly) {
     return Status::Ok();
   }
   const StatusOr<MeshSize> size = CountMeshElements(options.sculpt_path);
@@ -93,6 +101,7 @@ MemoryNeed EstimateMemory(std::size_t sculpt_vertices, std::size_t sculpt_faces,
   if (matches) need.match = kMatchBytesPerFace * std::uint64_t{sculpt_faces};
   const double primitives = double(sculpt_indices) / 4.0 + double(sculpt_faces);  // upper bound
   need.bvh = static_cast<std::uint64_t>(kBvhBytesPerPrimitive * primitives);
+  need.compact_bvh = static_cast<std::uint64_t>(kCompactBvhBytesPerPrimitive * primitives);
   // The map's texels as floats (kept for the edges, then compressed): the oversampling reads
   // a sculpt's detail at about 4 samples per sculpt face, up to every face at the largest.
   need.output = 4 * std::min<std::uint64_t>(max_texels, 4 * std::uint64_t{sculpt_faces});
@@ -113,6 +122,11 @@ StatusOr<SculptParts> SculptPartsWithin(const MemoryNeed& need, std::size_t scul
   const std::uint64_t whole = need.arrays + need.bvh + need.output;
   *estimate = whole;
   if (limit == 0 || whole <= limit || sculpt_faces == 0) return SculptParts{1, sculpt_faces};
+  const std::uint64_t compact = need.arrays + need.compact_bvh + need.output;
+  if (compact <= limit) {
+    *estimate = compact;
+    return SculptParts{1, sculpt_faces, true};
+  }
   // A part: sculpt faces with their arrays and BVH, besides the whole sculpt's arrays.
   const std::uint64_t floor = need.arrays + need.vertex_map + need.output;
   const double per_face = double(need.arrays + need.bvh) / double(sculpt_faces);

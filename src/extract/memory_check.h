@@ -24,11 +24,12 @@ bool MatchesSculpt(const ExtractOptions& options);
 std::uint64_t ReadPeakBytes(const ExtractOptions& options);
 
 struct MemoryNeed {
-  std::uint64_t arrays = 0;      // the sculpt's vertex and face arrays
-  std::uint64_t vertex_map = 0;  // renumbering and flags to take a part of it (SculptPart)
-  std::uint64_t match = 0;       // the correspondence at its peak (0: the method does not match)
-  std::uint64_t bvh = 0;         // a BVH of the whole sculpt
-  std::uint64_t output = 0;      // the map's blocks at most
+  std::uint64_t arrays = 0;       // the sculpt's vertex and face arrays
+  std::uint64_t vertex_map = 0;   // renumbering and flags to take a part of it (SculptPart)
+  std::uint64_t match = 0;        // the correspondence at its peak (0: the method does not match)
+  std::uint64_t bvh = 0;          // a BVH of the whole sculpt
+  std::uint64_t compact_bvh = 0;  // the same built compact at medium quality
+  std::uint64_t output = 0;       // the map's blocks at most
 };
 // The most texels an output estimate counts (EstimateMemory's max_texels).
 inline constexpr std::uint64_t kMaxEstimatedTexels = std::uint64_t{1} << 31;
@@ -40,13 +41,15 @@ Status CheckMemoryForSculpt(const MemoryNeed& need, std::size_t sculpt_faces, st
                             bool given);
 
 // How a rays extraction keeps within `limit` (0: none): the whole sculpt's BVH when it fits
-// (parts = 1), else the faces traced in runs, one BVH of the sculpt within reach of a run at a
-// time, each of at most part_faces sculpt faces (about `parts` of them). Over the limit even
-// with kMaxSculptParts, an error. `*estimate`: the plan's need.
+// (parts = 1), else the same built compact when that fits (compact_bvh: medium quality, about
+// half the memory, the same hits), else the faces traced in runs, one BVH of the sculpt within
+// reach of a run at a time, each of at most part_faces sculpt faces (about `parts` of them).
+// Over the limit even with kMaxSculptParts, an error. `*estimate`: the plan's need.
 inline constexpr int kMaxSculptParts = 64;
 struct SculptParts {
   int parts = 1;
   std::size_t part_faces = 0;
+  bool compact_bvh = false;
 };
 StatusOr<SculptParts> SculptPartsWithin(const MemoryNeed& need, std::size_t sculpt_faces,
                                         std::uint64_t limit, bool given, std::uint64_t* estimate);

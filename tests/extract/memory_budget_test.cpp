@@ -1,9 +1,10 @@
 // A memory budget that is kept (ExtractOptions::max_memory): a rays extraction whose whole
-// sculpt's BVH is estimated over the limit is traced in runs, a BVH of the sculpt within reach
-// of one run of faces at a time, and must write the map, byte for byte, of the whole sculpt's
-// BVH -- with the automatic search distance (estimated over the sculpt in parts too) and a
-// given one, watertight edges on (the edge pass re-traces faces in runs) and off, half floats,
-// UV-space tiles. Below what any plan needs, nothing is done and nothing is written.
+// sculpt's BVH is estimated over the limit builds it compact where that fits, else traces in
+// runs, a BVH of the sculpt within reach of one run of faces at a time, and must write the map,
+// byte for byte, of the whole sculpt's BVH -- with the automatic search distance (estimated over
+// the sculpt in parts too) and a given one, watertight edges on (the edge pass re-traces faces in
+// runs) and off, half floats, UV-space tiles. Below what any plan needs, nothing is done and
+// nothing is written.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -80,42 +81,64 @@ class MemoryBudget : public ::testing::TestWithParam<Variant> {
   std::string base_, sculpt_;
 };
 
-TEST_P(MemoryBudget, TracedInPartsIsTheMapOfTheWholeSculpt) {
+bool SaysInAWarning(const ExtractReport& report, const std::string& said) {
+  return std::any_of(report.warnings.begin(), report.warnings.end(),
+                     [&](const std::string& w) { return w.find(said) != std::string::npos; });
+}
+
+TEST_P(MemoryBudget, CompactOrInPartsIsTheMapOfTheWholeSculpt) {
   const ExtractOptions whole = Options("whole");
   auto expected = Extract(whole);
   ASSERT_TRUE(expected.ok()) << expected.status().message();
   EXPECT_EQ(expected->plan.tracer, ExtractPlan::Tracer::kWholeSculpt);
+  EXPECT_FALSE(expected->plan.compact_bvh);
   EXPECT_EQ(expected->plan.sculpt_parts, 0);
   const std::uint64_t one_pass = expected->plan.memory_estimate;
   ASSERT_GT(one_pass, 0u);
   if (GetParam().watertight != WatertightEdges::kOff) {
     EXPECT_GT(expected->edges.raised_faces, 0);  // the edge pass runs, in runs of faces
   }
+  auto same_map = [&](const ExtractOptions& limited, const std::string& name) {
+    EXPECT_TRUE(Slurp(limited.output_path) == Slurp(whole.output_path))
+        << name << ": the map differs from the whole BVH's";
+    if (GetParam().uv_maps) {
+      const auto tiles = Tiles(limited.uv_maps_dir, name);
+      EXPECT_FALSE(tiles.empty());
+      EXPECT_TRUE(tiles == Tiles(whole.uv_maps_dir, "whole")) << name << ": the tiles differ";
+    }
+  };
 
+  // A little under the one pass: the whole sculpt's BVH built compact.
+  ExtractOptions compact = Options("compact");
+  compact.max_memory = static_cast<std::uint64_t>(0.9 * double(one_pass));
+  auto report = Extract(compact);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  EXPECT_EQ(report->plan.tracer, ExtractPlan::Tracer::kWholeSculpt);
+  EXPECT_TRUE(report->plan.compact_bvh);
+  EXPECT_EQ(report->plan.sculpt_parts, 0);
+  EXPECT_LE(report->plan.memory_estimate, compact.max_memory);
+  EXPECT_EQ(report->settings.search_distance, expected->settings.search_distance);
+  EXPECT_TRUE(SaysInAWarning(*report, "built compact at medium quality"));
+  same_map(compact, "compact");
+  const std::uint64_t compact_pass = report->plan.memory_estimate;
+
+  // Under what the compact BVH needs: traced in runs.
   int last_parts = 1;
-  for (double fraction : {0.6, 0.4}) {
+  for (double fraction : {0.85, 0.7}) {
     ExtractOptions limited = Options("parts");
-    limited.max_memory = static_cast<std::uint64_t>(fraction * double(one_pass));
-    auto report = Extract(limited);
+    limited.max_memory = static_cast<std::uint64_t>(fraction * double(compact_pass));
+    report = Extract(limited);
     ASSERT_TRUE(report.ok()) << report.status().message();
     EXPECT_EQ(report->plan.tracer, ExtractPlan::Tracer::kInParts);
+    EXPECT_FALSE(report->plan.compact_bvh);
     EXPECT_GT(report->plan.sculpt_parts, last_parts) << "a smaller budget, more parts";
     last_parts = report->plan.sculpt_parts;
     EXPECT_LE(report->plan.memory_estimate, limited.max_memory);
     EXPECT_EQ(report->plan.memory_limit, limited.max_memory);
     EXPECT_EQ(report->settings.search_distance, expected->settings.search_distance);
-    EXPECT_TRUE(Slurp(limited.output_path) == Slurp(whole.output_path))
-        << "in " << report->plan.sculpt_parts << " parts the map differs from the whole BVH's";
-    if (GetParam().uv_maps) {
-      const auto tiles = Tiles(limited.uv_maps_dir, "parts");
-      EXPECT_FALSE(tiles.empty());
-      EXPECT_TRUE(tiles == Tiles(whole.uv_maps_dir, "whole")) << "the UV-space tiles differ";
-    }
+    same_map(limited, "parts");
     const std::string said = "traced in " + std::to_string(report->plan.sculpt_parts) + " parts";
-    EXPECT_TRUE(
-        std::any_of(report->warnings.begin(), report->warnings.end(),
-                    [&](const std::string& w) { return w.find(said) != std::string::npos; }))
-        << "no warning says: " << said;
+    EXPECT_TRUE(SaysInAWarning(*report, said)) << "no warning says: " << said;
   }
 }
 
