@@ -664,6 +664,17 @@ void ReportDisplacement(const GroundTruth& truth, const std::vector<float>& tang
   }
 }
 
+// What every report says of the frame the pattern was evaluated in, and the cage's ignored tags.
+MakeSculptReport FrameReport(const Mesh& cage, const PatternFrame& frame) {
+  MakeSculptReport report;
+  report.amplitude = frame.amplitude;
+  report.diagonal = frame.diagonal;
+  report.edge = frame.edge;
+  report.frame = frame;
+  report.warnings = IgnoredTagWarnings(cage);
+  return report;
+}
+
 // MakeSculpt with options.streamed: the refinement written as it is evaluated, without truth.
 StatusOr<MakeSculptReport> MakeStreamedSculpt(const MakeSculptOptions& options, const Mesh& cage,
                                               const LimitSurface& surface,
@@ -674,19 +685,14 @@ StatusOr<MakeSculptReport> MakeStreamedSculpt(const MakeSculptOptions& options, 
       verify::StreamedSculpt sculpt,
       verify::WriteStreamedRefinement(cage, surface, options.levels, pattern, options.output_path,
                                       SculptComment(options, frame)));
-  MakeSculptReport report;
+  MakeSculptReport report = FrameReport(cage, frame);
   report.vertices = sculpt.vertices;
   report.faces = sculpt.faces;
-  report.amplitude = frame.amplitude;
-  report.diagonal = frame.diagonal;
-  report.edge = frame.edge;
-  report.frame = frame;
   report.h_min = sculpt.h_min;
   report.h_max = sculpt.h_max;
   report.max_displacement = sculpt.max_displacement;
   report.max_tangential = sculpt.max_tangential;
   report.linear_error = std::numeric_limits<double>::quiet_NaN();
-  report.warnings = IgnoredTagWarnings(cage);
   report.seconds = clock.seconds();
   return report;
 }
@@ -718,17 +724,12 @@ StatusOr<MakeSculptReport> MakeSculpt(const MakeSculptOptions& options) {
   truth.local_error = LocalErrors(sculpt, quality.face_errors);
   DISPEX_RETURN_IF_ERROR(WriteSculpt(options, frame, sculpt, truth));
 
-  MakeSculptReport report;
+  MakeSculptReport report = FrameReport(cage, frame);
   report.vertices = sculpt.num_vertices();
   report.faces = sculpt.num_faces();
-  report.amplitude = frame.amplitude;
-  report.diagonal = frame.diagonal;
-  report.edge = frame.edge;
-  report.frame = frame;
   ReportDisplacement(truth, tangential, report);
   report.linear_error = quality.linear_error;
   report.folded_faces = quality.folded_faces;
-  report.warnings = IgnoredTagWarnings(cage);
   report.seconds = clock.seconds();
   return report;
 }
