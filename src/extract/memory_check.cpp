@@ -21,9 +21,9 @@ constexpr double kReadPeakFactor = 1.5;
 // Embree's BVH over quads at medium quality, per primitive (incl. its build scratch).
 constexpr double kBvhBytesPerPrimitive = 80;
 // The same built compact (RTC_SCENE_FLAG_COMPACT, medium quality). Measured through rays with
-// the whole sculpt's BVH (bench/film-scale's sculpts, peak less the sculpt's arrays): 72 bytes
-// a quad on the body (16.9M quads), 69 on 135.3M quads, against 143 without compact; per
-// primitive as counted here (2 a quad), 36 and 72.
+// the whole sculpt's BVH (bench/film-scale's sculpts, peak less the sculpt's arrays): 74 bytes
+// a quad on the body (16.9M quads), 72 on 135.3M quads, against 143 at low quality without
+// compact; per primitive as counted here (2 a quad), 37 and 36 against 72.
 constexpr double kCompactBvhBytesPerPrimitive = 40;
 // MatchRefinedSculpt's peak per sculpt face, its half-edge adjacency (dispex/correspondence.h).
 constexpr std::uint64_t kMatchBytesPerFace = 40;
