@@ -598,25 +598,13 @@ GroundTruth Displace(SculptLayoutMesh& layout, const verify::PatternField& patte
                         Float3& p = sculpt.positions[v];
                         const float xyz[3] = {p.x, p.y, p.z};
                         const float* normal = &layout.normals[3 * v];
-                        // D, and h = D.N (for the scalar patterns the pattern's h itself, D = h N).
-                        const PtexFaceId face = truth.faces[v];
-                        const float u = truth.uvs[2 * v], w = truth.uvs[2 * v + 1];
-                        double d[3], h;
-                        if (pattern.vector()) {
-                          pattern.Displacement(face, u, w, xyz, normal, d);
-                          h = d[0] * normal[0] + d[1] * normal[1] + d[2] * normal[2];
-                        } else {
-                          h = pattern(face, u, w, xyz);
-                          for (int i = 0; i < 3; ++i) d[i] = h * normal[i];
-                        }
-                        double t2 = 0;
-                        for (int i = 0; i < 3; ++i) {
-                          truth.d[3 * v + i] = static_cast<float>(d[i]);
-                          const double t = d[i] - h * normal[i];
-                          t2 += t * t;
-                        }
+                        double d[3], t;
+                        const double h =
+                            pattern.HeightAndDisplacement(truth.faces[v], truth.uvs[2 * v],
+                                                          truth.uvs[2 * v + 1], xyz, normal, d, &t);
+                        for (int i = 0; i < 3; ++i) truth.d[3 * v + i] = static_cast<float>(d[i]);
                         truth.h[v] = static_cast<float>(h);
-                        tangential[v] = static_cast<float>(std::sqrt(t2));
+                        tangential[v] = static_cast<float>(t);
                         p.x = static_cast<float>(p.x + d[0]);
                         p.y = static_cast<float>(p.y + d[1]);
                         p.z = static_cast<float>(p.z + d[2]);

@@ -5,6 +5,7 @@
 // make_sculpt.cpp evaluates it at the sculpt's vertices and at its faces' centres.
 #pragma once
 
+#include <cmath>
 #include <optional>
 
 #include "dispex/mesh.h"
@@ -40,6 +41,24 @@ class PatternField {
       return EvaluatePatternVector(pattern_, frame_, position, normal, d);
     const double h = (*this)(face, u, v, position);
     for (int i = 0; i < 3; ++i) d[i] = h * normal[i];
+  }
+
+  // D there as Displacement gives it, and h = D.N: for the scalar patterns the pattern's h
+  // itself (D = h N). `*tangential`: |D - h N|.
+  double HeightAndDisplacement(PtexFaceId face, float u, float v, const float position[3],
+                               const float normal[3], double d[3], double* tangential) const {
+    double h;
+    if (vector()) {
+      EvaluatePatternVector(pattern_, frame_, position, normal, d);
+      h = d[0] * normal[0] + d[1] * normal[1] + d[2] * normal[2];
+    } else {
+      h = (*this)(face, u, v, position);
+      for (int i = 0; i < 3; ++i) d[i] = h * normal[i];
+    }
+    double t2 = 0;
+    for (int i = 0; i < 3; ++i) t2 += (d[i] - h * normal[i]) * (d[i] - h * normal[i]);
+    *tangential = std::sqrt(t2);
+    return h;
   }
 
   bool vector() const { return IsVectorPattern(pattern_); }

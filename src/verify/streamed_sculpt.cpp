@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <span>
 #include <vector>
 
 namespace dispex::verify {
@@ -140,39 +141,37 @@ std::vector<Job> PlanJobs(const Mesh& cage, const StreamLayout& layout, int n) {
   return jobs;
 }
 
-// The job's points' (u, v) on its face, in slot order.
-void JobUvs(const Mesh& cage, const Job& job, int n, std::vector<float>& uv) {
-  uv.resize(2 * std::size_t(job.count));
-  const float* a = kCornerUv[job.k];
-  if (job.kind == Job::kCorner) {
-    uv[0] = a[0], uv[1] = a[1];
-    return;
-  }
-  if (job.kind == Job::kEdge) {
-    auto c = cage.face(std::size_t(job.face));
-    const float* b = kCornerUv[(job.k + 1) % 4];
-    const bool from_corner = c[job.k] < c[(job.k + 1) % 4];
-    for (int s = 1; s < n; ++s) {
-      const float t = float(from_corner ? s : n - s) / float(n);  // exact: n is a power of two
-      uv[2 * std::size_t(s - 1)] = a[0] + t * (b[0] - a[0]);
-      uv[2 * std::size_t(s - 1) + 1] = a[1] + t * (b[1] - a[1]);
-    }
-    return;
-  }
-  std::size_t at = 0;
+// Every face's inner points' (u, v), row by row (exact: n is a power of two).
+std::vector<float> InnerUvs(int n) {
+  std::vector<float> uv;
+  uv.reserve(2 * std::size_t(n - 1) * std::size_t(n - 1));
   for (int j = 1; j < n; ++j) {
-    for (int i = 1; i < n; ++i) {
-      uv[at++] = float(i) / float(n);
-      uv[at++] = float(j) / float(n);
-    }
+    for (int i = 1; i < n; ++i) uv.insert(uv.end(), {float(i) / float(n), float(j) / float(n)});
   }
+  return uv;
 }
 
-struct DisplacementRange {
-  double h_min = std::numeric_limits<double>::infinity();
-  double h_max = -std::numeric_limits<double>::infinity();
-  double max_displacement = 0, max_tangential = 0;
-};
+// The job's points' (u, v) on its face, in slot order: `inner` for a face's inner points, else
+// written to `scratch`.
+std::span<const float> JobUvs(const Mesh& cage, const Job& job, int n,
+                              const std::vector<float>& inner, std::vector<float>& scratch) {
+  if (job.kind == Job::kInner) return inner;
+  scratch.resize(2 * std::size_t(job.count));
+  const float* a = kCornerUv[job.k];
+  if (job.kind == Job::kCorner) {
+    scratch[0] = a[0], scratch[1] = a[1];
+    return scratch;
+  }
+  auto c = cage.face(std::size_t(job.face));
+  const float* b = kCornerUv[(job.k + 1) % 4];
+  const bool from_corner = c[job.k] < c[(job.k + 1) % 4];
+  for (int s = 1; s < n; ++s) {
+    const float t = float(from_corner ? s : n - s) / float(n);
+    scratch[2 * std::size_t(s - 1)] = a[0] + t * (b[0] - a[0]);
+    scratch[2 * std::size_t(s - 1) + 1] = a[1] + t * (b[1] - a[1]);
+  }
+  return scratch;
+}
 
 }  // namespace
 
@@ -180,7 +179,7 @@ StatusOr<StreamedSculpt> WriteStreamedRefinement(const Mesh& cage, const LimitSu
                                                  int levels, const PatternField& pattern,
                                                  const std::string& path,
                                                  std::string_view comment) {
-  const std::string& name = cage.source.empty() ? std::string("cage") : cage.source;
+  const std::string name = cage.source.empty() ? "cage" : cage.source;
   if (cage.num_faces() == 0) return Status::Error(fmt::format("{}: no faces", name));
   for (std::size_t f = 0; f < cage.num_faces(); ++f) {
     if (cage.face_size(int(f)) != 4) {
@@ -218,7 +217,8 @@ StatusOr<StreamedSculpt> WriteStreamedRefinement(const Mesh& cage, const LimitSu
   constexpr std::int64_t kChunkPoints = std::int64_t(1) << 22;
   tbb::enumerable_thread_specific<std::optional<LimitEvaluator>> evaluators;
   tbb::enumerable_thread_specific<std::vector<float>> uv_scratch, normal_scratch;
-  tbb::combinable<DisplacementRange> ranges;
+  tbb::combinable<StreamedSculpt> ranges;
+  const std::vector<float> inner_uvs = InnerUvs(n);
   std::atomic<bool> failed{false};
   std::vector<float> points;
   for (std::size_t begin = 0; begin < jobs.size();) {
@@ -234,9 +234,8 @@ StatusOr<StreamedSculpt> WriteStreamedRefinement(const Mesh& cage, const LimitSu
       const Job& job = jobs[j];
       auto& evaluator = evaluators.local();
       if (!evaluator) evaluator.emplace(surface);
-      std::vector<float>& uv = uv_scratch.local();
+      const std::span<const float> uv = JobUvs(cage, job, n, inner_uvs, uv_scratch.local());
       std::vector<float>& normals = normal_scratch.local();
-      JobUvs(cage, job, n, uv);
       normals.resize(3 * std::size_t(job.count));
       std::span<float> p(&points[3 * std::size_t(job.first - chunk_first)],
                          3 * std::size_t(job.count));
@@ -244,25 +243,19 @@ StatusOr<StreamedSculpt> WriteStreamedRefinement(const Mesh& cage, const LimitSu
         failed = true;
         return;
       }
-      DisplacementRange& range = ranges.local();
+      StreamedSculpt& range = ranges.local();
       for (std::int64_t v = 0; v < job.count; ++v) {
         float* xyz = &p[3 * std::size_t(v)];
-        const float* normal = &normals[3 * std::size_t(v)];
-        double d[3];
-        pattern.Displacement(PtexFaceId(job.face), uv[2 * std::size_t(v)],
-                             uv[2 * std::size_t(v) + 1], xyz, normal, d);
-        const double h = d[0] * normal[0] + d[1] * normal[1] + d[2] * normal[2];
-        double t2 = 0, d2 = 0;
-        for (int i = 0; i < 3; ++i) {
-          const double t = d[i] - h * normal[i];
-          t2 += t * t;
-          d2 += d[i] * d[i];
-          xyz[i] = static_cast<float>(xyz[i] + d[i]);
-        }
+        double d[3], tangential;
+        const double h = pattern.HeightAndDisplacement(
+            PtexFaceId(job.face), uv[2 * std::size_t(v)], uv[2 * std::size_t(v) + 1], xyz,
+            &normals[3 * std::size_t(v)], d, &tangential);
+        for (int i = 0; i < 3; ++i) xyz[i] = static_cast<float>(xyz[i] + d[i]);
         range.h_min = std::min(range.h_min, h);
         range.h_max = std::max(range.h_max, h);
-        range.max_displacement = std::max(range.max_displacement, std::sqrt(d2));
-        range.max_tangential = std::max(range.max_tangential, std::sqrt(t2));
+        range.max_displacement =
+            std::max(range.max_displacement, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+        range.max_tangential = std::max(range.max_tangential, tangential);
       }
     });
     if (failed) {
@@ -286,20 +279,15 @@ StatusOr<StreamedSculpt> WriteStreamedRefinement(const Mesh& cage, const LimitSu
   }
   DISPEX_RETURN_IF_ERROR(out.Commit());
 
-  StreamedSculpt result;
-  result.vertices = std::size_t(layout.vertices());
-  result.faces = std::size_t(faces);
-  const DisplacementRange all = ranges.combine([](DisplacementRange a, const DisplacementRange& b) {
+  StreamedSculpt result = ranges.combine([](StreamedSculpt a, const StreamedSculpt& b) {
     a.h_min = std::min(a.h_min, b.h_min);
     a.h_max = std::max(a.h_max, b.h_max);
     a.max_displacement = std::max(a.max_displacement, b.max_displacement);
     a.max_tangential = std::max(a.max_tangential, b.max_tangential);
     return a;
   });
-  result.h_min = all.h_min;
-  result.h_max = all.h_max;
-  result.max_displacement = all.max_displacement;
-  result.max_tangential = all.max_tangential;
+  result.vertices = std::size_t(layout.vertices());
+  result.faces = std::size_t(faces);
   return result;
 }
 

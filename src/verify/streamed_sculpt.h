@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -19,7 +20,9 @@ namespace dispex::verify {
 
 struct StreamedSculpt {
   std::size_t vertices = 0, faces = 0;
-  double h_min = 0, h_max = 0;  // of D.N
+  // Over the vertices: the range of h = D.N, the largest |D| and |D - h N|.
+  double h_min = std::numeric_limits<double>::infinity();
+  double h_max = -std::numeric_limits<double>::infinity();
   double max_displacement = 0, max_tangential = 0;
 };
 

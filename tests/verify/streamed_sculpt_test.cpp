@@ -115,30 +115,24 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(StreamedSculptRefusals, NonQuadsHolesAndObjWriteNothing) {
   TempDir dir;
-  MakeSculptOptions nonquads = SculptOptions(DataPath("meshes/opensubdiv/catmark_nonquads.obj"),
-                                             dir / "s.ply", 2, Pattern::kDetail, 0);
-  nonquads.streamed = true;
-  auto made = MakeSculpt(nonquads);
-  ASSERT_FALSE(made.ok());
-  EXPECT_NE(made.status().message().find("corners: a streamed sculpt needs a cage of quads"),
-            std::string::npos)
-      << made.status().message();
-
-  MakeSculptOptions holes = SculptOptions(DataPath("meshes/opensubdiv/catmark_hole_test1.obj"),
-                                          dir / "s.ply", 2, Pattern::kDetail, 0);
-  holes.streamed = true;
-  made = MakeSculpt(holes);
-  ASSERT_FALSE(made.ok());
-  EXPECT_NE(made.status().message().find("is a hole"), std::string::npos)
-      << made.status().message();
-
-  MakeSculptOptions obj = SculptOptions(DataPath("meshes/opensubdiv/catmark_cube.obj"),
-                                        dir / "s.obj", 2, Pattern::kDetail, 0);
-  obj.streamed = true;
-  made = MakeSculpt(obj);
-  ASSERT_FALSE(made.ok());
-  EXPECT_NE(made.status().message().find("written as PLY"), std::string::npos)
-      << made.status().message();
+  struct Refusal {
+    const char* cage;
+    const char* output;
+    const char* says;
+  };
+  for (const Refusal& r : {
+           Refusal{"catmark_nonquads.obj", "s.ply",
+                   "corners: a streamed sculpt needs a cage of quads"},
+           Refusal{"catmark_hole_test1.obj", "s.ply", "is a hole"},
+           Refusal{"catmark_cube.obj", "s.obj", "written as PLY"},
+       }) {
+    MakeSculptOptions options = SculptOptions(DataPath(std::string("meshes/opensubdiv/") + r.cage),
+                                              dir / r.output, 2, Pattern::kDetail, 0);
+    options.streamed = true;
+    auto made = MakeSculpt(options);
+    ASSERT_FALSE(made.ok()) << r.cage;
+    EXPECT_NE(made.status().message().find(r.says), std::string::npos) << made.status().message();
+  }
   EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 
