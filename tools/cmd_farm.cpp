@@ -193,11 +193,24 @@ int RunFarmSlurm(FarmArgs& a) {
         return ReportFailure(plan.status().WithPrefix(where + " (--mem " + a.mem + ")"), 2);
       }
       if (auto_sculpt) sculpt = plan->shard_sculpt;
+      const std::string compact =
+          plan->compact_bytes > 0
+              ? fmt::format(" ({} with its BVH built compact)", MemorySize(plan->compact_bytes))
+              : "";
       if (auto_sculpt && sculpt == ShardSculpt::kPart) {
         std::fprintf(stderr,
-                     "dispex: asset %s: one extraction is estimated at %s, more than --mem %s: "
+                     "dispex: asset %s: one extraction is estimated at %s%s, more than --mem %s: "
                      "its shards keep only their part of the sculpt (--shard-sculpt part)\n",
-                     asset.name.c_str(), MemorySize(plan->whole_bytes).c_str(), a.mem.c_str());
+                     asset.name.c_str(), MemorySize(plan->whole_bytes).c_str(), compact.c_str(),
+                     a.mem.c_str());
+      }
+      if (auto_sculpt && plan->compact_bvh) {
+        std::fprintf(stderr,
+                     "dispex: asset %s: one extraction is estimated at %s%s, more than --mem %s "
+                     "at the asked BVH quality: its shards keep the whole sculpt and build its "
+                     "BVH compact\n",
+                     asset.name.c_str(), MemorySize(plan->whole_bytes).c_str(), compact.c_str(),
+                     a.mem.c_str());
       }
     }
     ExtractOptions o = asset.options;

@@ -546,14 +546,18 @@ Status ParseShard(std::string_view text, int& index, int& count);
 // What a shard of `options` keeps of the sculpt within `node_memory` bytes (a farm node's), from
 // the sculpt file's counts (CountMeshElements) and the estimates max_memory plans with: kWhole
 // when one extraction fits (a BVH of the whole sculpt where it may trace -- method kRays, or
-// kAuto should the match fail -- else the correspondence), else kPart (each shard traces only
-// the sculpt within reach of its faces, in parts when even that does not fit). kOverBudget,
+// kAuto should the match fail -- at the asked quality, else built compact at medium quality as
+// the shard's own memory plan does; where it does not trace, the correspondence), else kPart
+// (each shard traces only the sculpt within reach of its faces, in parts when even that does
+// not fit). kOverBudget,
 // naming the sculpt, when not even reading it, its arrays, its correspondence (where matched)
 // and the output fit.
 struct ShardMemoryPlan {
   ShardSculpt shard_sculpt = ShardSculpt::kWhole;
-  std::uint64_t whole_bytes = 0;  // one extraction at its peak
-  std::uint64_t floor_bytes = 0;  // any shard: reading, the arrays, the correspondence, output
+  std::uint64_t whole_bytes = 0;    // one extraction at its peak
+  std::uint64_t compact_bytes = 0;  // the same with the BVH built compact (0: not estimated)
+  bool compact_bvh = false;         // kWhole only with the sculpt's BVH built compact
+  std::uint64_t floor_bytes = 0;    // any shard: reading, the arrays, the correspondence, output
 };
 StatusOr<ShardMemoryPlan> PlanShardMemory(const ExtractOptions& options, std::uint64_t node_memory);
 

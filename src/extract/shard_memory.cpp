@@ -25,6 +25,13 @@ StatusOr<ShardMemoryPlan> PlanShardMemory(const ExtractOptions& options,
   plan.whole_bytes =
       std::max(plan.floor_bytes, need.arrays + need.output + (may_trace ? need.bvh : need.match));
   if (node_memory == 0 || plan.whole_bytes <= node_memory) return plan;
+  // A shard reads its job's memory limit and builds the BVH compact where that fits
+  // (SculptPartsWithin), so the whole sculpt may still fit the node.
+  if (may_trace) {
+    plan.compact_bytes = std::max(plan.floor_bytes, need.arrays + need.output + need.compact_bvh);
+    plan.compact_bvh = plan.compact_bytes <= node_memory;
+    if (plan.compact_bvh) return plan;
+  }
   if (plan.floor_bytes > node_memory) {
     return Status::Error(
         StatusCode::kOverBudget,
